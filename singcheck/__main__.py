@@ -1,0 +1,3 @@
+from singcheck.cli import main
+
+main()

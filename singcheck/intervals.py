@@ -1,0 +1,98 @@
+"""Rigorous interval (ball) evaluation of exact polynomials.
+
+Enclosures are FLINT ``arb`` balls (real) and ``acb`` balls (complex): every
+operation rounds outward, so the true value of an expression at any point of the
+input balls lies in the output ball.  FLINT's comparisons are certain: ``x > 0`` is
+True only when every point of ``x`` is positive, so a False says "not proven",
+never "proven false".  That is the three-valued logic a certificate needs.
+
+>>> from flint import fmpq_mpoly_ctx
+>>> ctx = fmpq_mpoly_ctx.get(("x", "y"), "lex")
+>>> x, y = ctx.gens()
+>>> b = evaluate(x**2 - 2*y, [arb(3), arb(1)])
+>>> b.contains(7) and b.rad() == 0
+True
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from fractions import Fraction
+
+from flint import acb, arb, ctx, fmpq, fmpq_mpoly
+
+Ball = arb | acb
+
+
+def fraction_ball(q: Fraction | int) -> arb:
+    """The ball of an exact rational (exact when dyadic, else a tight enclosure)."""
+    q = Fraction(q)
+    return arb(fmpq(q.numerator, q.denominator))
+
+
+def evaluate(poly: fmpq_mpoly, values: Sequence[Ball]) -> Ball:
+    """Enclose ``poly(values)``; ``values[i]`` is the ball of the i-th generator.
+
+    Powers are computed once per generator and exponent; each term is summed in
+    ball arithmetic, so the result encloses the exact value for every point of the
+    input balls.
+    """
+    powers: list[dict[int, Ball]] = [{0: arb(1), 1: v} for v in values]
+
+    def power(i: int, e: int) -> Ball:
+        cache = powers[i]
+        if e not in cache:
+            cache[e] = values[i] ** e
+        return cache[e]
+
+    total: Ball = arb(0)
+    for exps, coeff in poly.terms():
+        term: Ball = arb(coeff)
+        for i, e in enumerate(exps):
+            if e:
+                term = term * power(i, e)
+        total = total + term
+    return total
+
+
+def hull(lo: arb, hi: arb) -> arb:
+    """The smallest ball holding both balls (used for ``[lo, hi]`` intervals)."""
+    return lo.union(hi)
+
+
+def sign(x: arb) -> int | None:
+    """+1 or -1 when the sign of every point of ``x`` is proven, else None."""
+    if x > 0:
+        return 1
+    if x < 0:
+        return -1
+    return None
+
+
+def excludes_zero(x: Ball) -> bool:
+    """True only when 0 is provably not in the ball (real or complex)."""
+    if isinstance(x, acb):
+        return not x.real.contains(0) or not x.imag.contains(0)
+    return not x.contains(0)
+
+
+def endpoints(x: arb) -> tuple[float, float]:
+    """Floats ``lo ≤ x ≤ hi`` for every point of the ball (rounded outward)."""
+    import math
+
+    lo = float(x.lower())
+    hi = float(x.upper())
+    # float() rounds to nearest; step outward one ulp to keep the enclosure.
+    return math.nextafter(lo, -math.inf), math.nextafter(hi, math.inf)
+
+
+@contextmanager
+def working_precision(bits: int) -> Iterator[None]:
+    """Run a block with FLINT's ball precision raised to at least ``bits``; restore after."""
+    old = ctx.prec
+    ctx.prec = max(old, int(bits))
+    try:
+        yield
+    finally:
+        ctx.prec = old

@@ -1,0 +1,127 @@
+"""Trajectories made algebraic: polynomials in t, s = sin t and c = cos t.
+
+Every trajectory coordinate, and everything composed from it (μ(t) = ξ(φ(t)), the
+discriminants and joint-limit polynomials along the path), lives in the ring
+``TRIG = Q[t, s, c]`` taken modulo ``s² + c² - 1``.  The canonical representative
+has degree at most 1 in ``s`` (:func:`reduce_trig`), so two trig polynomials are
+equal as functions of t exactly when their reduced forms are equal.
+
+``sin(k t)`` and ``cos(k t)`` for integers k are expanded exactly with Chebyshev
+polynomials: ``cos(k t) = T_k(c)`` and ``sin(k t) = s · U_{k-1}(c)``.
+
+>>> str(cos_multiple(2))
+'2*c^2 - 1'
+>>> str(sin_multiple(2))
+'2*s*c'
+>>> str(reduce_trig(S**2 + C**2))
+'1'
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz_poly
+
+#: Q[t, s, c]; exponents are (t, s, c).
+TRIG = fmpq_mpoly_ctx.get(("t", "s", "c"), "lex")
+T, S, C = TRIG.gens()
+
+
+def reduce_trig(p: fmpq_mpoly) -> fmpq_mpoly:
+    """The representative of ``p`` modulo ``s² + c² - 1`` with degree ≤ 1 in s."""
+    if p.degrees()[1] < 2:
+        return p
+    one_minus_c2 = 1 - C**2
+    out = TRIG.from_dict({})
+    powers: dict[int, fmpq_mpoly] = {0: TRIG.from_dict({(0, 0, 0): 1})}
+    for (i, j, k), coeff in p.terms():
+        half, odd = divmod(j, 2)
+        if half not in powers:
+            powers[half] = one_minus_c2**half
+        out += TRIG.from_dict({(i, odd, k): coeff}) * powers[half]
+    return out
+
+
+def _chebyshev_in_c(poly: fmpz_poly) -> fmpq_mpoly:
+    return TRIG.from_dict({(0, 0, n): int(a) for n, a in enumerate(poly.coeffs()) if a != 0})
+
+
+def cos_multiple(k: int) -> fmpq_mpoly:
+    """``cos(k t)`` as a polynomial in c (exact, any integer k)."""
+    return _chebyshev_in_c(fmpz_poly.chebyshev_t(abs(k)))
+
+
+def sin_multiple(k: int) -> fmpq_mpoly:
+    """``sin(k t)`` as ``s`` times a polynomial in c (exact, any integer k)."""
+    if k == 0:
+        return TRIG.from_dict({})
+    u = _chebyshev_in_c(fmpz_poly.chebyshev_u(abs(k) - 1))
+    return S * u if k > 0 else -S * u
+
+
+def uses_t(p: fmpq_mpoly) -> bool:
+    """True when ``p`` depends on the bare parameter t (not only through sin/cos)."""
+    return p.degrees()[0] > 0
+
+
+def uses_trig(p: fmpq_mpoly) -> bool:
+    """True when ``p`` depends on sin t or cos t."""
+    d = p.degrees()
+    return d[1] > 0 or d[2] > 0
+
+
+@dataclass(frozen=True, order=False)
+class LinearInPi:
+    """An exact real number ``rational + pi_coefficient · π`` (range endpoints)."""
+
+    rational: Fraction
+    pi_coefficient: Fraction = Fraction(0)
+
+    def ball(self) -> arb:
+        """A rigorous enclosure at the current working precision."""
+        return arb(fmpq(self.rational.numerator, self.rational.denominator)) + arb(
+            fmpq(self.pi_coefficient.numerator, self.pi_coefficient.denominator)
+        ) * arb.pi()
+
+    def __float__(self) -> float:
+        return float(self.rational) + float(self.pi_coefficient) * 3.141592653589793
+
+    def __str__(self) -> str:
+        parts = []
+        if self.rational or not self.pi_coefficient:
+            parts.append(str(self.rational))
+        if self.pi_coefficient:
+            k = self.pi_coefficient
+            term = "pi" if k == 1 else "-pi" if k == -1 else f"{k}*pi"
+            parts.append(term if not parts or term.startswith("-") else "+" + term)
+        return "".join(parts)
+
+
+@dataclass(frozen=True)
+class TimeRange:
+    """The closed parameter range ``[start, end]`` of a trajectory, ``start < end``."""
+
+    start: LinearInPi
+    end: LinearInPi
+
+    def __str__(self) -> str:
+        return f"[{self.start}, {self.end}]"
+
+
+def derivative(p: fmpq_mpoly) -> fmpq_mpoly:
+    """d/dt of a trig polynomial: ∂p/∂t + c·∂p/∂s - s·∂p/∂c (reduced).
+
+    >>> str(derivative(S))
+    'c'
+    """
+    return reduce_trig(p.derivative("t") + C * p.derivative("s") - S * p.derivative("c"))
+
+
+def evaluate_trig(p: fmpq_mpoly, t: arb) -> arb:
+    """Rigorous enclosure of ``p(t, sin t, cos t)`` for every t in the ball ``t``."""
+    from singcheck.intervals import evaluate
+
+    s, c = t.sin_cos()
+    return evaluate(p, [t, s, c])

@@ -9,4 +9,5 @@ class ExitCode(IntEnum):
     USAGE = 2  #: bad command line or bad spec file
     UNKNOWN = 3  #: some trajectory could not be decided (and none is singular)
     BACKEND = 4  #: an elimination backend is missing or failed
+    INTERNAL = 70  #: a bug in singcheck (reported in one line; SINGCHECK_DEBUG=1 for details)
     INTERRUPTED = 130  #: Ctrl-C

@@ -111,10 +111,17 @@ class ExternalBackend:
     def script(self, request: EliminationRequest) -> str:
         return self.cas.script(request)
 
+    def cache_identity(self, request: EliminationRequest) -> str:
+        """What determines the result: the script and the library it loads."""
+        library = "singcheck.lib" if self.name == "singular" else "singcheck.m2"
+        with open(library_path(library), encoding="utf-8") as f:
+            return self.script(request) + "\n" + f.read()
+
     def eliminate(self, request: EliminationRequest) -> EliminationResult:
         script = self.script(request)
         with tempfile.TemporaryDirectory(prefix="singcheck-") as tmp:
-            path = os.path.join(tmp, f"{request.label}.{'sing' if self.name == 'singular' else 'm2'}")
+            suffix = "sing" if self.name == "singular" else "m2"
+            path = os.path.join(tmp, f"{request.label}.{suffix}")
             with open(path, "w", encoding="utf-8") as f:
                 f.write(script)
             run = run_program(self.cas.argv(self.executable, path), self.timeout, cwd=tmp)

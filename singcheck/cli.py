@@ -1,0 +1,259 @@
+"""The command line: the only place where errors become exit codes.
+
+stdout carries the result (a table, or JSON with ``--format json``); stderr carries
+progress, notes and errors.  Exit codes are :class:`~singcheck.exitcodes.ExitCode`.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import click
+
+from singcheck import __version__
+from singcheck.errors import BackendError, SingcheckError, SpecError
+from singcheck.exitcodes import ExitCode
+
+RUN_EPILOG = """\b
+Examples:
+  singcheck run robots/orthoglide.yaml trajectories/heart1.yaml
+  singcheck run robots/orthoglide.yaml trajectories/*.yaml --format json > report.json
+
+\b
+Exit status:
+  0  every trajectory is proven singularity-free
+  1  some trajectory is singular or infeasible
+  2  bad command line or bad spec file
+  3  some trajectory could not be decided (unknown), none singular
+  4  an elimination backend is missing or failed
+  130 interrupted
+"""
+
+
+class Progress:
+    """Progress notes on stderr (silent with --quiet)."""
+
+    def __init__(self, quiet: bool) -> None:
+        from rich.console import Console
+
+        self.quiet = quiet
+        self.console = Console(stderr=True, highlight=False)
+
+    def note(self, message: str) -> None:
+        if not self.quiet:
+            self.console.print(f"[dim]singcheck:[/dim] {message}")
+
+    def status(self, message: str):
+        from contextlib import nullcontext
+
+        if self.quiet or not self.console.is_terminal:
+            self.note(message)
+            return nullcontext()
+        return self.console.status(message)
+
+
+def _write_atomically(path: str, text: str) -> None:
+    target = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=target.parent or ".", prefix=f".{target.name}.",
+                               suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _fail(message: str, code: ExitCode) -> None:
+    click.echo(f"singcheck: error: {message}", err=True)
+    sys.exit(int(code))
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
+@click.version_option(__version__, prog_name="singcheck")
+def cli() -> None:
+    """Prove whether a parallel robot's trajectory is free of parallel singularities.
+
+    singcheck follows Jha, Chablat, Rouillier & Moroz (IDETC 2015): the robot
+    F(ρ, X) = 0 is projected onto its workspace (ξ(X), eliminating the joints), the
+    trajectory X = φ(t) is substituted, and every real root of μ(t) = ξ(φ(t)) is
+    isolated in a certified interval.  Each candidate is then classified per working
+    mode (inverse-kinematics branch) as a real singularity or a spurious one.
+
+    Answers are proven with exact arithmetic and rigorous ball arithmetic, or reported
+    as "unknown" with the reason; nothing is decided by sampling.
+    """
+
+
+@cli.command(epilog=RUN_EPILOG)
+@click.argument("robot", type=click.Path(dir_okay=False))
+@click.argument("trajectories", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.option("--backend", type=click.Choice(["auto", "singular", "macaulay2", "sympy"]),
+              default="auto", envvar="SINGCHECK_BACKEND", show_default=True, show_envvar=True,
+              help="Elimination engine for the robot's projection; auto picks Singular, else "
+                   "Macaulay2, else SymPy (see `singcheck backends`).")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=600,
+              show_default=True, help="Wall-clock limit in seconds for each CAS run.")
+@click.option("--no-cache", is_flag=True,
+              help="Neither read nor write the elimination cache (see `singcheck cache`).")
+@click.option("--tolerance", type=click.FloatRange(min=0, min_open=True), default=1e-9,
+              show_default=True, help="Width of the certified enclosure of each root in t.")
+@click.option("--format", "fmt", type=click.Choice(["table", "json"]), default="table",
+              show_default=True, help="table for people, json for programs (schema in README).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, writable=True),
+              help="Write the result to this file (atomically) instead of stdout.")
+@click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
+@click.option("-v", "--verbose", is_flag=True,
+              help="Show root enclosures and the proof used for every mode and candidate.")
+def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, quiet,
+        verbose) -> None:
+    """Certify each TRAJECTORY of ROBOT (YAML spec files).
+
+    For every trajectory it prints the candidate singular times (certified
+    enclosures of the roots of μ(t)), the pose and joints there, which working
+    modes are singular, whether each candidate is real or spurious for the feasible
+    mode(s), the working modes with their feasibility, and the verdict:
+    singularity-free, singular, infeasible or unknown.
+    """
+    progress = Progress(quiet)
+    try:
+        code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
+                    verbose, progress)
+    except KeyboardInterrupt:
+        _fail("interrupted", ExitCode.INTERRUPTED)
+    except SpecError as e:
+        _fail(str(e), ExitCode.USAGE)
+    except BackendError as e:
+        _fail(str(e), ExitCode.BACKEND)
+    except SingcheckError as e:
+        _fail(str(e), ExitCode.UNKNOWN)
+    sys.exit(int(code))
+
+
+def _exit_code(verdicts: list[str]) -> ExitCode:
+    if any(v in ("singular", "infeasible") for v in verdicts):
+        return ExitCode.SINGULAR
+    if any(v == "unknown" for v in verdicts):
+        return ExitCode.UNKNOWN
+    return ExitCode.SINGULARITY_FREE
+
+
+def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
+         progress):
+    from singcheck.cache import CachedBackend, EliminationCache
+    from singcheck.cas import get_backend
+    from singcheck.certify import certify_path
+    from singcheck.model import build_model
+    from singcheck.path import build_path
+    from singcheck.projection import project_robot
+    from singcheck.spec import load_robot, load_trajectory
+
+    spec = load_robot(robot)
+    specs = [load_trajectory(path, spec) for path in trajectories]
+    model = build_model(spec)
+    backend = get_backend(backend_name, timeout=timeout)
+    if backend_name == "auto":
+        progress.note(f"backend: {backend.name} {backend.version()} (auto)")
+    if not no_cache:
+        backend = CachedBackend(backend, EliminationCache())
+    with progress.status(f"projecting {spec.name} onto its workspace ({backend.name})"):
+        projection = project_robot(model, backend)
+    degree = projection.singularity_surface.total_degree()
+    progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
+    reports = []
+    for i, traj in enumerate(specs, 1):
+        with progress.status(f"[{i}/{len(specs)}] certifying {traj.name}"):
+            report = certify_path(build_path(projection, traj), tolerance)
+        progress.note(f"[{i}/{len(specs)}] {traj.name}: {report.verdict}")
+        reports.append(report)
+    code = _exit_code([r.verdict for r in reports])
+    text = _render(projection, reports, tolerance, fmt, verbose, code, to_file=bool(output))
+    if output:
+        _write_atomically(output, text)
+    else:
+        sys.stdout.write(text)
+    return code
+
+
+def _render(projection, reports, tolerance, fmt, verbose, code, to_file: bool) -> str:
+    from singcheck import report as rep
+
+    if fmt == "json":
+        return rep.to_json(rep.document(projection, reports, tolerance, int(code)))
+    from io import StringIO
+
+    from rich.console import Console
+
+    buffer = StringIO()
+    interactive = sys.stdout.isatty() and not to_file
+    console = Console(file=buffer, force_terminal=interactive, width=120 if not interactive
+                      else None, highlight=False)
+    rep.render_tables(console, projection, reports, verbose)
+    return buffer.getvalue()
+
+
+@cli.command()
+@click.option("--format", "fmt", type=click.Choice(["table", "json"]), default="table",
+              show_default=True)
+def backends(fmt) -> None:
+    """List the elimination backends: found or not, path, version, tested versions."""
+    from singcheck.cas import describe_backends
+
+    infos = describe_backends()
+    if fmt == "json":
+        import json
+
+        click.echo(json.dumps([info.__dict__ for info in infos], indent=2))
+        return
+    for info in infos:
+        state = "found" if info.found else "missing"
+        click.echo(f"{info.name:10} {state:8} {info.version or '-':10} {info.path or '-'}")
+        click.echo(f"{'':10} tested with {info.tested}" + (f"; {info.note}" if info.note else ""))
+
+
+@cli.group()
+def cache() -> None:
+    """The on-disk cache of elimination results (SINGCHECK_CACHE_DIR moves it)."""
+
+
+@cache.command("info")
+def cache_info() -> None:
+    """Where the cache is, and how many entries and bytes it holds."""
+    from singcheck.cache import EliminationCache
+
+    c = EliminationCache()
+    entries = c.entries()
+    size = sum(p.stat().st_size for p in entries)
+    click.echo(f"directory: {c.directory}\nentries:   {len(entries)}\nbytes:     {size}")
+
+
+@cache.command("clear")
+def cache_clear() -> None:
+    """Delete every cached elimination result."""
+    from singcheck.cache import EliminationCache
+
+    click.echo(f"removed {EliminationCache().clear()} entries")
+
+
+def main() -> None:
+    """Console-script entry point: never lets a traceback reach the user."""
+    try:
+        cli.main(standalone_mode=False)
+    except click.exceptions.Abort:
+        _fail("interrupted", ExitCode.INTERRUPTED)
+    except click.ClickException as e:
+        e.show()
+        sys.exit(int(ExitCode.USAGE))
+    except KeyboardInterrupt:
+        _fail("interrupted", ExitCode.INTERRUPTED)
+    except SystemExit:
+        raise
+    except Exception as e:  # a bug: say so in one line, keep the traceback for --debug users
+        if os.environ.get("SINGCHECK_DEBUG"):
+            raise
+        _fail(f"internal error: {type(e).__name__}: {e} (set SINGCHECK_DEBUG=1 for the "
+              "traceback, and please report it)", ExitCode.INTERNAL)

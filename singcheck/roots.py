@@ -1,0 +1,452 @@
+"""Certified isolation of the real roots of a trig polynomial on a time range.
+
+``isolate_real_roots(poly, interval)`` returns balls in t, each proven to hold exactly
+one root of ``poly(t, sin t, cos t)``, proves every gap between them root-free, and
+reports whatever it cannot prove as :class:`Undecided` with a reason.  Three methods:
+
+* **exact univariate** (no sin/cos): the squarefree factors of the polynomial in t
+  over Z; FLINT's ``arb_fmpz_poly_complex_roots`` certifies that each real-root ball
+  isolates one root (it returns real roots first, with imaginary part exactly zero).
+  The balls become rational intervals with a sign change, refined by exact bisection.
+* **tangent half-angle** (sin/cos only): u = tan(t/2), s = 2u/(1+u²),
+  c = (1-u²)/(1+u²) turn μ into M(u) = (1+u²)^d μ ∈ Q[u]; its real roots are isolated
+  as above and mapped to t = 2·atan(u) + 2kπ with Arb's rigorous ``atan``; t ≡ π
+  (u = ∞) is decided exactly by evaluating μ at s = 0, c = -1.
+* **interval branch-and-bound** (t mixed with sin/cos): a box is excluded when the ball
+  enclosure of μ over it (naive, or mean-value form) excludes 0; a box on which μ' excludes
+  0 is strictly monotone, so a proven sign change at its ends proves exactly one root
+  (and equal signs prove none).  Boxes that stay ambiguous down to the minimum width
+  become :class:`Undecided`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from flint import arb, fmpq, fmpq_mpoly, fmpq_poly, fmpz_poly
+
+from singcheck.errors import SingcheckError
+from singcheck.intervals import excludes_zero, sign, working_precision
+from singcheck.trig import (
+    LinearInPi,
+    TimeRange,
+    derivative,
+    evaluate_trig,
+    reduce_trig,
+    uses_t,
+    uses_trig,
+)
+
+EXACT = "exact univariate"
+HALF_ANGLE = "tangent half-angle"
+BRANCH_AND_BOUND = "interval branch-and-bound"
+
+
+class IdenticallyZeroError(SingcheckError):
+    """The function is identically zero along the path: it has no isolated roots."""
+
+
+@dataclass(frozen=True)
+class RealRoot:
+    t: arb  # holds exactly one root in the range
+    multiplicity: int | None  # exact where the method knows it
+    _refine: Callable[[float], arb] | None = field(default=None, compare=False, repr=False)
+
+    def refined(self, tolerance: float) -> RealRoot:
+        """The same root in a ball of width at most ``tolerance`` (when refinable)."""
+        if self._refine is None or 2 * float(self.t.rad()) <= tolerance:
+            return self
+        return RealRoot(self._refine(tolerance), self.multiplicity, self._refine)
+
+
+@dataclass(frozen=True)
+class Undecided:
+    t: arb
+    reason: str
+
+
+@dataclass(frozen=True)
+class RootIsolation:
+    roots: tuple[RealRoot, ...]
+    undecided: tuple[Undecided, ...]
+    method: str
+
+    @property
+    def certified(self) -> bool:
+        return not self.undecided
+
+
+def _bits(tolerance: float) -> int:
+    return max(53, int(-math.log2(tolerance)) + 30)
+
+
+def _q(x: float) -> fmpq:
+    """An exact rational for a positive float tolerance (tiny ones clamped to 2^-1000)."""
+    if x < 1e-300:
+        return fmpq(1, 2**1000)
+    num, den = x.as_integer_ratio()
+    return fmpq(num, den)
+
+
+def _ball(lo: fmpq, hi: fmpq) -> arb:
+    """A ball containing the rational interval [lo, hi], at a precision fine enough
+    that rounding does not widen it noticeably."""
+    width = hi - lo
+    bits = 60 + (int(-math.log2(float(width))) if width > 0 and float(width) > 0 else 200)
+    with working_precision(bits):
+        return arb(lo).union(arb(hi))
+
+
+def _to_fmpq(x: arb) -> fmpq:
+    man, exp = x.man_exp()
+    return fmpq(int(man) * 2**int(exp)) if exp >= 0 else fmpq(int(man), 2 ** (-int(exp)))
+
+
+# ---------------------------------------------------------------------------------
+# exact univariate isolation
+
+
+@dataclass
+class _RationalRoot:
+    """A root of a squarefree integer polynomial in [lo, hi] with a sign change (or lo == hi)."""
+
+    poly: fmpq_poly
+    lo: fmpq
+    hi: fmpq
+
+    def width(self) -> fmpq:
+        return self.hi - self.lo
+
+    def bisect_to(self, width: fmpq) -> None:
+        f = self.poly
+        slo = _qsign(f(self.lo))
+        if slo == 0:
+            self.hi = self.lo
+            return
+        if _qsign(f(self.hi)) == 0:
+            self.lo = self.hi
+            return
+        while self.hi - self.lo > width:
+            mid = (self.lo + self.hi) / 2
+            sm = _qsign(f(mid))
+            if sm == 0:
+                self.lo = self.hi = mid
+                return
+            if sm == slo:
+                self.lo = mid
+            else:
+                self.hi = mid
+
+    def ball(self) -> arb:
+        return _ball(self.lo, self.hi)
+
+
+def _qsign(q: fmpq) -> int:
+    return (q > 0) - (q < 0)
+
+
+def _real_roots_exact(p: fmpq_poly) -> list[tuple[_RationalRoot, int]]:
+    """Isolating rational intervals of the real roots of ``p``, with multiplicities."""
+    if p.degree() < 1:
+        return []
+    num = fmpz_poly([int(c * p.denom()) for c in p.coeffs()])
+    _, factors = num.factor_squarefree()
+    out = []
+    for factor, mult in factors:
+        f = fmpq_poly(factor)
+        for root, _ in factor.complex_roots():
+            if root.imag != 0:
+                continue
+            r = root.real
+            lo, hi = _to_fmpq(r.mid()) - _to_fmpq(r.rad()), _to_fmpq(r.mid()) + _to_fmpq(r.rad())
+            out.append((_RationalRoot(f, lo, hi), mult))
+    out.sort(key=lambda item: item[0].lo)
+    return out
+
+
+# ---------------------------------------------------------------------------------
+# comparing times with the range ends
+
+
+def _relation(t: arb, exact: LinearInPi | None, end: LinearInPi, bits: int) -> int | None:
+    """-1 if t < end, 0 if t == end, +1 if t > end (proven), None if not decided."""
+    if exact is not None and exact == end:
+        return 0
+    with working_precision(bits):
+        e = end.ball()
+        if t.is_exact() and e.is_exact() and t == e:
+            return 0
+        if t < e:
+            return -1
+        if t > e:
+            return 1
+    return None
+
+
+def _inside(t: arb, exact: LinearInPi | None, interval: TimeRange, bits: int) -> bool | None:
+    a = _relation(t, exact, interval.start, bits)
+    b = _relation(t, exact, interval.end, bits)
+    if a is None or b is None:
+        return None
+    return a >= 0 and b <= 0
+
+
+def _locate(make_ball: Callable[[float], arb], exact: LinearInPi | None,
+            interval: TimeRange, tolerance: float) -> tuple[bool | None, arb]:
+    """Refine a root until it is proven inside or outside the range (or give up)."""
+    tol = tolerance
+    for _ in range(8):
+        t = make_ball(tol)
+        where = _inside(t, exact, interval, _bits(tol))
+        if where is not None:
+            return where, t
+        tol /= 1e6
+    return None, make_ball(tol)
+
+
+# ---------------------------------------------------------------------------------
+# the three methods
+
+
+def _as_univariate_t(p: fmpq_mpoly) -> fmpq_poly:
+    coeffs: dict[int, fmpq] = {}
+    for (i, _j, _k), c in p.terms():
+        coeffs[i] = coeffs.get(i, fmpq(0)) + c
+    return fmpq_poly([coeffs.get(i, fmpq(0)) for i in range(max(coeffs) + 1)])
+
+
+def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
+    roots, undecided = [], []
+    for rr, mult in _real_roots_exact(_as_univariate_t(p)):
+        def make(tol: float, rr=rr) -> arb:
+            rr.bisect_to(_q(tol))
+            return rr.ball()
+
+        exact = LinearInPi(_fraction(rr.lo)) if rr.lo == rr.hi else None
+        where, t = _locate(make, exact, interval, tolerance)
+        if where is None:
+            undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
+        elif where:
+            roots.append(RealRoot(make(tolerance), mult, make))
+    return RootIsolation(tuple(roots), tuple(undecided), EXACT)
+
+
+def _fraction(q: fmpq):
+    from fractions import Fraction
+
+    return Fraction(int(q.p), int(q.q))
+
+
+def _half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
+    """M(u) = (1+u²)^d · p(2u/(1+u²), (1-u²)/(1+u²)) and d (p free of t)."""
+    d = max((j + k for (_i, j, k), _ in p.terms()), default=0)
+    u = fmpq_poly([0, 1])
+    one_plus = fmpq_poly([1, 0, 1])
+    one_minus = fmpq_poly([1, 0, -1])
+    total = fmpq_poly([])
+    for (_i, j, k), c in p.terms():
+        total += c * (2 * u) ** j * one_minus**k * one_plus ** (d - j - k)
+    return total, d
+
+
+def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
+    m, _ = _half_angle_polynomial(p)
+    at_pi = p.subs({"s": 0, "c": -1})
+    bases: list[tuple[Callable[[float], arb], LinearInPi | None, int]] = []
+    for rr, mult in _real_roots_exact(m):
+        def base(tol: float, rr=rr) -> arb:
+            rr.bisect_to(_q(tol) / 4)
+            with working_precision(_bits(tol)):
+                return 2 * rr.ball().atan()
+
+        exact = None
+        if rr.lo == rr.hi and rr.lo in (fmpq(0), fmpq(1), fmpq(-1)):
+            from fractions import Fraction
+
+            exact = LinearInPi(Fraction(0), Fraction(int(rr.lo.p), 2))
+        bases.append((base, exact, mult))
+    if at_pi.is_zero():
+        from fractions import Fraction
+
+        def base_pi(tol: float) -> arb:
+            with working_precision(_bits(tol)):
+                return arb.pi()
+
+        # multiplicity of t = π: the degree drop of M counts it
+        bases.append((base_pi, LinearInPi(Fraction(0), Fraction(1)), None))
+    roots, undecided = [], []
+    for base, exact, mult in bases:
+        for k in _periods(base(tolerance), interval):
+            def make(tol: float, base=base, k=k) -> arb:
+                with working_precision(_bits(tol)):
+                    return base(tol) + 2 * k * arb.pi()
+
+            shifted = None
+            if exact is not None:
+                shifted = LinearInPi(exact.rational, exact.pi_coefficient + 2 * k)
+            where, t = _locate(make, shifted, interval, tolerance)
+            if where is None:
+                undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
+            elif where:
+                roots.append(RealRoot(make(tolerance), mult, make))
+    roots.sort(key=lambda r: float(r.t.mid()))
+    return RootIsolation(tuple(roots), tuple(undecided), HALF_ANGLE)
+
+
+def _periods(t0: arb, interval: TimeRange) -> range:
+    """Every k for which t0 + 2kπ may meet the range (a superset)."""
+    two_pi = 2 * math.pi
+    lo = math.floor((float(interval.start) - float(t0.mid())) / two_pi) - 1
+    hi = math.ceil((float(interval.end) - float(t0.mid())) / two_pi) + 1
+    return range(lo, hi + 1)
+
+
+# --- branch and bound ------------------------------------------------------------
+
+_MAX_BOXES = 200_000
+_SPLIT = fmpq(1, 2) - fmpq(1, 97)  # off-centre, so a root rarely sits on a split point
+
+
+def _eval(p: fmpq_mpoly, lo: fmpq, hi: fmpq) -> arb:
+    return evaluate_trig(p, _ball(lo, hi))
+
+
+def _point(p: fmpq_mpoly, t: fmpq) -> arb:
+    return evaluate_trig(p, arb(t))
+
+
+def _excluded(p, dp, lo: fmpq, hi: fmpq) -> tuple[bool, arb]:
+    box = _ball(lo, hi)
+    naive = evaluate_trig(p, box)
+    if excludes_zero(naive):
+        return True, None
+    mid = (lo + hi) / 2
+    slope = evaluate_trig(dp, box)
+    centred = _point(p, mid) + slope * (box - arb(mid))
+    return excludes_zero(centred), slope
+
+
+def _bisect_root(p, lo: fmpq, hi: fmpq, s_lo: int, width: fmpq) -> tuple[fmpq, fmpq]:
+    """Shrink a bracketing box (sign s_lo at lo, opposite at hi) to ``width``."""
+    bits = 53
+    while hi - lo > width:
+        mid = (lo + hi) / 2
+        with working_precision(bits):
+            s = sign(_point(p, mid))
+        if s is None:
+            if bits > 4000:
+                break  # cannot separate further: return the current bracket
+            bits *= 2
+            continue
+        if s == s_lo:
+            lo = mid
+        else:
+            hi = mid
+    return lo, hi
+
+
+def _branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
+    dp = derivative(p)
+    a, b = interval.start.ball(), interval.end.ball()
+    lo0, hi0 = _to_fmpq(a.lower()), _to_fmpq(b.upper())
+    min_width = _q(max(tolerance, 1e-12) / 1000)
+    stack = [(lo0, hi0)]
+    found: list[tuple[fmpq, fmpq]] = []
+    exact_points: list[fmpq] = []
+    ambiguous: list[tuple[fmpq, fmpq, str]] = []
+    boxes = 0
+    while stack:
+        lo, hi = stack.pop()
+        boxes += 1
+        if boxes > _MAX_BOXES:
+            ambiguous.append((lo, hi, "the branch-and-bound budget ran out"))
+            ambiguous += [(l_, h_, "the branch-and-bound budget ran out") for l_, h_ in stack]
+            break
+        out, slope = _excluded(p, dp, lo, hi)
+        if out:
+            continue
+        if slope is not None and excludes_zero(slope):
+            f_lo, f_hi = _point(p, lo), _point(p, hi)
+            s_lo, s_hi = sign(f_lo), sign(f_hi)
+            if s_lo is not None and s_hi is not None:
+                if s_lo != s_hi:
+                    found.append((lo, hi, s_lo))
+                continue  # strictly monotone: one root, or none
+            for end, value in ((lo, f_lo), (hi, f_hi)):
+                if value.is_exact() and value == 0:
+                    exact_points.append(end)
+            if any(value.is_exact() and value == 0 for value in (f_lo, f_hi)) and \
+                    (s_lo is not None or s_hi is not None or lo == hi):
+                continue  # the root is the exact end point; monotone: no other
+        if hi - lo < min_width:
+            ambiguous.append((lo, hi, "possible multiple root or tangency: neither exclusion "
+                              "nor a monotone sign change could be proven"))
+            continue
+        cut = lo + (hi - lo) * _SPLIT
+        stack += [(cut, hi), (lo, cut)]
+    return _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambiguous)
+
+
+def _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambiguous):
+    roots, undecided = [], []
+    for lo, hi, s_lo in found:
+        bracket = {"lo": lo, "hi": hi}
+
+        def make(tol: float, bracket=bracket, s_lo=s_lo) -> arb:
+            w = _q(tol) / 2
+            bracket["lo"], bracket["hi"] = _bisect_root(p, bracket["lo"], bracket["hi"], s_lo, w)
+            return _ball(bracket["lo"], bracket["hi"])
+
+        where, t = _locate(make, None, interval, tolerance)
+        if where is None:
+            undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
+        elif where:
+            make(tolerance)
+            roots.append(RealRoot(_ball(bracket["lo"], bracket["hi"]), None, make))
+    for q in sorted(set(exact_points)):
+        t = arb(q)
+        where = _inside(t, None, interval, 53)
+        if where:
+            roots.append(RealRoot(t, None, None))
+    for lo, hi, reason in _merge(ambiguous):
+        box = _ball(lo, hi)
+        undecided.append(Undecided(box, f"{reason} near t ≈ {float(box.mid()):.6g}"))
+    roots = _dedupe(sorted(roots, key=lambda r: float(r.t.mid())))
+    return RootIsolation(tuple(roots), tuple(undecided), BRANCH_AND_BOUND)
+
+
+def _dedupe(roots: list[RealRoot]) -> list[RealRoot]:
+    """A root found as an exact box end and as a bracket is one root."""
+    out: list[RealRoot] = []
+    for r in roots:
+        if out and out[-1].t.overlaps(r.t) and (out[-1]._refine is None or r._refine is None):
+            keep = out[-1] if out[-1]._refine is None else r
+            out[-1] = keep
+            continue
+        out.append(r)
+    return out
+
+
+def _merge(boxes):
+    out = []
+    for lo, hi, reason in sorted(boxes):
+        if out and lo <= out[-1][1]:
+            out[-1] = (out[-1][0], max(hi, out[-1][1]), out[-1][2])
+        else:
+            out.append((lo, hi, reason))
+    return out
+
+
+def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
+                       tolerance: float = 1e-9) -> RootIsolation:
+    """Every real root of ``poly(t, sin t, cos t)`` on the closed range, certified."""
+    p = reduce_trig(poly)
+    if p.is_zero():
+        raise IdenticallyZeroError("the function is identically zero along the path")
+    if uses_t(p) and uses_trig(p):
+        return _branch_and_bound(p, interval, tolerance)
+    if uses_trig(p):
+        return _half_angle(p, interval, tolerance)
+    return _exact_univariate(p, interval, tolerance)

@@ -1,0 +1,45 @@
+"""Shared fixtures: the bundled robots and trajectories, parsed once per session."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+ROBOTS = ROOT / "robots"
+TRAJECTORIES = ROOT / "trajectories"
+
+
+@pytest.fixture(scope="session")
+def orthoglide():
+    from singcheck.model import build_model
+    from singcheck.spec import load_robot
+
+    return build_model(load_robot(ROBOTS / "orthoglide.yaml"))
+
+
+@pytest.fixture(scope="session")
+def orthoglide_projection(orthoglide):
+    from singcheck.cas import get_backend
+    from singcheck.projection import project_robot
+
+    return project_robot(orthoglide, get_backend("sympy"))
+
+
+@pytest.fixture(scope="session")
+def certify(orthoglide_projection):
+    """certify(name) -> TrajectoryReport for a bundled Orthoglide trajectory (cached)."""
+    from singcheck.certify import certify_path
+    from singcheck.path import build_path
+    from singcheck.spec import load_trajectory
+
+    cache = {}
+
+    def run(name: str):
+        if name not in cache:
+            spec = load_trajectory(TRAJECTORIES / f"{name}.yaml", orthoglide_projection.model.spec)
+            cache[name] = certify_path(build_path(orthoglide_projection, spec))
+        return cache[name]
+
+    return run

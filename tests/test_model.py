@@ -1,0 +1,118 @@
+"""The polynomial model and its projections, against the paper's formulas."""
+
+from __future__ import annotations
+
+import pytest
+from flint import fmpq_mpoly_ctx
+
+from singcheck.errors import UnsupportedRobotError
+from singcheck.model import build_model, determinant
+from singcheck.projection import joint_space_singularities
+from singcheck.spec import parse_robot
+
+R = fmpq_mpoly_ctx.get(("rho1", "rho2", "rho3", "x", "y", "z"), "lex")
+r1, r2, r3, x, y, z = R.gens()
+P = fmpq_mpoly_ctx.get(("x", "y", "z"), "lex")
+px, py, pz = P.gens()
+
+
+def test_det_A_is_the_papers(orthoglide):
+    # paper, Eq. (singlr): det A = -8ρ1ρ2ρ3 + 8ρ1ρ2 z + 8ρ1ρ3 y + 8ρ2ρ3 x
+    paper = -8 * r1 * r2 * r3 + 8 * r1 * r2 * z + 8 * r1 * r3 * y + 8 * r2 * r3 * x
+    assert orthoglide.det_A == paper
+
+
+def test_det_B_is_the_product_of_the_legs(orthoglide):
+    assert orthoglide.det_B == -8 * (x - r1) * (y - r2) * (z - r3)
+
+
+def test_joint_space_singularities_are_the_papers_epsilon(orthoglide):
+    from singcheck.cas import get_backend
+
+    eps = joint_space_singularities(orthoglide, get_backend("sympy"))
+    J = eps.context()
+    a, b, c = J.gens()
+    paper = (a**4 * b**2 + a**4 * c**2 + a**2 * b**4 + 2 * a**2 * b**2 * c**2 + a**2 * c**4
+             + b**4 * c**2 + b**2 * c**4 - 16 * a**2 * b**2 - 16 * a**2 * c**2 - 16 * b**2 * c**2)
+    assert eps == paper / paper.leading_coefficient()
+
+
+def test_singularity_surface_factor_structure(orthoglide_projection):
+    xi = orthoglide_projection.singularity_surface
+    raw = orthoglide_projection.singularity_surface_as_computed
+    _, factors = raw.factor()
+    degrees = sorted((f.total_degree(), m) for f, m in factors)
+    # norm of det A over the 8 modes: ξ14 · sphere^5 (README, "factor structure")
+    assert degrees == [(2, 5), (14, 1)]
+    sphere = px**2 + py**2 + pz**2 - 4
+    assert any(f == sphere for f, _ in factors)
+    # singcheck keeps the squarefree part: same zero set, simple factors, degree 16
+    assert xi.total_degree() == 16
+    assert sorted((f.total_degree(), m) for f, m in xi.factor()[1]) == [(2, 1), (14, 1)]
+
+
+def test_joint_limit_surfaces_are_the_papers(orthoglide_projection):
+    # paper, Eq. (cnstrnt): ρi = 0 -> x²+y²+z²-4 ; ρ1 = 4 -> x²+y²+z²-8x+12 …
+    surfaces = {(s.joint, s.bound): s.polynomial for s in
+                orthoglide_projection.joint_limit_surfaces}
+    sphere = px**2 + py**2 + pz**2 - 4
+    assert surfaces[("rho1", "min")] == sphere
+    assert surfaces[("rho2", "min")] == sphere
+    assert surfaces[("rho1", "max")] == px**2 + py**2 + pz**2 - 8 * px + 12
+    assert surfaces[("rho2", "max")] == px**2 + py**2 + pz**2 - 8 * py + 12
+    assert surfaces[("rho3", "max")] == px**2 + py**2 + pz**2 - 8 * pz + 12
+
+
+def test_workspace_boundary_is_the_leg_discriminants(orthoglide_projection):
+    d1, d2, d3 = orthoglide_projection.workspace_boundary
+    assert d1 == -4 * (py**2 + pz**2 - 4)
+    assert d3 == -4 * (px**2 + py**2 - 4)
+
+
+def test_determinant_of_a_3x3_matches_sarrus():
+    ctx = fmpq_mpoly_ctx.get(tuple("abcdefghi"), "lex")
+    a, b, c, d, e, f, g, h, i = ctx.gens()
+    m = ((a, b, c), (d, e, f), (g, h, i))
+    assert determinant(m) == a * e * i + b * f * g + c * d * h - c * e * g - b * d * i - a * f * h
+
+
+COUPLED = """\
+name: coupled
+joints: [p, q]
+pose: [x, y]
+constraints:
+  - x - p - q
+  - y - p*q
+"""
+
+CUBIC = """\
+name: cubic
+joints: [p, q]
+pose: [x, y]
+constraints:
+  - p^3 - x
+  - q - y
+"""
+
+NOT_MONIC = """\
+name: notmonic
+joints: [p, q]
+pose: [x, y]
+constraints:
+  - x*p^2 - 1
+  - q - y
+"""
+
+
+@pytest.mark.parametrize("text, line, phrase", [
+    (COUPLED, 5, "exactly one actuated joint"),
+    (CUBIC, 5, "degree 3 in p"),
+    (NOT_MONIC, 5, "depends on the pose"),
+])
+def test_robots_outside_the_leg_decoupled_class_are_refused(text, line, phrase):
+    with pytest.raises(UnsupportedRobotError) as err:
+        build_model(parse_robot(text, "r.yaml"))
+    message = str(err.value)
+    assert message.startswith(f"r.yaml:{line}:")
+    assert "constraints[0]" in message
+    assert phrase in message

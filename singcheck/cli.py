@@ -40,7 +40,7 @@ class Progress:
         from rich.console import Console
 
         self.quiet = quiet
-        self.console = Console(stderr=True, highlight=False)
+        self.console = Console(stderr=True, highlight=False, soft_wrap=True)
 
     def note(self, message: str) -> None:
         if not self.quiet:
@@ -190,8 +190,8 @@ def _render(projection, reports, tolerance, fmt, verbose, code, to_file: bool) -
 
     buffer = StringIO()
     interactive = sys.stdout.isatty() and not to_file
-    console = Console(file=buffer, force_terminal=interactive, width=120 if not interactive
-                      else None, highlight=False)
+    console = Console(file=buffer, force_terminal=interactive, width=None if interactive
+                      else 140, highlight=False)
     rep.render_tables(console, projection, reports, verbose)
     return buffer.getvalue()
 

@@ -82,7 +82,7 @@ def document(projection: RobotProjection, reports: list[TrajectoryReport], toler
                   "pose": list(model.pose)},
         "backend": projection.backend,
         "elimination_method": projection.method,
-        "singularity_surface_degree": projection.singularity_surface.total_degree(),
+        "singularity_surface_degree": int(projection.singularity_surface.total_degree()),
         "tolerance": tolerance,
         "trajectories": [trajectory_json(r) for r in reports],
         "exit_code": exit_code,
@@ -106,8 +106,6 @@ def render_tables(console, projection: RobotProjection, reports: list[Trajectory
         table = Table(title=title, title_justify="left")
         table.add_column("#", justify="right")
         table.add_column(spec.parameter, justify="right")
-        if verbose:
-            table.add_column(f"{spec.parameter} enclosure", justify="left")
         for v in model.pose:
             table.add_column(v, justify="right")
         feasible = [m.label for m in report.modes if m.feasible]
@@ -117,9 +115,6 @@ def render_tables(console, projection: RobotProjection, reports: list[Trajectory
         table.add_column("status")
         for i, c in enumerate(report.candidates, 1):
             row = [str(i), _num(float(c.t.mid()), 9)]
-            if verbose:
-                lo, hi = _interval(c.t)
-                row.append(f"[{lo:.12g}, {hi:.12g}]")
             row += [_num(float(b.mid()), 4) for b in c.pose]
             joints = c.joints.get(feasible[0], {}) if feasible else {}
             row += [_num(joints.get(j), 4) for j in model.joints]
@@ -146,8 +141,10 @@ def render_tables(console, projection: RobotProjection, reports: list[Trajectory
         console.print(modes)
         if verbose:
             for i, c in enumerate(report.candidates, 1):
-                proofs = "; ".join(f"{m.mode}: {m.status} ({m.proof})" for m in c.modes)
-                console.print(f"  candidate {i}: {proofs}")
+                lo, hi = _interval(c.t)
+                console.print(f"  candidate {i}: {spec.parameter} ∈ [{lo:.17g}, {hi:.17g}]")
+                for m in c.modes:
+                    console.print(f"    {m.mode}: {m.status} ({m.proof})")
         for t, reason in report.undecided:
             console.print(f"  undecided near {spec.parameter} ≈ {float(t.mid()):.6g}: {reason}")
         style = _VERDICT_STYLE.get(report.verdict, "bold")

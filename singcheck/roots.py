@@ -142,6 +142,13 @@ class _RationalRoot:
     def ball(self) -> arb:
         return _ball(self.lo, self.hi)
 
+    def pin(self, q: fmpq) -> bool:
+        """Collapse to ``q`` when it lies in the interval and is exactly a root."""
+        if self.lo <= q <= self.hi and self.poly(q) == 0:
+            self.lo = self.hi = q
+            return True
+        return False
+
 
 def _qsign(q: fmpq) -> int:
     return (q > 0) - (q < 0)
@@ -219,7 +226,12 @@ def _as_univariate_t(p: fmpq_mpoly) -> fmpq_poly:
 
 def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
     roots, undecided = [], []
+    ends = [fmpq(e.rational.numerator, e.rational.denominator)
+            for e in (interval.start, interval.end) if not e.pi_coefficient]
     for rr, mult in _real_roots_exact(_as_univariate_t(p)):
+        for q in ends:
+            rr.pin(q)
+
         def make(tol: float, rr=rr) -> arb:
             rr.bisect_to(_q(tol))
             return rr.ball()
@@ -256,6 +268,9 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
     at_pi = p.subs({"s": 0, "c": -1})
     bases: list[tuple[Callable[[float], arb], LinearInPi | None, int]] = []
     for rr, mult in _real_roots_exact(m):
+        for q in (fmpq(0), fmpq(1), fmpq(-1)):  # t = 0, ±π/2: exact, may be range ends
+            rr.pin(q)
+
         def base(tol: float, rr=rr) -> arb:
             rr.bisect_to(_q(tol) / 4)
             with working_precision(_bits(tol)):

@@ -96,10 +96,6 @@ class _Doc:
     def scalar(self, node, key: str) -> str:
         if not isinstance(node, yaml.ScalarNode):
             raise self.error(node, key, f"expected a single value, got {_kind(node)}")
-        if node.tag not in ("tag:yaml.org,2002:str", "tag:yaml.org,2002:int",
-                            "tag:yaml.org,2002:float", "tag:yaml.org,2002:null") \
-                and not node.tag.startswith("tag:yaml.org,2002:"):
-            raise self.error(node, key, f"tags like {node.tag} are not allowed")
         return str(node.value)
 
     def text(self, node, key: str) -> str:
@@ -163,8 +159,12 @@ def _compose(text: str, path: str):
     return node
 
 
+_PLAIN_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "null", "bool",
+                                                  "map", "seq")}
+
+
 def _refuse_tags(node, doc: _Doc) -> None:
-    if not node.tag.startswith("tag:yaml.org,2002:"):
+    if node.tag not in _PLAIN_TAGS:
         raise doc.error(node, None, f"YAML tags like {node.tag} are not allowed")
     children = []
     if isinstance(node, yaml.MappingNode):
@@ -236,7 +236,7 @@ def parse_robot(text: str, path: str) -> RobotSpec:
         constraints.append(poly)
         constraint_lines.append(_line(item))
     if not len(constraints) == len(joints) == len(pose):
-        raise doc.error(cnode, "constraints",
+        raise doc.error(top["constraints"][0], "constraints",
                         f"{len(constraints)} constraints for {len(joints)} joints and "
                         f"{len(pose)} pose variables: the system must be square")
     limits: dict[str, tuple[Fraction, Fraction]] = {}
@@ -312,7 +312,7 @@ def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
                         f"{extra[0]!r} is not a pose variable of robot {robot.name} "
                         f"(pose: {', '.join(robot.pose)})")
     if missing:
-        raise doc.error(top["pose"][1], "pose",
+        raise doc.error(top["pose"][0], "pose",
                         f"missing coordinate(s) {', '.join(missing)} of robot {robot.name}")
     coords = {}
     for v in robot.pose:

@@ -1,0 +1,133 @@
+"""Certified real-root isolation, checked against roots known in closed form."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import mpmath
+import pytest
+from flint import arb, fmpq, fmpz_poly
+
+from singcheck.roots import IdenticallyZeroError, isolate_real_roots
+from singcheck.trig import C, LinearInPi, S, T, TimeRange, cos_multiple, sin_multiple
+
+mpmath.mp.dps = 50
+PI = mpmath.pi
+
+
+def rng(a, b, pa=0, pb=0) -> TimeRange:
+    return TimeRange(LinearInPi(Fraction(a), Fraction(pa)), LinearInPi(Fraction(b), Fraction(pb)))
+
+
+def contains(ball: arb, x) -> bool:
+    lo, hi = mpmath.mpf(ball.lower().str(60, radius=False)), \
+        mpmath.mpf(ball.upper().str(60, radius=False))
+    # arb's printed endpoints are rounded; widen by a hair below the test's precision
+    return lo - mpmath.mpf(10) ** -40 <= x <= hi + mpmath.mpf(10) ** -40
+
+
+def assert_roots(iso, expected, width=1e-9):
+    assert iso.certified
+    assert len(iso.roots) == len(expected), [float(r.t.mid()) for r in iso.roots]
+    for root, x in zip(iso.roots, sorted(expected), strict=True):
+        assert contains(root.t, x), (root.t, x)
+        assert 2 * float(root.t.rad()) <= width
+
+
+def test_flint_returns_real_roots_first_with_zero_imaginary_part():
+    roots = (fmpz_poly([-2, 0, 1]) * fmpz_poly([1, 0, 1])).complex_roots()
+    assert [r.imag == 0 for r, _ in roots] == [True, True, False, False]
+    assert float(roots[0][0].real.mid()) < float(roots[1][0].real.mid())
+
+
+def test_polynomial_roots_and_a_complex_pair():
+    p = (T - fmpq(1, 3)) * (T - 2) * (T**2 + 1)
+    assert_roots(isolate_real_roots(p, rng(0, 5)), [mpmath.mpf(1) / 3, 2])
+    assert isolate_real_roots(p, rng(0, 5)).method == "exact univariate"
+
+
+def test_repeated_root_has_its_multiplicity():
+    iso = isolate_real_roots((T - 1) ** 2 * (T + 1), rng(-2, 2))
+    assert_roots(iso, [-1, 1])
+    assert [r.multiplicity for r in iso.roots] == [1, 2]
+
+
+def test_roots_at_and_just_outside_the_range_ends():
+    p = T * (T - 1) * (3 * T - 4)  # roots 0, 1, 4/3
+    assert_roots(isolate_real_roots(p, rng(0, 1)), [0, 1])
+    eps = Fraction(1, 10**12)
+    assert_roots(isolate_real_roots(p, rng(eps, Fraction(4, 3) - eps)), [1])
+
+
+def test_sine_on_minus_pi_to_pi_has_three_roots():
+    iso = isolate_real_roots(S, rng(0, 0, -1, 1))
+    assert iso.method == "tangent half-angle"
+    assert_roots(iso, [-PI, 0, PI])
+
+
+def test_sine_over_several_periods():
+    assert_roots(isolate_real_roots(S, rng(0, 20)), [k * PI for k in range(7)])
+    assert_roots(isolate_real_roots(S, rng(0, Fraction(1, 2), -3, 0)),
+                 [k * PI for k in range(-3, 1)])
+
+
+def test_cos_2t_is_one_half_at_four_points():
+    iso = isolate_real_roots(cos_multiple(2) - fmpq(1, 2), rng(0, 0, 0, 2))
+    assert_roots(iso, [PI / 6, 5 * PI / 6, 7 * PI / 6, 11 * PI / 6])
+
+
+def test_high_degree_trig_product_with_known_roots():
+    # (2s - 1)(5c - 3)(sin 7t) * (c^2 + 2)^15: degree > 40 in (s, c)
+    p = (2 * S - 1) * (5 * C - 3) * sin_multiple(7) * (C**2 + 2) ** 15
+    expected = [PI / 6, 5 * PI / 6, mpmath.atan2(4, 3), -mpmath.atan2(4, 3)]
+    expected += [k * PI / 7 for k in range(-7, 8)]
+    iso = isolate_real_roots(p, rng(0, 0, -1, 1))
+    assert_roots(iso, expected)
+
+
+def test_mixed_t_and_sine_by_branch_and_bound():
+    iso = isolate_real_roots(S - T / 20, rng(0, 20))
+    assert iso.method == "interval branch-and-bound"
+    f = lambda t: mpmath.sin(t) - t / 20  # noqa: E731
+    # independent cross-check (test only): sign changes of a fine scan, then findroot
+    grid = [mpmath.mpf(i) / 100 for i in range(1, 2001)]
+    brackets = [(a, b) for a, b in zip(grid, grid[1:], strict=False) if f(a) * f(b) < 0]
+    expected = [0] + [mpmath.findroot(f, (a, b), solver="bisect") for a, b in brackets]
+    assert_roots(iso, expected)
+
+
+def test_no_root_is_certified_empty():
+    iso = isolate_real_roots(2 + S + T / 100, rng(0, 20))
+    assert iso.roots == () and iso.certified
+
+
+@pytest.mark.slow
+def test_a_double_root_is_undecided_not_guessed():
+    # (sin t - t/20)^2 touches zero without crossing: branch-and-bound cannot prove it
+    iso = isolate_real_roots((S - T / 20) ** 2 + 0 * T, rng(1, 20))
+    assert not iso.certified
+    assert all("tangency" in u.reason or "multiple" in u.reason for u in iso.undecided)
+
+
+def test_identically_zero_is_refused():
+    with pytest.raises(IdenticallyZeroError):
+        isolate_real_roots(S**2 + C**2 - 1, rng(0, 1))
+
+
+def test_refinement_keeps_the_root():
+    for p, r in [(S - T / 20, rng(1, 4)), (5 * C - 3, rng(0, 2)), (T**2 - 2, rng(0, 2))]:
+        (root,) = isolate_real_roots(p, r).roots
+        fine = root.refined(1e-30)
+        assert 2 * float(fine.t.rad()) <= 1e-30
+        assert fine.t.overlaps(root.t)
+    (root,) = isolate_real_roots(T**2 - 2, rng(0, 2)).roots
+    assert contains(root.refined(1e-30).t, mpmath.sqrt(2))
+
+
+def test_pi_endpoint_is_exact():
+    # 1 + cos t vanishes exactly at t = pi, a range end
+    iso = isolate_real_roots(1 + C, rng(0, 0, 0, 1))
+    assert_roots(iso, [PI])
+    assert isolate_real_roots(1 + C, rng(0, 3)).roots == ()
+    assert math.isclose(float(isolate_real_roots(1 + C, rng(0, 4)).roots[0].t.mid()), math.pi)

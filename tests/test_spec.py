@@ -1,0 +1,189 @@
+"""Spec files: exact parsing, and one located line for every kind of bad input."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import pytest
+from flint import arb, fmpq
+
+from singcheck.errors import SpecError
+from singcheck.expr import ExprError, compile_constant, compile_trajectory_coordinate, parse
+from singcheck.spec import load_robot, load_trajectory, parse_robot, parse_trajectory
+from singcheck.trig import LinearInPi, evaluate_trig
+from tests.conftest import ROBOTS, TRAJECTORIES
+
+ROBOT = """\
+name: r
+joints: [p, q]
+pose: [x, y]
+parameters: {l: 2}
+constraints:
+  - (x - p)^2 + y^2 - l^2
+  - x^2 + (y - q)^2 - l^2
+joint_limits: {p: [0, 4]}
+"""
+
+TRAJ = """\
+name: c
+parameter: t
+range: [-pi, pi]
+pose:
+  x: cos(t)
+  y: sin(t)
+"""
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return parse_robot(ROBOT, "r.yaml")
+
+
+def test_numbers_are_exact():
+    assert compile_constant(parse("0.1")) == LinearInPi(Fraction(1, 10))
+    assert compile_constant(parse("1e-3")) == LinearInPi(Fraction(1, 1000))
+    assert compile_constant(parse("2/3 - 1/6")) == LinearInPi(Fraction(1, 2))
+    assert compile_constant(parse("-pi/2")) == LinearInPi(Fraction(0), Fraction(-1, 2))
+
+
+def test_precedence_power_binds_tighter_than_unary_minus():
+    assert compile_constant(parse("-2^2")) == LinearInPi(Fraction(-4))
+    assert compile_constant(parse("2^3^2")) == LinearInPi(Fraction(512))
+    assert compile_constant(parse("2**3*2")) == LinearInPi(Fraction(16))
+    assert compile_constant(parse("1 - 2 - 3")) == LinearInPi(Fraction(-4))
+    assert compile_constant(parse("12/2/3")) == LinearInPi(Fraction(2))
+
+
+@pytest.mark.parametrize("text", [
+    "8/7*sin(t)^3",
+    "13/14*cos(t) - 5/14*cos(2*t) - 1/10*cos(3*t) - 1/14*cos(4*t)",
+    "sin(-3*t)*cos(t*5) + t^2/7",
+    "(2*t)^2 - sin((2*t))",
+])
+def test_trig_expansion_agrees_with_direct_evaluation(text):
+    import mpmath
+
+    poly = compile_trajectory_coordinate(parse(text), "t", {})
+    env = {"sin": mpmath.sin, "cos": mpmath.cos}
+    for q in (Fraction(1, 3), Fraction(-7, 5), Fraction(22, 7)):
+        mpmath.mp.dps = 40
+        direct = eval(text.replace("^", "**"), env, {"t": mpmath.mpf(q.numerator) / q.denominator})
+        ball = evaluate_trig(poly, arb(fmpq(q.numerator, q.denominator)))
+        assert abs(float(ball.mid()) - float(direct)) < 1e-12
+
+
+def test_the_orthoglide_spec(orthoglide):
+    spec = orthoglide.spec
+    assert spec.joints == ("rho1", "rho2", "rho3") and spec.pose == ("x", "y", "z")
+    r1, r2, r3, x, y, z = spec.context.gens()
+    assert spec.constraints[0] == (x - r1) ** 2 + y**2 + z**2 - 4
+    assert spec.joint_limits["rho3"] == (0, 4)
+    assert spec.constraint_lines == (8, 9, 10)
+
+
+def test_heart1_range_is_exactly_minus_pi_to_pi(orthoglide):
+    traj = load_trajectory(TRAJECTORIES / "heart1.yaml", orthoglide.spec)
+    assert traj.range.start == LinearInPi(Fraction(0), Fraction(-1))
+    assert traj.range.end == LinearInPi(Fraction(0), Fraction(1))
+    assert str(traj.pose["z"]) == "1"
+
+
+BAD_ROBOTS = [
+    # (text, line, key, phrase)
+    (ROBOT.replace("(x - p)^2", "(x - w)^2"), 6, "constraints[0]", "undeclared name 'w'"),
+    (ROBOT.replace("(x - p)^2", "sin(x - p)"), 6, "constraints[0]", "must be polynomial"),
+    (ROBOT.replace("(x - p)^2", "(x - p)/y"), 6, "constraints[0]", "division by a non-constant"),
+    (ROBOT.replace("(x - p)^2", "(x - p)^-2"), 6, "constraints[0]", "non-negative integers"),
+    (ROBOT.replace("(x - p)^2", "(x - p)^(1/2)"), 6, "constraints[0]", "non-negative integers"),
+    (ROBOT.replace("(x - p)^2", "(x - p)^1000"), 6, "constraints[0]", "larger than 64"),
+    (ROBOT.replace("(x - p)^2", "2(x - p)"), 6, "constraints[0]", "missing operator"),
+    (ROBOT.replace("(x - p)^2", "((x - p)^2"), 6, "constraints[0]", "expected ')'"),
+    (ROBOT.replace("(x - p)^2", "pi*x"), 6, "constraints[0]", "pi is not allowed"),
+    (ROBOT.replace("  - x^2 + (y - q)^2 - l^2\n", ""), 5, "constraints", "must be square"),
+    (ROBOT.replace("name: r\n", ""), 1, "name", "missing required key"),
+    (ROBOT + "colour: red\n", 9, "colour", "unknown key"),
+    (ROBOT + "name: again\n", 9, None, "duplicate key 'name'"),
+    (ROBOT.replace("{p: [0, 4]}", "{p: [4, 0]}"), 8, "joint_limits.p", "must be smaller"),
+    (ROBOT.replace("{p: [0, 4]}", "{w: [0, 4]}"), 8, "joint_limits.w", "is not a joint"),
+    (ROBOT.replace("{p: [0, 4]}", "{p: [0, pi]}"), 8, "joint_limits.p", "exact rational"),
+    (ROBOT.replace("{l: 2}", "{l: two}"), 4, "parameters.l", "'two' is not allowed"),
+    (ROBOT.replace("pose: [x, y]", "pose: [x, p]"), 3, "pose", "both a joint and a pose"),
+    (ROBOT.replace("joints: [p, q]", "joints: [p, pi]"), 2, "joints[1]", "reserved"),
+    (ROBOT.split("constraints:")[0] + "constraints: 3\n", 5, "constraints", "non-empty list"),
+    (ROBOT.replace("  - (x - p)^2 + y^2 - l^2", "  - {a: 1}"), 6, "constraints[0]",
+     "single value"),
+    (ROBOT.replace("  - (x - p)^2 + y^2 - l^2", "  - x - x"), 6, "constraints[0]",
+     "identically zero"),
+    ("name: [unclosed\n", 2, None, "not valid YAML"),
+    ("", 1, None, "the file is empty"),
+    ("!!python/object/apply:os.system ['echo hacked']\n", 1, None, "not allowed"),
+    ("name: !!python/name:os.system x\n", 1, None, "not allowed"),
+    ("- just\n- a list\n", 1, None, "expected a mapping"),
+]
+
+
+@pytest.mark.parametrize("text, line, key, phrase", BAD_ROBOTS,
+                         ids=[p for *_, p in BAD_ROBOTS])
+def test_bad_robot_specs_get_one_located_line(text, line, key, phrase):
+    with pytest.raises(SpecError) as err:
+        parse_robot(text, "bad.yaml")
+    message = str(err.value)
+    assert "\n" not in message
+    assert message.startswith(f"bad.yaml:{line}:"), message
+    if key:
+        assert f" {key}:" in message, message
+    assert phrase in message, message
+
+
+BAD_TRAJECTORIES = [
+    (TRAJ.replace("[-pi, pi]", "[pi, pi]"), 3, "range", "empty range"),
+    (TRAJ.replace("[-pi, pi]", "[1, -1]"), 3, "range", "empty range"),
+    (TRAJ.replace("[-pi, pi]", "[0, pi^2]"), 3, "range[1]", "powers of pi"),
+    (TRAJ.replace("[-pi, pi]", "[0]"), 3, "range", "expected [start, end]"),
+    (TRAJ.replace("cos(t)", "cos(t + 1)"), 5, "pose.x", "integer multiple of t"),
+    (TRAJ.replace("cos(t)", "cos(t/2)"), 5, "pose.x", "integer multiple of t"),
+    (TRAJ.replace("cos(t)", "tan(t)"), 5, "pose.x", "unknown function 'tan'"),
+    (TRAJ.replace("cos(t)", "cos(s)"), 5, "pose.x", "integer multiple of t"),
+    (TRAJ.replace("cos(t)", "u"), 5, "pose.x", "undeclared name 'u'"),
+    (TRAJ.replace("  y: sin(t)\n", ""), 4, "pose", "missing coordinate(s) y"),
+    (TRAJ + "  z: 1\n", 7, "pose.z", "not a pose variable"),
+    (TRAJ.replace("parameter: t", "parameter: x"), 2, "parameter", "already a name"),
+    (TRAJ.replace("name: c\n", ""), 1, "name", "missing required key"),
+    (TRAJ + "speed: 2\n", 7, "speed", "unknown key"),
+]
+
+
+@pytest.mark.parametrize("text, line, key, phrase", BAD_TRAJECTORIES,
+                         ids=[p for *_, p in BAD_TRAJECTORIES])
+def test_bad_trajectory_specs_get_one_located_line(robot, text, line, key, phrase):
+    with pytest.raises(SpecError) as err:
+        parse_trajectory(text, "t.yaml", robot)
+    message = str(err.value)
+    assert "\n" not in message
+    assert message.startswith(f"t.yaml:{line}:"), message
+    assert f" {key}:" in message, message
+    assert phrase in message, message
+
+
+def test_unreadable_files(tmp_path):
+    with pytest.raises(SpecError, match="cannot read the file"):
+        load_robot(tmp_path / "missing.yaml")
+    latin = tmp_path / "latin.yaml"
+    latin.write_bytes(b"name: r\ndescription: caf\xe9\n")
+    with pytest.raises(SpecError, match=r"latin.yaml:2: the file is not UTF-8"):
+        load_robot(latin)
+    with pytest.raises(SpecError, match="cannot read the file"):
+        load_robot(tmp_path)
+
+
+def test_expression_errors_carry_a_column():
+    with pytest.raises(ExprError) as err:
+        parse("x + * y")
+    assert err.value.column == 5
+
+
+def test_bundled_specs_all_load():
+    from singcheck.model import build_model
+
+    for path in ROBOTS.glob("*.yaml"):
+        build_model(load_robot(path))

@@ -106,11 +106,35 @@ def joint_limit_surfaces(model: RobotModel, pose_ctx) -> tuple[JointLimitSurface
     return tuple(out)
 
 
+def norm_over_legs(model: RobotModel) -> fmpq_mpoly:
+    """``Res_ρn(… Res_ρ1(det A, F_1) …, F_n)``, computed in-process with FLINT.
+
+    For a leg-decoupled robot this is the product of det A over every (complex)
+    working mode, up to a non-zero constant: its zero set is exactly ξ's.
+    """
+    acc = model.det_A
+    for leg in model.legs:
+        acc = acc.resultant(leg.constraint, leg.joint)
+    return restrict(acc, _pose_context(model))
+
+
+def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str) -> None:
+    """Refuse a ξ whose zero set differs from the independently computed norm's.
+
+    Both are reduced to monic squarefree parts and compared exactly; a CAS result that
+    parsed but is wrong (or belongs to another request) fails here, loudly.
+    """
+    if squarefree_part(xi) != squarefree_part(norm_over_legs(model)):
+        raise BackendError(f"{backend}: the singularity surface it returned fails the "
+                           "re-check against the in-process norm of det A over the legs")
+
+
 def project_robot(model: RobotModel, backend: EliminationBackend) -> RobotProjection:
-    """Every workspace surface of the robot, with ξ from ``backend``."""
+    """Every workspace surface of the robot, with ξ from ``backend`` (re-checked)."""
     pose_ctx = _pose_context(model)
     result = backend.eliminate(singularity_surface_request(model))
     raw = _single(result, "singularity surface")
+    recheck_singularity_surface(model, raw, result.backend)
     xi = squarefree_part(raw)
     return RobotProjection(model, pose_ctx, xi, raw, workspace_boundary(model, pose_ctx),
                            joint_limit_surfaces(model, pose_ctx), result.backend, result.method)

@@ -116,3 +116,14 @@ def test_robots_outside_the_leg_decoupled_class_are_refused(text, line, phrase):
     assert message.startswith(f"r.yaml:{line}:")
     assert "constraints[0]" in message
     assert phrase in message
+
+
+def test_a_wrong_singularity_surface_fails_the_recheck(orthoglide, orthoglide_projection):
+    from singcheck.errors import BackendError
+    from singcheck.projection import recheck_singularity_surface
+
+    xi = orthoglide_projection.singularity_surface_as_computed
+    recheck_singularity_surface(orthoglide, xi, "test")  # the right one passes
+    for wrong in (xi * (px - 1), xi + 1, orthoglide_projection.workspace_boundary[0]):
+        with pytest.raises(BackendError, match="fails the re-check"):
+            recheck_singularity_surface(orthoglide, wrong, "test")

@@ -79,8 +79,41 @@ MACAULAY2 = ExternalCAS(
     "install it with `apt-get install macaulay2` (Debian/Ubuntu)")
 
 
+def _binary_identity(executable: str) -> str:
+    real = os.path.realpath(executable)
+    st = os.stat(real)
+    return f"{real}:{st.st_size}:{st.st_mtime_ns}"
+
+
 @cache
 def cas_version(cas: ExternalCAS, executable: str) -> str:
+    """The CAS version, remembered on disk per binary (path, size, mtime) so that a
+    warm run starts no CAS process at all."""
+    import json
+
+    from singcheck.cache import cache_dir
+
+    memo = cache_dir() / "versions.json"
+    ident = _binary_identity(executable)
+    try:
+        known = json.loads(memo.read_text(encoding="utf-8"))
+        if isinstance(known.get(ident), str):
+            return known[ident]
+    except (OSError, ValueError, AttributeError):
+        known = {}
+    version = _ask_version(cas, executable)
+    try:
+        memo.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=memo.parent, prefix=".tmp-", suffix=".json")
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            json.dump({**(known if isinstance(known, dict) else {}), ident: version}, f)
+        os.replace(tmp, memo)
+    except OSError:
+        pass
+    return version
+
+
+def _ask_version(cas: ExternalCAS, executable: str) -> str:
     run = run_program(cas.version_argv(executable), timeout=60)
     text = (run.stdout or run.stderr).strip().splitlines()
     if not text:

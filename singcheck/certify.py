@@ -12,6 +12,8 @@ What is proven, and how:
 * **Singular, by elimination.**  For a leg-decoupled robot the working modes list every
   complex solution of the inverse kinematics, so μ(τ) = 0 means some mode's det A
   vanishes at τ.  When every other mode is proven non-zero on T, it is this one.
+* **Singular, exactly.**  At a root known exactly (a point ball, e.g. t = 0) where every
+  enclosure is exact, det A evaluating to an exact 0 is a proof.
 * **Singular, by sign change.**  When det A along a real mode has proven opposite signs
   at the two ends of T, it vanishes inside T (intermediate values); that zero is a
   root of μ in T, hence τ itself (T isolates one root).
@@ -33,6 +35,7 @@ SINGULAR, REGULAR = "singular", "regular"
 BY_ELIMINATION = "elimination"
 BY_SIGN_CHANGE = "sign change"
 BY_EXCLUSION = "det A ≠ 0 (ball arithmetic)"
+BY_EXACT_ZERO = "det A = 0 exactly"
 
 VERDICT_FREE = "singularity-free"
 VERDICT_SINGULAR = "singular"
@@ -97,6 +100,16 @@ def _sign_at(path: PathModel, mode: WorkingMode, point: arb) -> int | None:
     return sign(value) if isinstance(value, arb) else None
 
 
+def _branches_continuous(path: PathModel, t: arb) -> bool:
+    """True when every quadratic leg's discriminant is proven > 0 on the whole ball:
+    then each branch is real and continuous there, as the intermediate value
+    theorem needs."""
+    from singcheck.trig import evaluate_trig
+
+    return all(leg.discriminant is None or evaluate_trig(leg.discriminant, t) > 0
+               for leg in path.legs)
+
+
 def _decide(path, modes, root: RealRoot):
     """One attempt at the given enclosure; returns ``{mode: ModeAtCandidate}``."""
     pose, joints, values = _mode_values(path, modes, root.t)
@@ -106,12 +119,17 @@ def _decide(path, modes, root: RealRoot):
         v = values[mode.label]
         if v is not None and excludes_zero(v):
             decided[mode.label] = ModeAtCandidate(mode.label, REGULAR, BY_EXCLUSION)
+        elif v is not None and v.is_exact() and v == 0:
+            # an exactly known root, evaluated without rounding: det A is 0 there
+            decided[mode.label] = ModeAtCandidate(mode.label, SINGULAR, BY_EXACT_ZERO)
         else:
             open_modes.append(mode)
     if len(open_modes) == 1:
         m = open_modes[0]
         decided[m.label] = ModeAtCandidate(m.label, SINGULAR, BY_ELIMINATION)
         open_modes = []
+    if open_modes and not _branches_continuous(path, root.t):
+        return pose, joints, decided
     for mode in open_modes:
         lo, hi = _sign_at(path, mode, root.t.lower()), _sign_at(path, mode, root.t.upper())
         if lo is not None and hi is not None and lo != hi:

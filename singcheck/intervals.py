@@ -81,10 +81,14 @@ def endpoints(x: arb) -> tuple[float, float]:
     """Floats ``lo ≤ x ≤ hi`` for every point of the ball (rounded outward)."""
     import math
 
-    lo = float(x.lower())
-    hi = float(x.upper())
-    # float() rounds to nearest; step outward one ulp to keep the enclosure.
-    return math.nextafter(lo, -math.inf), math.nextafter(hi, math.inf)
+    lo_ball, hi_ball = x.lower(), x.upper()
+    lo, hi = float(lo_ball), float(hi_ball)
+    # float() rounds to nearest: step outward one ulp unless the float is already outside
+    if not arb(lo) <= lo_ball:
+        lo = math.nextafter(lo, -math.inf)
+    if not arb(hi) >= hi_ball:
+        hi = math.nextafter(hi, math.inf)
+    return lo, hi
 
 
 @contextmanager

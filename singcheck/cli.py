@@ -46,6 +46,51 @@ class Progress:
         if not self.quiet:
             self.console.print(f"[dim]singcheck:[/dim] {message}")
 
+    def bar(self, total: int):
+        """A context giving ``advance(name, verdict)``: a bar on a terminal, else notes."""
+        from contextlib import contextmanager
+
+        @contextmanager
+        def plain():
+            done = [0]
+            step = max(1, total // 10)
+
+            def advance(name: str, verdict: str) -> None:
+                done[0] += 1
+                if total <= 20:
+                    self.note(f"[{done[0]}/{total}] {name}: {verdict}")
+                elif done[0] % step == 0 or done[0] == total:
+                    self.note(f"certified {done[0]}/{total} trajectories")
+
+            yield advance
+
+        @contextmanager
+        def rich_bar():
+            from rich.progress import (
+                BarColumn,
+                MofNCompleteColumn,
+                Progress,
+                TextColumn,
+                TimeRemainingColumn,
+            )
+
+            with Progress(TextColumn("certifying"), BarColumn(), MofNCompleteColumn(),
+                          TimeRemainingColumn(), console=self.console, transient=True) as bar:
+                task = bar.add_task("certify", total=total)
+
+                def advance(name: str, verdict: str) -> None:
+                    bar.advance(task)
+
+                yield advance
+            self.note(f"certified {total} trajectories")
+
+        if self.quiet:
+            @contextmanager
+            def silent():
+                yield lambda name, verdict: None
+            return silent()
+        return rich_bar() if self.console.is_terminal and total > 1 else plain()
+
     def status(self, message: str):
         from contextlib import nullcontext
 
@@ -106,10 +151,13 @@ def cli() -> None:
               show_default=True, help="table for people, json for programs (schema in README).")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, writable=True),
               help="Write the result to this file (atomically) instead of stdout.")
+@click.option("-j", "--jobs", type=click.IntRange(min=1), default=os.cpu_count() or 1,
+              show_default="number of cores",
+              help="Processes certifying trajectories in parallel (used for more than 4).")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
-def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, quiet,
+def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs, quiet,
         verbose) -> None:
     """Certify each TRAJECTORY of ROBOT (YAML spec files).
 
@@ -122,7 +170,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     progress = Progress(quiet)
     try:
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
-                    verbose, progress)
+                    verbose, progress, jobs)
     except KeyboardInterrupt:
         _fail("interrupted", ExitCode.INTERRUPTED)
     except SpecError as e:
@@ -143,12 +191,10 @@ def _exit_code(verdicts: list[str]) -> ExitCode:
 
 
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
-         progress):
+         progress, jobs):
     from singcheck.cache import CachedBackend, EliminationCache
     from singcheck.cas import get_backend
-    from singcheck.certify import certify_path
     from singcheck.model import build_model
-    from singcheck.path import build_path
     from singcheck.projection import project_robot
     from singcheck.spec import load_robot, load_trajectory
 
@@ -164,14 +210,9 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         projection = project_robot(model, backend)
     degree = projection.singularity_surface.total_degree()
     progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
-    reports = []
-    for i, traj in enumerate(specs, 1):
-        with progress.status(f"[{i}/{len(specs)}] certifying {traj.name}"):
-            report = certify_path(build_path(projection, traj), tolerance)
-        progress.note(f"[{i}/{len(specs)}] {traj.name}: {report.verdict}")
-        reports.append(report)
-    code = _exit_code([r.verdict for r in reports])
-    text = _render(projection, reports, tolerance, fmt, verbose, code, to_file=bool(output))
+    results = certify_all(projection, specs, tolerance, jobs, progress)
+    code = _exit_code([r["verdict"] for r in results])
+    text = _render(projection, results, tolerance, fmt, verbose, code, to_file=bool(output))
     if output:
         _write_atomically(output, text)
     else:
@@ -179,11 +220,46 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     return code
 
 
-def _render(projection, reports, tolerance, fmt, verbose, code, to_file: bool) -> str:
+# state inherited by forked workers (set just before the pool starts)
+_WORKER: dict = {}
+
+
+def _certify_index(i: int) -> dict:
+    from singcheck.certify import certify_path
+    from singcheck.path import build_path
+    from singcheck.report import trajectory_json
+
+    projection, specs, tolerance = _WORKER["projection"], _WORKER["specs"], _WORKER["tolerance"]
+    return trajectory_json(certify_path(build_path(projection, specs[i]), tolerance))
+
+
+def certify_all(projection, specs, tolerance: float, jobs: int, progress) -> list[dict]:
+    """Certify every trajectory, in ``jobs`` forked processes when there are many."""
+    _WORKER.update(projection=projection, specs=specs, tolerance=tolerance)
+    n = len(specs)
+    results: list[dict | None] = [None] * n
+    with progress.bar(n) as advance:
+        if jobs > 1 and n > 4:
+            import multiprocessing
+
+            with multiprocessing.get_context("fork").Pool(jobs) as pool:
+                for i, result in enumerate(pool.imap(_certify_index, range(n),
+                                                     chunksize=max(1, n // (jobs * 16)))):
+                    results[i] = result
+                    advance(result["name"], result["verdict"])
+        else:
+            for i in range(n):
+                results[i] = _certify_index(i)
+                advance(results[i]["name"], results[i]["verdict"])
+    _WORKER.clear()
+    return results
+
+
+def _render(projection, results, tolerance, fmt, verbose, code, to_file: bool) -> str:
     from singcheck import report as rep
 
     if fmt == "json":
-        return rep.to_json(rep.document(projection, reports, tolerance, int(code)))
+        return rep.to_json(rep.document(projection, results, tolerance, int(code)))
     from io import StringIO
 
     from rich.console import Console
@@ -192,7 +268,7 @@ def _render(projection, reports, tolerance, fmt, verbose, code, to_file: bool) -
     interactive = sys.stdout.isatty() and not to_file
     console = Console(file=buffer, force_terminal=interactive, width=None if interactive
                       else 140, highlight=False)
-    rep.render_tables(console, projection, reports, verbose)
+    rep.render_tables(console, rep.robot_json(projection), results, verbose)
     return buffer.getvalue()
 
 

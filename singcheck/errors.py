@@ -21,6 +21,9 @@ class SpecError(SingcheckError):
         self.key = key
         super().__init__(str(self))
 
+    def __reduce__(self):  # keep the location when crossing a process boundary
+        return (_rebuild_spec_error, (type(self), self.message, self.path, self.line, self.key))
+
     def __str__(self) -> str:
         where = self.path or "<spec>"
         if self.line is not None:
@@ -35,3 +38,7 @@ class UnsupportedRobotError(SpecError):
 
 class BackendError(SingcheckError):
     """An elimination backend is missing, failed, or returned something unexpected."""
+
+
+def _rebuild_spec_error(cls, message, path, line, key):
+    return cls(message, path=path, line=line, key=key)

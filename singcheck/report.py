@@ -72,19 +72,23 @@ def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
     }
 
 
-def document(projection: RobotProjection, reports: list[TrajectoryReport], tolerance: float,
-             exit_code: int) -> dict[str, Any]:
+def robot_json(projection: RobotProjection) -> dict[str, Any]:
     model = projection.model
+    return {"name": model.name, "path": model.spec.path, "joints": list(model.joints),
+            "pose": list(model.pose)}
+
+
+def document(projection: RobotProjection, trajectories: list[dict[str, Any]],
+             tolerance: float, exit_code: int) -> dict[str, Any]:
     return {
         "schema_version": SCHEMA_VERSION,
         "singcheck_version": __version__,
-        "robot": {"name": model.name, "path": model.spec.path, "joints": list(model.joints),
-                  "pose": list(model.pose)},
+        "robot": robot_json(projection),
         "backend": projection.backend,
         "elimination_method": projection.method,
         "singularity_surface_degree": int(projection.singularity_surface.total_degree()),
         "tolerance": tolerance,
-        "trajectories": [trajectory_json(r) for r in reports],
+        "trajectories": trajectories,
         "exit_code": exit_code,
     }
 
@@ -93,59 +97,59 @@ def to_json(doc: dict[str, Any]) -> str:
     return json.dumps(doc, indent=2, ensure_ascii=False) + "\n"
 
 
-def render_tables(console, projection: RobotProjection, reports: list[TrajectoryReport],
+def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, Any]],
                   verbose: bool = False) -> None:
-    """Print one candidates table and one working-modes table per trajectory."""
+    """Print one candidates table and one working-modes table per trajectory.
+
+    Works from the JSON-shaped dicts of :func:`trajectory_json`, so reports computed in
+    worker processes render the same way.
+    """
     from rich.table import Table
 
-    model = projection.model
-    for report in reports:
-        spec = report.path.trajectory
-        title = (f"{model.name} · {spec.name}  ({spec.parameter} ∈ {spec.range}, "
-                 f"roots by {report.root_method})")
-        table = Table(title=title, title_justify="left")
-        table.add_column("#", justify="right")
-        table.add_column(spec.parameter, justify="right")
-        for v in model.pose:
-            table.add_column(v, justify="right")
-        feasible = [m.label for m in report.modes if m.feasible]
-        for j in model.joints:
-            table.add_column(j + (f" [{feasible[0]}]" if feasible else ""), justify="right")
-        table.add_column("singular modes")
-        table.add_column("status")
-        for i, c in enumerate(report.candidates, 1):
-            row = [str(i), _num(float(c.t.mid()), 9)]
-            row += [_num(float(b.mid()), 4) for b in c.pose]
-            joints = c.joints.get(feasible[0], {}) if feasible else {}
-            row += [_num(joints.get(j), 4) for j in model.joints]
-            row.append(", ".join(c.singular_modes) or "none")
-            style = {"real": "red", "spurious": "green"}.get(c.status, "magenta")
-            row.append(f"[{style}]{c.status}[/{style}]")
-            table.add_row(*row)
-        if not report.candidates:
+    joints, pose = robot["joints"], robot["pose"]
+    for t in trajectories:
+        title = (f"{robot['name']} · {t['name']}  ({t['parameter']} ∈ [{t['range'][0]}, "
+                 f"{t['range'][1]}], roots by {t['root_isolation']})")
+        feasible = [m["label"] for m in t["working_modes"] if m["feasible"]]
+        if t["candidates"]:
+            table = Table(title=title, title_justify="left")
+            for col in ("#", t["parameter"], *pose,
+                        *[j + (f" [{feasible[0]}]" if feasible else "") for j in joints]):
+                table.add_column(col, justify="right")
+            table.add_column("singular modes")
+            table.add_column("status")
+            for i, c in enumerate(t["candidates"], 1):
+                shown = c["joints"].get(feasible[0], {}) if feasible else {}
+                style = {"real": "red", "spurious": "green"}.get(c["status"], "magenta")
+                table.add_row(str(i), _num(c["t"], 9), *[_num(c["pose"][v], 4) for v in pose],
+                              *[_num(shown.get(j), 4) for j in joints],
+                              ", ".join(c["singular_modes"]) or "none",
+                              f"[{style}]{c['status']}[/{style}]")
+            console.print(table)
+        else:
             console.print(f"[bold]{title}[/bold]\n  no candidate: μ(t) = ξ(φ(t)) has no real "
                           "root on the range")
-        else:
-            console.print(table)
         modes = Table(title="working modes", title_justify="left")
-        for col in ("mode", "status", *[f"{j} at start" for j in model.joints],
-                    "singular at", "why"):
+        for col in ("mode", "status", *[f"{j} at start" for j in joints], "singular at",
+                    "why"):
             modes.add_column(col)
-        for m in report.modes:
-            if not verbose and m.status == "infeasible" and len(report.modes) > 8:
+        for m in t["working_modes"]:
+            if not verbose and m["status"] == "infeasible" and len(t["working_modes"]) > 8:
                 continue
-            modes.add_row(m.label, m.status,
-                          *[_num(m.joints_at_start.get(j), 4) for j in model.joints],
-                          ", ".join(_num(float(c.t.mid()), 6) for c in m.singular_times) or "—",
-                          m.reason or "")
+            modes.add_row(m["label"], m["status"],
+                          *[_num(m["joints_at_start"].get(j), 4) for j in joints],
+                          ", ".join(_num(x, 6) for x in m["singular_times"]) or "—",
+                          m["reason"] or "")
         console.print(modes)
         if verbose:
-            for i, c in enumerate(report.candidates, 1):
-                lo, hi = _interval(c.t)
-                console.print(f"  candidate {i}: {spec.parameter} ∈ [{lo:.17g}, {hi:.17g}]")
-                for m in c.modes:
-                    console.print(f"    {m.mode}: {m.status} ({m.proof})")
-        for t, reason in report.undecided:
-            console.print(f"  undecided near {spec.parameter} ≈ {float(t.mid()):.6g}: {reason}")
-        style = _VERDICT_STYLE.get(report.verdict, "bold")
-        console.print(f"verdict [{style}]{report.verdict}[/{style}]: {report.reason}\n")
+            for i, c in enumerate(t["candidates"], 1):
+                lo, hi = c["t_interval"]
+                console.print(f"  candidate {i}: {t['parameter']} ∈ [{lo:.17g}, {hi:.17g}]")
+                for m in c["modes"]:
+                    console.print(f"    {m['mode']}: {m['status']} ({m['proof']})")
+        for u in t["undecided"]:
+            lo, hi = u["t_interval"]
+            console.print(f"  undecided for {t['parameter']} in [{lo:.9g}, {hi:.9g}]: "
+                          f"{u['reason']}")
+        style = _VERDICT_STYLE.get(t["verdict"], "bold")
+        console.print(f"verdict [{style}]{t['verdict']}[/{style}]: {t['reason']}\n")

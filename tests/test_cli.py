@@ -235,3 +235,18 @@ def test_readme_commands_exist():
     ci = (ROOT / ".ci" / "run").read_text()
     assert "make test" in ci and "make demo" in ci
     assert Path(ROOT / "robots" / "orthoglide.yaml").exists()
+
+
+def test_a_batch_in_parallel_gives_the_same_answers_as_one_process(tmp_path):
+    sys.path.insert(0, str(ROOT / "bench"))
+    from generate import write
+
+    paths = [str(p) for p in write(tmp_path, 12, harmonics=4, seed=7)]
+    common = ["run", ORTHO, *paths, "--format", "json", "--backend", "sympy"]
+    serial = singcheck(*common, "--jobs", "1")
+    parallel = singcheck(*common, "--jobs", "2")
+    assert serial.returncode == parallel.returncode
+    assert json.loads(serial.stdout)["trajectories"] == json.loads(parallel.stdout)["trajectories"]
+    assert "certified" in parallel.stderr or "12/12" in parallel.stderr
+    verdicts = {t["verdict"] for t in json.loads(serial.stdout)["trajectories"]}
+    assert verdicts <= {"singular", "singularity-free", "infeasible"}

@@ -137,7 +137,8 @@ def cli() -> None:
 @cli.command(epilog=RUN_EPILOG)
 @click.argument("robot", type=click.Path(dir_okay=False))
 @click.argument("trajectories", nargs=-1, required=True, type=click.Path(dir_okay=False))
-@click.option("--backend", type=click.Choice(["auto", "singular", "macaulay2", "sympy"]),
+@click.option("--backend",
+              type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
               default="auto", envvar="SINGCHECK_BACKEND", show_default=True, show_envvar=True,
               help="Elimination engine for the robot's projection; auto picks Singular, else "
                    "Macaulay2, else SymPy (see `singcheck backends`).")

@@ -20,6 +20,7 @@ from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 from singcheck.elimination import (
     EliminationBackend,
     EliminationRequest,
+    norm_chain,
     restrict,
     squarefree_part,
 )
@@ -107,15 +108,9 @@ def joint_limit_surfaces(model: RobotModel, pose_ctx) -> tuple[JointLimitSurface
 
 
 def norm_over_legs(model: RobotModel) -> fmpq_mpoly:
-    """``Res_ρn(… Res_ρ1(det A, F_1) …, F_n)``, computed in-process with FLINT.
-
-    For a leg-decoupled robot this is the product of det A over every (complex)
-    working mode, up to a non-zero constant: its zero set is exactly ξ's.
-    """
-    acc = model.det_A
-    for leg in model.legs:
-        acc = acc.resultant(leg.constraint, leg.joint)
-    return restrict(acc, _pose_context(model))
+    """The norm of det A over the legs (squarefree, FLINT): exactly ξ's zero set."""
+    legs = [(leg.joint, leg.constraint) for leg in model.legs]
+    return restrict(norm_chain(model.det_A, legs), _pose_context(model))
 
 
 def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str) -> None:

@@ -127,3 +127,17 @@ def test_a_wrong_singularity_surface_fails_the_recheck(orthoglide, orthoglide_pr
     for wrong in (xi * (px - 1), xi + 1, orthoglide_projection.workspace_boundary[0]):
         with pytest.raises(BackendError, match="fails the re-check"):
             recheck_singularity_surface(orthoglide, wrong, "test")
+
+
+def test_the_flint_norm_keeps_factored_jacobians_small():
+    from singcheck.projection import norm_over_legs
+    from singcheck.spec import load_robot
+    from tests.conftest import ROBOTS
+
+    model = build_model(load_robot(ROBOTS / "stacked-orthoglide.yaml"))
+    _, factors = model.det_A.factor()
+    assert len(factors) >= 2  # block-triangular A: det A1 · det A2
+    xi = norm_over_legs(model)
+    # ξ1(X1) (degree 16, the Orthoglide's) times ξ2(X2 - X1) (degree 16)
+    assert xi.total_degree() == 32
+    assert sorted(f.total_degree() for f, _ in xi.factor()[1]) == [2, 2, 14, 14]

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from singcheck.elimination import EliminationBackend
 from singcheck.errors import BackendError
 
-BACKEND_NAMES = ("singular", "macaulay2", "sympy")
+BACKEND_NAMES = ("singular", "macaulay2", "sympy", "flint")
 
 
 @dataclass(frozen=True)
@@ -44,6 +44,10 @@ def get_backend(name: str = "auto", *, timeout: float | None = None) -> Eliminat
         from singcheck.cas.sympy_backend import SympyBackend
 
         return SympyBackend()
+    if name == "flint":
+        from singcheck.cas.flint_backend import FlintBackend
+
+        return FlintBackend()
     if name in ("singular", "macaulay2"):
         from singcheck.cas.external import DEFAULT_TIMEOUT, ExternalBackend
 
@@ -72,4 +76,8 @@ def describe_backends() -> list[BackendInfo]:
                                cas.tested_versions, note))
     out.append(BackendInfo("sympy", True, sympy.__file__, sympy.__version__, "1.12 – 1.14",
                            "in-process (resultant chains and Gröbner bases)"))
+    import flint
+
+    out.append(BackendInfo("flint", True, flint.__file__, flint.__version__, "0.7 – 0.9",
+                           "in-process FLINT resultant chains (fastest; Gröbner via SymPy)"))
     return out

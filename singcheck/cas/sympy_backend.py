@@ -17,7 +17,12 @@ from __future__ import annotations
 
 from flint import fmpq, fmpq_mpoly
 
-from singcheck.elimination import EliminationRequest, EliminationResult, restrict
+from singcheck.elimination import (
+    EliminationRequest,
+    EliminationResult,
+    leg_structure,
+    restrict,
+)
 
 
 def _to_sympy(p: fmpq_mpoly, gens):
@@ -36,28 +41,6 @@ def _from_sympy(poly, ctx, gens) -> fmpq_mpoly:
     return ctx.from_dict(out)
 
 
-def _leg_structure(request: EliminationRequest):
-    """``(g, [(v, f_v), …])`` when the request has the leg shape, else None."""
-    names = request.context.names()
-    legs: dict[str, fmpq_mpoly] = {}
-    rest = []
-    for f in request.generators:
-        involved = [v for v in request.eliminate if f.degrees()[names.index(v)] > 0]
-        if len(involved) == 1 and involved[0] not in legs and _constant_lead(f, names, involved[0]):
-            legs[involved[0]] = f
-        else:
-            rest.append(f)
-    if len(rest) != 1 or set(legs) != set(request.eliminate):
-        return None
-    return rest[0], [(v, legs[v]) for v in request.eliminate]
-
-
-def _constant_lead(f: fmpq_mpoly, names, v: str) -> bool:
-    i = names.index(v)
-    d = f.degrees()[i]
-    return all(sum(e) == d for e, _ in f.terms() if e[i] == d)
-
-
 class SympyBackend:
     name = "sympy"
 
@@ -72,7 +55,7 @@ class SympyBackend:
         gens = symbols(request.context.names())
         by_name = dict(zip(request.context.names(), gens, strict=True))
         kept = request.kept_context()
-        structure = _leg_structure(request)
+        structure = leg_structure(request)
         if structure is not None:
             g, legs = structure
             acc = _to_sympy(g, gens)

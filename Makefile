@@ -5,7 +5,7 @@ BIN    := $(VENV)/bin
 ROBOT  ?= robots/orthoglide.yaml
 TRAJ   ?= trajectories/heart1.yaml
 
-.PHONY: help setup cas test test-fast lint demo examples clean
+.PHONY: help setup cas test test-fast lint demo examples bench clean
 
 help:
 	@echo "make setup      install Singular and Macaulay2 (apt), create $(VENV), install singcheck"
@@ -14,6 +14,7 @@ help:
 	@echo "make test       set up, then run the whole test suite (slow tests included)"
 	@echo "make test-fast  the suite without the tests marked slow"
 	@echo "make lint       ruff"
+	@echo "make bench      benchmark singcheck against sampling; writes bench/results.json"
 
 setup: cas $(VENV)/.installed
 
@@ -35,7 +36,7 @@ $(VENV)/.installed: pyproject.toml
 	  $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq python3-venv && \
 	  $(PYTHON) -m venv $(VENV); }
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e '.[test]'
+	$(BIN)/python -m pip install -q -e '.[test,bench]'
 	@touch $@
 
 test: setup
@@ -56,3 +57,7 @@ examples: setup
 
 clean:
 	rm -rf $(VENV) *.egg-info .pytest_cache .ruff_cache
+
+# singcheck against the sampling check, side by side, one process; writes bench/results.json
+bench: setup
+	$(BIN)/python bench/bench.py

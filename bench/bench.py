@@ -1,0 +1,269 @@
+"""make bench: singcheck against the sampling check, same inputs, one process.
+
+Prints tables (contender, median, min, max, ratio to singcheck, found the true
+singularities?) and writes bench/results.json.  The sampling contender is what people
+use today: evaluate det A along the working mode at N points of the path (vectorised
+NumPy) and look for sign changes.  It is fast, and it can miss singularities.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "bench"))
+
+from generate import write  # noqa: E402
+
+from singcheck.cas import get_backend  # noqa: E402
+from singcheck.certify import certify_path  # noqa: E402
+from singcheck.model import build_model  # noqa: E402
+from singcheck.path import build_path  # noqa: E402
+from singcheck.projection import project_robot  # noqa: E402
+from singcheck.spec import load_robot, load_trajectory  # noqa: E402
+
+REPEAT = int(os.environ.get("BENCH_REPEAT", "15"))
+
+
+def times(fn, repeat: int = REPEAT) -> list[float]:
+    out = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - start)
+    return out
+
+
+def stats(ts: list[float]) -> dict:
+    return {"median_s": statistics.median(ts), "min_s": min(ts), "max_s": max(ts),
+            "runs": len(ts)}
+
+
+# -- the sampling contender -------------------------------------------------------
+
+def _numpy_poly(poly):
+    terms = [(float(c), tuple(int(x) for x in e)) for e, c in poly.terms()]
+
+    def f(arrays):
+        total = np.zeros_like(arrays[0])
+        for coeff, exps in terms:
+            term = np.full_like(arrays[0], coeff)
+            for a, e in zip(arrays, exps, strict=True):
+                if e:
+                    term = term * a**e
+            total = total + term
+        return total
+
+    return f
+
+
+class SamplingScan:
+    """det A along one working mode at n points, vectorised; sign changes are 'found'."""
+
+    def __init__(self, path, mode_label: str) -> None:
+        self.range = (float(path.trajectory.range.start), float(path.trajectory.range.end))
+        self.phi = [_numpy_poly(p) for p in path.phi]
+        self.legs = [([_numpy_poly(c) for c in leg.coefficients], sign)
+                     for leg, sign in zip(path.legs, mode_label, strict=True)]
+        self.det_a = _numpy_poly(path.projection.model.det_A)
+
+    def __call__(self, n: int) -> list[float]:
+        t = np.linspace(*self.range, n)
+        tsc = [t, np.sin(t), np.cos(t)]
+        pose = [f(tsc) for f in self.phi]
+        joints = []
+        for coeffs, sign in self.legs:
+            values = [f(tsc) for f in coeffs]
+            if len(values) == 2:
+                joints.append(-values[1] / values[0])
+            else:
+                a, b, c = values
+                root = np.sqrt(b * b - 4 * a * c)
+                joints.append((-b + (root if sign == "+" else -root)) / (2 * a))
+        d = self.det_a([*joints, *pose])
+        s = np.sign(d)
+        idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
+        return list((t[idx] + t[idx + 1]) / 2)
+
+
+def found_all(found: list[float], truth: list[float], spacing: float) -> bool:
+    return len(found) == len(truth) and all(
+        any(abs(f - x) <= spacing for f in found) for x in truth)
+
+
+# -- the runs -------------------------------------------------------------------------
+
+def load(robot: str, trajectory: str, backend: str = "flint"):
+    model = build_model(load_robot(ROOT / "robots" / f"{robot}.yaml"))
+    projection = project_robot(model, get_backend(backend))
+    spec = load_trajectory(ROOT / "trajectories" / f"{trajectory}.yaml", model.spec)
+    return projection, spec
+
+
+def truth_of(report, mode: str) -> list[float]:
+    return [float(c.t.mid()) for c in report.candidates if mode in c.singular_modes]
+
+
+def compare(robot: str, trajectory: str) -> list[dict]:
+    """singcheck and the sampling scans on one path: rows of the main table."""
+    projection, spec = load(robot, trajectory)
+    report = certify_path(build_path(projection, spec))
+    mode = next(m.label for m in report.modes if m.feasible)
+    truth = truth_of(report, mode)
+    rows = [{"case": f"{robot}/{trajectory}", "contender": "singcheck (certified)",
+             **stats(times(lambda: certify_path(build_path(projection, spec)))),
+             "found": True, "verdict": report.verdict, "singular_times": truth}]
+    scan = SamplingScan(build_path(projection, spec), mode)
+    width = scan.range[1] - scan.range[0]
+    for n in (10**3, 10**4, 10**5):
+        found = scan(n)
+        rows.append({"case": f"{robot}/{trajectory}", "contender": f"NumPy sampling, {n:.0e}",
+                     **stats(times(lambda n=n: scan(n))),
+                     "found": found_all(found, truth, 2 * width / (n - 1)),
+                     "sign_changes": len(found)})
+    base = rows[0]["median_s"]
+    for row in rows:
+        row["ratio_to_singcheck"] = row["median_s"] / base
+    return rows
+
+
+def projection_rows() -> list[dict]:
+    model = build_model(load_robot(ROOT / "robots" / "orthoglide.yaml"))
+    rows = []
+    for name in ("flint", "singular", "macaulay2", "sympy"):
+        try:
+            backend = get_backend(name)
+        except Exception as e:  # a missing CAS is a row, not a crash
+            rows.append({"backend": name, "error": str(e)})
+            continue
+        repeat = 3 if name == "sympy" else REPEAT
+        rows.append({"backend": name, **stats(times(lambda b=backend: project_robot(model, b),
+                                                    repeat))})
+    return rows
+
+
+def cli_rows() -> list[dict]:
+    exe = [sys.executable, "-m", "singcheck"]
+    with tempfile.TemporaryDirectory() as cache:
+        env = {**os.environ, "SINGCHECK_CACHE_DIR": cache}
+        args = [*exe, "run", "robots/orthoglide.yaml", "trajectories/heart1.yaml", "-q"]
+        subprocess.run(args, cwd=ROOT, env=env, capture_output=True)  # warm the cache
+        warm = times(lambda: subprocess.run(args, cwd=ROOT, env=env, capture_output=True), 7)
+        with tempfile.TemporaryDirectory() as out:
+            paths = write(Path(out), 1000)
+            cmd = [*exe, "run", "robots/orthoglide.yaml", *map(str, paths), "-q",
+                   "--format", "json", "--jobs", str(os.cpu_count() or 1)]
+            start = time.perf_counter()
+            batch = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True)
+            batch_s = time.perf_counter() - start
+    verdicts: dict[str, int] = {}
+    for t in json.loads(batch.stdout)["trajectories"]:
+        verdicts[t["verdict"]] = verdicts.get(t["verdict"], 0) + 1
+    return [{"what": "singcheck run orthoglide heart1, warm cache, whole process",
+             **stats(warm)},
+            {"what": f"1000 heart-like trajectories, --jobs {os.cpu_count()}",
+             "median_s": batch_s, "min_s": batch_s, "max_s": batch_s, "runs": 1,
+             "verdicts": verdicts}]
+
+
+def growth_rows() -> list[dict]:
+    rows = []
+    model = build_model(load_robot(ROOT / "robots" / "orthoglide.yaml"))
+    projection = project_robot(model, get_backend("flint"))
+    with tempfile.TemporaryDirectory() as out:
+        for k in range(1, 9):
+            paths = write(Path(out) / str(k), 3, harmonics=k, seed=k)
+            specs = [load_trajectory(p, model.spec) for p in paths]
+            paths_ = [build_path(projection, s) for s in specs]
+            ts = times(lambda ps=paths_: [certify_path(p) for p in ps], 3)
+            rows.append({"axis": "harmonics", "size": k,
+                         "mu_degree": max(int(p.mu.total_degree()) for p in paths_),
+                         "median_s": statistics.median(ts) / 3})
+    for robot, trajectory in (("skew-biglide", "skew-biglide-ellipse"),
+                              ("orthoglide", "heart1"),
+                              ("stacked-orthoglide", "stacked-heart")):
+        m = build_model(load_robot(ROOT / "robots" / f"{robot}.yaml"))
+        backend = get_backend("flint")
+        proj_t = times(lambda m=m: project_robot(m, backend), 3)
+        projection = project_robot(m, backend)
+        spec = load_trajectory(ROOT / "trajectories" / f"{trajectory}.yaml", m.spec)
+        cert_t = times(lambda: certify_path(build_path(projection, spec)), 3)
+        rows.append({"axis": "robot", "size": len(m.joints), "robot": robot,
+                     "trajectory": trajectory,
+                     "xi_degree": int(projection.singularity_surface.total_degree()),
+                     "projection_s": statistics.median(proj_t),
+                     "median_s": statistics.median(cert_t)})
+    return rows
+
+
+def machine() -> dict:
+    cpu = "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "python": platform.python_version(),
+            "platform": platform.platform()}
+
+
+def ms(x: float) -> str:
+    return f"{1000 * x:9.2f}"
+
+
+def main() -> None:
+    results = {"machine": machine(), "repeat": REPEAT}
+    print(f"machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, "
+          f"Python {results['machine']['python']}\n")
+    results["paths"] = rows = []
+    for robot, trajectory in (("orthoglide", "heart1"), ("orthoglide", "heart2"),
+                              ("orthoglide", "helix"), ("biglide", "biglide-double-cross"),
+                              ("biglide", "biglide-graze")):
+        rows += compare(robot, trajectory)
+    print(f"{'case':38} {'contender':24} {'median ms':>9} {'min ms':>9} {'max ms':>9} "
+          f"{'ratio':>7}  found the true singularities")
+    for r in rows:
+        print(f"{r['case']:38} {r['contender']:24} {ms(r['median_s'])} {ms(r['min_s'])} "
+              f"{ms(r['max_s'])} {r['ratio_to_singcheck']:7.2f}  "
+              f"{'yes' if r['found'] else 'NO'}")
+    results["projection"] = proj = projection_rows()
+    print("\nprojection of the Orthoglide (ξ, workspace and joint-limit surfaces), no cache")
+    for r in proj:
+        if "error" in r:
+            print(f"  {r['backend']:10} unavailable: {r['error']}")
+        else:
+            print(f"  {r['backend']:10} median {ms(r['median_s'])} ms  min {ms(r['min_s'])} "
+                  f"ms  max {ms(r['max_s'])} ms")
+    results["command_line"] = cli = cli_rows()
+    print("\ncommand line")
+    for r in cli:
+        print(f"  {r['what']:62} median {ms(r['median_s'])} ms" +
+              (f"  {r['verdicts']}" if "verdicts" in r else ""))
+    results["growth"] = growth = growth_rows()
+    print("\ngrowth: certification time per trajectory (projection cached)")
+    for r in growth:
+        if r["axis"] == "harmonics":
+            print(f"  harmonics {r['size']}: μ degree {r['mu_degree']:4}  "
+                  f"{ms(r['median_s'])} ms")
+        else:
+            print(f"  {r['robot']:20} {r['size']} joints, ξ degree {r['xi_degree']:3}: "
+                  f"projection {ms(r['projection_s'])} ms, certify {ms(r['median_s'])} ms")
+    out = ROOT / "bench" / "results.json"
+    out.write_text(json.dumps(results, indent=2) + "\n")
+    print(f"\nwritten: {out.relative_to(ROOT)}")
+
+
+if __name__ == "__main__":
+    main()

@@ -52,16 +52,28 @@ def stats(ts: list[float]) -> dict:
 # -- the sampling contender -------------------------------------------------------
 
 def _numpy_poly(poly):
-    terms = [(float(c), tuple(int(x) for x in e)) for e, c in poly.terms()]
+    """A vectorised evaluator: powers computed once per variable, one product per term."""
+    terms = [(float(c), [(i, int(e)) for i, e in enumerate(exps) if e])
+             for exps, c in poly.terms()]
+    top = [max((int(e[i]) for e, _ in poly.terms()), default=0)
+           for i in range(poly.context().nvars())]
 
     def f(arrays):
+        powers = []
+        for a, m in zip(arrays, top, strict=True):
+            p = [None, a]
+            for _ in range(2, m + 1):
+                p.append(p[-1] * a)
+            powers.append(p)
         total = np.zeros_like(arrays[0])
-        for coeff, exps in terms:
-            term = np.full_like(arrays[0], coeff)
-            for a, e in zip(arrays, exps, strict=True):
-                if e:
-                    term = term * a**e
-            total = total + term
+        for coeff, factors in terms:
+            if not factors:
+                total += coeff
+                continue
+            term = coeff * powers[factors[0][0]][factors[0][1]]
+            for i, e in factors[1:]:
+                term = term * powers[i][e]
+            total += term
         return total
 
     return f
@@ -194,10 +206,10 @@ def growth_rows() -> list[dict]:
                               ("stacked-orthoglide", "stacked-heart")):
         m = build_model(load_robot(ROOT / "robots" / f"{robot}.yaml"))
         backend = get_backend("flint")
-        proj_t = times(lambda m=m: project_robot(m, backend), 3)
+        proj_t = times(lambda m=m, backend=backend: project_robot(m, backend), 3)
         projection = project_robot(m, backend)
         spec = load_trajectory(ROOT / "trajectories" / f"{trajectory}.yaml", m.spec)
-        cert_t = times(lambda: certify_path(build_path(projection, spec)), 3)
+        cert_t = times(lambda p=projection, s=spec: certify_path(build_path(p, s)), 3)
         rows.append({"axis": "robot", "size": len(m.joints), "robot": robot,
                      "trajectory": trajectory,
                      "xi_degree": int(projection.singularity_surface.total_degree()),

@@ -143,8 +143,12 @@ class _RationalRoot:
         return _ball(self.lo, self.hi)
 
     def pin(self, q: fmpq) -> bool:
-        """Collapse to ``q`` when it lies in the interval and is exactly a root."""
-        if self.lo <= q <= self.hi and self.poly(q) == 0:
+        """Collapse to ``q`` when it lies inside the isolating interval and is a root.
+
+        The end points of an isolating interval are never its root (they may be
+        another root), so only a point strictly inside, or the point itself, counts.
+        """
+        if (self.lo < q < self.hi or self.lo == q == self.hi) and self.poly(q) == 0:
             self.lo = self.hi = q
             return True
         return False
@@ -152,6 +156,61 @@ class _RationalRoot:
 
 def _qsign(q: fmpq) -> int:
     return (q > 0) - (q < 0)
+
+
+def _sign_variations(coeffs) -> int:
+    signs = [c > 0 for c in coeffs if c != 0]
+    return sum(1 for x, y in zip(signs, signs[1:], strict=False) if x != y)
+
+
+_X_PLUS_1 = fmpz_poly([1, 1])
+
+
+def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
+    """Isolating intervals of the positive real roots of a squarefree ``f`` with f(0) ≠ 0.
+
+    Vincent–Collins–Akritas bisection: roots are first scaled into (0, 1) by a power
+    of two above the Cauchy bound; on a dyadic interval, the number of sign variations
+    of the coefficients of (x+1)^n g(1/(x+1)) bounds the number of roots and has the
+    same parity (Descartes); 0 proves none, 1 proves exactly one (Vincent's theorem
+    makes the bisection terminate for squarefree input).  A root found exactly at a
+    bisection point is returned as a point interval; an interval whose end is such a
+    root is bisected further, so every other interval has a sign change at its ends.
+    """
+    cs = [int(c) for c in f.coeffs()]
+    n = len(cs) - 1
+    # Fujiwara: every root has |z| <= 2 max |a_i / a_n|^(1/(n-i)); bounded with bit
+    # lengths (|a| < 2^bitlen), plus one more bit so that every root is < 2^b strictly.
+    top = abs(cs[-1]).bit_length() - 1  # 2^top <= |a_n|
+    b = 2 + max((-(-(abs(c).bit_length() - top) // (n - i)) for i, c in enumerate(cs[:-1])
+                 if c), default=0)
+    b = max(b, 1)
+    g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)])  # g(x) = f(2^b x)
+    out: list[tuple[int, int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
+    stack = [(g, 0, 0)]
+    while stack:
+        g, a, k = stack.pop()
+        rev = fmpz_poly(g.coeffs()[::-1])
+        v = _sign_variations(rev(_X_PLUS_1).coeffs())
+        ends_are_roots = g(0) == 0 or g(1) == 0
+        if v == 0:
+            continue
+        if v == 1 and not ends_are_roots:
+            out.append((a, k, False))
+            continue
+        gc = [int(c) for c in g.coeffs()]
+        m = len(gc) - 1
+        half = fmpz_poly([c << (m - i) for i, c in enumerate(gc)])  # 2^m g(x/2)
+        if half(1) == 0:
+            out.append((2 * a + 1, k + 1, True))
+        stack.append((half(_X_PLUS_1), 2 * a + 1, k + 1))
+        stack.append((half, 2 * a, k + 1))
+    scale = fmpq(2**b)
+    intervals = []
+    for a, k, exact in out:
+        lo = scale * fmpq(a, 2**k)
+        intervals.append((lo, lo) if exact else (lo, scale * fmpq(a + 1, 2**k)))
+    return intervals
 
 
 def _real_roots_exact(p: fmpq_poly) -> list[tuple[_RationalRoot, int]]:
@@ -163,12 +222,20 @@ def _real_roots_exact(p: fmpq_poly) -> list[tuple[_RationalRoot, int]]:
     out = []
     for factor, mult in factors:
         f = fmpq_poly(factor)
-        for root, _ in factor.complex_roots():
-            if root.imag != 0:
-                continue
-            r = root.real
-            lo, hi = _to_fmpq(r.mid()) - _to_fmpq(r.rad()), _to_fmpq(r.mid()) + _to_fmpq(r.rad())
+        cs = [int(c) for c in factor.coeffs()]
+        shift = next(i for i, c in enumerate(cs) if c != 0)
+        if shift:  # a root at 0 (squarefree: simple)
+            out.append((_RationalRoot(f, fmpq(0), fmpq(0)), mult))
+            factor = fmpz_poly(cs[shift:])
+            f = fmpq_poly(factor)  # the other roots: f no longer vanishes at 0
+        if factor.degree() < 1:
+            continue
+        for lo, hi in _positive_root_intervals(factor):
             out.append((_RationalRoot(f, lo, hi), mult))
+        mirrored = fmpz_poly([c if i % 2 == 0 else -c
+                              for i, c in enumerate(int(c) for c in factor.coeffs())])
+        for lo, hi in _positive_root_intervals(mirrored):
+            out.append((_RationalRoot(f, -hi, -lo), mult))
     out.sort(key=lambda item: item[0].lo)
     return out
 

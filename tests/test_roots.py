@@ -7,7 +7,7 @@ from fractions import Fraction
 
 import mpmath
 import pytest
-from flint import arb, fmpq, fmpz_poly
+from flint import arb, fmpq, fmpq_poly, fmpz_poly
 
 from singcheck.roots import IdenticallyZeroError, isolate_real_roots
 from singcheck.trig import C, LinearInPi, S, T, TimeRange, cos_multiple, sin_multiple
@@ -131,3 +131,23 @@ def test_pi_endpoint_is_exact():
     assert_roots(iso, [PI])
     assert isolate_real_roots(1 + C, rng(0, 3)).roots == ()
     assert math.isclose(float(isolate_real_roots(1 + C, rng(0, 4)).roots[0].t.mid()), math.pi)
+
+
+def test_descartes_isolation_agrees_with_flint_complex_roots():
+    import random
+
+    from singcheck.roots import _real_roots_exact
+
+    rng = random.Random(11)
+    for _ in range(40):
+        degree = rng.randint(1, 40)
+        f = fmpz_poly([rng.randint(-10**6, 10**6) for _ in range(degree)] + [rng.randint(1, 99)])
+        f *= fmpz_poly([rng.randint(-5, 5), rng.randint(1, 3)])  # a rational root
+        if rng.random() < 0.3:
+            f *= fmpz_poly([0, 1])  # a root at 0
+        ours = _real_roots_exact(fmpq_poly(f))
+        flint_real = sorted(float(r.real.mid()) for r, _ in f.complex_roots() if r.imag == 0)
+        assert len(ours) == len(flint_real)
+        for (rr, _), x in zip(ours, flint_real, strict=True):
+            rr.bisect_to(fmpq(1, 10**12))
+            assert float(rr.lo) - 1e-9 <= x <= float(rr.hi) + 1e-9

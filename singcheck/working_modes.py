@@ -10,11 +10,15 @@ stays inside the joint limits over the whole closed range.  How each part is pro
    arithmetic) proves D > 0 on the whole range by continuity: both branches are real
    and distinct (no serial singularity).  A root means the branches meet: the path
    reaches the workspace boundary (det B = 0) and the leg's modes are infeasible.
+   A quick proof comes first: D > 0 in ball arithmetic on each of 8 pieces covering
+   the range; only when it fails are the roots of D isolated.
 2. **Inside the limits.**  A branch equals a limit L only at roots of the leg
    constraint with ρ = L.  Those roots cut the range into open gaps in which the branch
    is never equal to a limit, so it is inside or outside over each whole gap; one
    ball evaluation at a point of each gap decides which.  Touching a limit is inside
-   (the limits are closed).
+   (the limits are closed).  Quick proofs come first: a branch certainly outside the
+   limits at the range start is infeasible, and one certainly inside them on each of
+   8 pieces covering the range is feasible, without isolating any root.
 Whatever cannot be proven makes the branch ``unknown``, with the reason.
 """
 
@@ -81,9 +85,29 @@ def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | Non
         return None
 
 
+_PIECES = 8
+
+
+def _pieces(interval: TimeRange) -> list[arb]:
+    """Balls covering the closed range (slightly more at irrational ends)."""
+    lo, hi = interval.start.ball().lower(), interval.end.ball().upper()
+    step = (hi - lo) / _PIECES
+    edges = [(lo + step * i).mid() for i in range(_PIECES)] + [hi]
+    edges[0] = lo
+    return [a.union(b) for a, b in zip(edges, edges[1:], strict=False)]
+
+
+def _everywhere(predicate, interval: TimeRange) -> bool:
+    """True when ``predicate(ball)`` is proven on every piece of the range: a quick
+    proof by ball arithmetic that spares a root isolation (False means "not proven")."""
+    return all(predicate(piece) for piece in _pieces(interval))
+
+
 def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float):
     """Status of both branches of a quadratic leg with respect to step 1."""
     joint = leg.leg.joint
+    if _everywhere(lambda t: evaluate_trig(leg.discriminant, t) > 0, interval):
+        return FEASIBLE, "", None
     iso = _isolate(leg.discriminant, interval, tolerance)
     if iso is None:
         return INFEASIBLE, f"the two branches of {joint} coincide along the whole path " \
@@ -121,6 +145,12 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
                    tolerance: float) -> BranchFeasibility:
     joint = leg.leg.joint
     lo, hi = (fraction_ball(v) for v in limits)
+    bounds = f"[{limits[0]}, {limits[1]}]"
+    if _inside(leg.branches(interval.start.ball())[label], lo, hi) is False:
+        return BranchFeasibility(joint, label, INFEASIBLE,
+                                 f"{joint} is outside {bounds} from the start")
+    if _everywhere(lambda t: _inside(leg.branches(t)[label], lo, hi) is True, interval):
+        return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
     undecided = []
     for value in limits:
@@ -149,7 +179,6 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         if verdict is False:
             crossing = max((e for e in events if e < point), key=lambda b: b.mid(),
                            default=None)
-            bounds = f"[{limits[0]}, {limits[1]}]"
             reason = f"{joint} is outside {bounds} from the start" if crossing is None else \
                 f"{joint} leaves {bounds} at t ≈ {float(crossing.mid()):.6g}"
             return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing)

@@ -15,10 +15,10 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from singcheck.atomic import write_atomically
 from singcheck.cas.polytext import PolynomialSyntaxError, format_polynomial, parse_polynomial
 from singcheck.elimination import EliminationRequest, EliminationResult, restrict
 
@@ -103,13 +103,8 @@ class EliminationCache:
         }
         entry = {"format": FORMAT, "key": key, "payload": payload,
                  "sha256": _digest(json.dumps(payload, sort_keys=True))}
-        path = self._path(key)
         try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".tmp-", suffix=".json")
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                json.dump(entry, f)
-            os.replace(tmp, path)
+            write_atomically(self._path(key), json.dumps(entry))
         except OSError:
             return  # a cache that cannot be written is only slower, never wrong
 

@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import os
 import sys
-import tempfile
-from pathlib import Path
 
 import click
 
@@ -98,19 +96,6 @@ class Progress:
             self.note(message)
             return nullcontext()
         return self.console.status(message)
-
-
-def _write_atomically(path: str, text: str) -> None:
-    target = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=target.parent or ".", prefix=f".{target.name}.",
-                               suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _fail(message: str, code: ExitCode) -> None:
@@ -215,7 +200,9 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     code = _exit_code([r["verdict"] for r in results])
     text = _render(projection, results, tolerance, fmt, verbose, code, to_file=bool(output))
     if output:
-        _write_atomically(output, text)
+        from singcheck.atomic import write_atomically
+
+        write_atomically(output, text)
     else:
         sys.stdout.write(text)
     return code

@@ -96,7 +96,7 @@ def test_concurrent_writers_leave_one_whole_entry(cache):
     assert not errors
     (path,) = cache.entries()
     assert json.loads(path.read_text())["payload"]["backend"] == "sympy"
-    assert not list(cache.directory.glob("*/.tmp-*"))
+    assert not list(cache.directory.glob("*/.*.tmp"))  # no temporary file left behind
 
 
 def test_clear_removes_every_entry(cache):

@@ -103,11 +103,10 @@ def cas_version(cas: ExternalCAS, executable: str) -> str:
         known = {}
     version = _ask_version(cas, executable)
     try:
-        memo.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=memo.parent, prefix=".tmp-", suffix=".json")
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump({**(known if isinstance(known, dict) else {}), ident: version}, f)
-        os.replace(tmp, memo)
+        from singcheck.atomic import write_atomically
+
+        write_atomically(memo, json.dumps({**(known if isinstance(known, dict) else {}),
+                                           ident: version}))
     except OSError:
         pass
     return version

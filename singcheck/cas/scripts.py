@@ -34,14 +34,20 @@ def _var(request: EliminationRequest, name: str) -> str:
     return f"v{request.context.names().index(name) + 1}"
 
 
+def _parts(request: EliminationRequest) -> tuple[list[str], str, list[str]]:
+    """Ring variables, the generators (one per line) and the variables to eliminate."""
+    names = [f"v{i}" for i in range(1, request.context.nvars() + 1)]
+    generators = ",\n  ".join(format_polynomial(g) for g in request.generators)
+    return names, generators, [_var(request, v) for v in request.eliminate]
+
+
 def singular_script(request: EliminationRequest, library: str) -> str:
     """The Singular script for ``request`` (``library``: path of singcheck.lib)."""
-    n = request.context.nvars()
-    generators = ",\n  ".join(format_polynomial(g) for g in request.generators)
-    monomial = "*".join(_var(request, v) for v in request.eliminate)
+    names, generators, eliminated = _parts(request)
+    monomial = "*".join(eliminated)
     return (
         f'LIB "{library}";\n'
-        f"ring R = 0, ({','.join(f'v{i}' for i in range(1, n + 1))}), dp;\n"
+        f"ring R = 0, ({','.join(names)}), dp;\n"
         "short = 0;\n"
         f"ideal I =\n  {generators};\n"
         f'sc_eliminate(I, {monomial}, "{_label(request)}");\n'
@@ -51,14 +57,12 @@ def singular_script(request: EliminationRequest, library: str) -> str:
 
 def macaulay2_script(request: EliminationRequest, library: str) -> str:
     """The Macaulay2 script for ``request`` (``library``: path of singcheck.m2)."""
-    n = request.context.nvars()
-    generators = ",\n  ".join(format_polynomial(g) for g in request.generators)
-    eliminated = ", ".join(_var(request, v) for v in request.eliminate)
+    names, generators, eliminated = _parts(request)
     return (
         f'load "{library}";\n'
-        f"R = QQ[{', '.join(f'v{i}' for i in range(1, n + 1))}];\n"
+        f"R = QQ[{', '.join(names)}];\n"
         f"I = ideal(\n  {generators});\n"
-        f'scEliminate(I, {{{eliminated}}}, "{_label(request)}");\n'
+        f'scEliminate(I, {{{", ".join(eliminated)}}}, "{_label(request)}");\n'
         "exit 0;\n"
     )
 

@@ -25,7 +25,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from flint import arb, fmpq, fmpq_mpoly, fmpq_poly, fmpz_poly
+from flint import arb, arb_poly, fmpq, fmpq_mpoly, fmpq_poly, fmpz_poly
 
 from singcheck.errors import SingcheckError
 from singcheck.intervals import excludes_zero, sign, working_precision
@@ -115,9 +115,24 @@ class _RationalRoot:
     poly: fmpq_poly
     lo: fmpq
     hi: fmpq
+    _balls: arb_poly | None = None
 
     def width(self) -> fmpq:
         return self.hi - self.lo
+
+    def sign_at(self, q: fmpq) -> int:
+        """The exact sign of the polynomial at q: a ball evaluation when it decides,
+        exact rational arithmetic otherwise."""
+        if self._balls is None:
+            with working_precision(128):
+                self._balls = arb_poly([arb(c) for c in self.poly.coeffs()])
+        with working_precision(128):
+            value = self._balls(arb(q))
+        if value > 0:
+            return 1
+        if value < 0:
+            return -1
+        return _qsign(self.poly(q))
 
     def bisect_to(self, width: fmpq) -> None:
         f = self.poly
@@ -130,7 +145,7 @@ class _RationalRoot:
             return
         while self.hi - self.lo > width:
             mid = (self.lo + self.hi) / 2
-            sm = _qsign(f(mid))
+            sm = self.sign_at(mid)
             if sm == 0:
                 self.lo = self.hi = mid
                 return
@@ -164,6 +179,7 @@ def _sign_variations(coeffs) -> int:
 
 
 _X_PLUS_1 = fmpz_poly([1, 1])
+_TWO_X = fmpz_poly([0, 2])
 
 
 def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
@@ -190,17 +206,20 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     stack = [(g, 0, 0)]
     while stack:
         g, a, k = stack.pop()
-        rev = fmpz_poly(g.coeffs()[::-1])
-        v = _sign_variations(rev(_X_PLUS_1).coeffs())
-        ends_are_roots = g(0) == 0 or g(1) == 0
+        coeffs = g.coeffs()
+        m = len(coeffs) - 1
+        reversed_g = fmpz_poly(coeffs[::-1])
+        v = _sign_variations(reversed_g(_X_PLUS_1).coeffs())
+        ends_are_roots = coeffs[0] == 0 or g(1) == 0
         if v == 0:
             continue
         if v == 1 and not ends_are_roots:
             out.append((a, k, False))
             continue
-        gc = [int(c) for c in g.coeffs()]
-        m = len(gc) - 1
-        half = fmpz_poly([c << (m - i) for i, c in enumerate(gc)])  # 2^m g(x/2)
+        # 2^m g(x/2): reverse, substitute 2x, reverse back (all in FLINT)
+        scaled = reversed_g(_TWO_X).coeffs()
+        scaled += [0] * (m + 1 - len(scaled))
+        half = fmpz_poly(scaled[::-1])
         if half(1) == 0:
             out.append((2 * a + 1, k + 1, True))
         stack.append((half(_X_PLUS_1), 2 * a + 1, k + 1))
@@ -321,12 +340,17 @@ def _fraction(q: fmpq):
 def _half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
     """M(u) = (1+u²)^d · p(2u/(1+u²), (1-u²)/(1+u²)) and d (p free of t)."""
     d = max((j + k for (_i, j, k), _ in p.terms()), default=0)
-    u = fmpq_poly([0, 1])
-    one_plus = fmpq_poly([1, 0, 1])
-    one_minus = fmpq_poly([1, 0, -1])
+    def powers(base: fmpq_poly) -> list[fmpq_poly]:
+        out = [fmpq_poly([1])]
+        for _ in range(d):
+            out.append(out[-1] * base)
+        return out
+
+    two_u, one_minus, one_plus = (powers(fmpq_poly(c)) for c in ([0, 2], [1, 0, -1],
+                                                                  [1, 0, 1]))
     total = fmpq_poly([])
     for (_i, j, k), c in p.terms():
-        total += c * (2 * u) ** j * one_minus**k * one_plus ** (d - j - k)
+        total += c * two_u[j] * one_minus[k] * one_plus[d - j - k]
     return total, d
 
 

@@ -260,6 +260,49 @@ def _render(projection, results, tolerance, fmt, verbose, code, to_file: bool) -
     return buffer.getvalue()
 
 
+@cli.command(epilog="""\b
+Examples:
+  singcheck project robots/orthoglide.yaml
+  singcheck project robots/orthoglide.yaml trajectories/heart1.yaml --latex
+""")
+@click.argument("robot", type=click.Path(dir_okay=False))
+@click.argument("trajectory", required=False, type=click.Path(dir_okay=False))
+@click.option("--backend", type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
+              default="auto", envvar="SINGCHECK_BACKEND", show_default=True)
+@click.option("--latex", "as_latex", is_flag=True, help="LaTeX (an align* environment).")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
+              show_default=True)
+@click.option("--no-epsilon", is_flag=True,
+              help="Skip ε(ρ) (a Gröbner elimination of the pose, slow for large robots).")
+def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
+    """Print the robot's formulas: det A, det B, ξ(X), ε(ρ), the workspace boundary and
+    joint-limit surfaces; with a TRAJECTORY, φ(t) and every joint's parametrisation
+    ρ(t) = P(t) ± √Q(t)/k (the paper's form, in s = sin t and c = cos t)."""
+    try:
+        from singcheck.cas import get_backend
+        from singcheck.formulas import render
+        from singcheck.model import build_model
+        from singcheck.path import build_path
+        from singcheck.projection import joint_space_singularities, project_robot
+        from singcheck.spec import load_robot, load_trajectory
+
+        spec = load_robot(robot)
+        traj = load_trajectory(trajectory, spec) if trajectory else None
+        model = build_model(spec)
+        engine = get_backend(backend)
+        projection = project_robot(model, engine)
+        epsilon = None if no_epsilon else joint_space_singularities(model, engine)
+        path = build_path(projection, traj) if traj else None
+        click.echo(render(projection, epsilon, path, "json" if fmt == "json" else
+                          "latex" if as_latex else "text"), nl=False)
+    except KeyboardInterrupt:
+        _fail("interrupted", ExitCode.INTERRUPTED)
+    except SpecError as e:
+        _fail(str(e), ExitCode.USAGE)
+    except BackendError as e:
+        _fail(str(e), ExitCode.BACKEND)
+
+
 @cli.command()
 @click.option("--format", "fmt", type=click.Choice(["table", "json"]), default="table",
               show_default=True)

@@ -140,11 +140,13 @@ def cli() -> None:
 @click.option("-j", "--jobs", type=click.IntRange(min=1), default=os.cpu_count() or 1,
               show_default="number of cores",
               help="Processes certifying trajectories in parallel (used for more than 4).")
+@click.option("--plot", "plot_dir", type=click.Path(file_okay=False),
+              help="Also write the figures (see `singcheck plot`) to this directory.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
-def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs, quiet,
-        verbose) -> None:
+def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs, plot_dir,
+        quiet, verbose) -> None:
     """Certify each TRAJECTORY of ROBOT (YAML spec files).
 
     For every trajectory it prints the candidate singular times (certified
@@ -156,7 +158,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     progress = Progress(quiet)
     try:
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
-                    verbose, progress, jobs)
+                    verbose, progress, jobs, plot_dir)
     except KeyboardInterrupt:
         _fail("interrupted", ExitCode.INTERRUPTED)
     except SpecError as e:
@@ -177,7 +179,7 @@ def _exit_code(verdicts: list[str]) -> ExitCode:
 
 
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
-         progress, jobs):
+         progress, jobs, plot_dir=None):
     from singcheck.cache import CachedBackend, EliminationCache
     from singcheck.cas import get_backend
     from singcheck.model import build_model
@@ -197,6 +199,8 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     degree = projection.singularity_surface.total_degree()
     progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
     results = certify_all(projection, specs, tolerance, jobs, progress)
+    if plot_dir:
+        _plot_all(projection, specs, tolerance, plot_dir, progress)
     code = _exit_code([r["verdict"] for r in results])
     text = _render(projection, results, tolerance, fmt, verbose, code, to_file=bool(output))
     if output:
@@ -295,6 +299,60 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
         path = build_path(projection, traj) if traj else None
         click.echo(render(projection, epsilon, path, "json" if fmt == "json" else
                           "latex" if as_latex else "text"), nl=False)
+    except KeyboardInterrupt:
+        _fail("interrupted", ExitCode.INTERRUPTED)
+    except SpecError as e:
+        _fail(str(e), ExitCode.USAGE)
+    except BackendError as e:
+        _fail(str(e), ExitCode.BACKEND)
+
+
+def _plot_all(projection, specs, tolerance: float, out_dir: str, progress) -> list:
+    try:
+        from singcheck.plots import write_figures
+    except ImportError as e:
+        raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
+                        "missing): pip install 'singcheck[plot]'") from None
+    from singcheck.certify import certify_path
+    from singcheck.path import build_path
+
+    written = []
+    for spec in specs:
+        report = certify_path(build_path(projection, spec), tolerance)
+        written += write_figures(report, out_dir)
+    progress.note(f"wrote {len(written)} figure files to {out_dir}")
+    return written
+
+
+@cli.command(epilog="""\b
+Example:
+  singcheck plot robots/orthoglide.yaml trajectories/heart1.yaml --out figures/
+""")
+@click.argument("robot", type=click.Path(dir_okay=False))
+@click.argument("trajectories", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False),
+              help="Directory for the PNG and SVG files (created if needed).")
+@click.option("--backend", type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
+              default="auto", envvar="SINGCHECK_BACKEND", show_default=True)
+@click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
+def plot(robot, trajectories, out_dir, backend, quiet) -> None:
+    """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
+    roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
+    and the working modes in joint space with the joint-limit box (PNG and SVG)."""
+    progress = Progress(quiet)
+    try:
+        from singcheck.cache import CachedBackend, EliminationCache
+        from singcheck.cas import get_backend
+        from singcheck.model import build_model
+        from singcheck.projection import project_robot
+        from singcheck.spec import load_robot, load_trajectory
+
+        spec = load_robot(robot)
+        specs = [load_trajectory(p, spec) for p in trajectories]
+        engine = CachedBackend(get_backend(backend), EliminationCache())
+        projection = project_robot(build_model(spec), engine)
+        for path in _plot_all(projection, specs, 1e-9, out_dir, progress):
+            click.echo(str(path))
     except KeyboardInterrupt:
         _fail("interrupted", ExitCode.INTERRUPTED)
     except SpecError as e:

@@ -1,0 +1,66 @@
+"""Figures: what is drawn and marked comes from the certified report; files are written."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from singcheck.plots import FIGURES, figure_data, write_figures
+from tests.conftest import TRAJECTORIES
+from tests.test_cli import ORTHO, singcheck
+
+HERE = Path(__file__).parent
+
+
+@pytest.fixture(scope="module")
+def heart1(certify):
+    return certify("heart1")
+
+
+def test_marks_are_the_certified_candidates(heart1):
+    d = figure_data(heart1)
+    assert [c["status"] for c in d.candidates] == ["spurious", "spurious", "real", "real"]
+    assert [c["t"] for c in d.candidates] == [float(c.t.mid()) for c in heart1.candidates]
+    assert d.feasible == ["+++"]
+    assert d.singular["+++"] == pytest.approx([0.9778, 1.5119], abs=1e-4)
+    assert np.max(np.abs(d.mu)) == pytest.approx(1.0)
+    # the samples agree with the marks: det A of the feasible mode changes sign there
+    det = d.det_a["+++"]
+    assert np.sum(det[:-1] * det[1:] < 0) == 2
+
+
+def test_joint_space_shows_all_eight_modes_and_the_feasible_one_inside(heart1):
+    d = figure_data(heart1)
+    assert len(d.joints) == 8
+    inside = np.all([(np.nanmin(v) >= 0) & (np.nanmax(v) <= 4) for v in d.joints["+++"]])
+    assert inside
+    assert d.limits == {"rho1": (0.0, 4.0), "rho2": (0.0, 4.0), "rho3": (0.0, 4.0)}
+
+
+def test_every_figure_is_written_non_empty(heart1, tmp_path):
+    files = write_figures(heart1, tmp_path)
+    assert sorted(p.name for p in files) == sorted(
+        f"heart1-{k}.{fmt}" for k in FIGURES for fmt in ("png", "svg"))
+    assert all(p.stat().st_size > 1000 for p in files)
+
+
+def test_mu_figure_matches_the_reference_at_low_resolution(heart1, tmp_path):
+    from matplotlib.testing.compare import compare_images
+
+    write_figures(heart1, tmp_path, ("png",), dpi=30)
+    result = compare_images(str(HERE / "golden" / "heart1-mu-30dpi.png"),
+                            str(tmp_path / "heart1-mu.png"), tol=8)
+    assert result is None, result
+
+
+def test_plot_and_run_plot_commands(tmp_path):
+    out = singcheck("plot", ORTHO, str(TRAJECTORIES / "heart2.yaml"), "--out", str(tmp_path),
+                    "--backend", "flint")
+    assert out.returncode == 0, out.stderr
+    assert len(out.stdout.split()) == 8
+    run = singcheck("run", ORTHO, str(TRAJECTORIES / "helix.yaml"), "--plot",
+                    str(tmp_path / "run"), "--backend", "flint", "-q")
+    assert run.returncode == 0
+    assert (tmp_path / "run" / "helix-workspace.svg").stat().st_size > 1000

@@ -29,6 +29,7 @@ from singcheck.cas import get_backend  # noqa: E402
 from singcheck.certify import certify_path  # noqa: E402
 from singcheck.model import build_model  # noqa: E402
 from singcheck.path import build_path  # noqa: E402
+from singcheck.plots import numpy_polynomial  # noqa: E402
 from singcheck.projection import project_robot  # noqa: E402
 from singcheck.spec import load_robot, load_trajectory  # noqa: E402
 
@@ -51,43 +52,15 @@ def stats(ts: list[float]) -> dict:
 
 # -- the sampling contender -------------------------------------------------------
 
-def _numpy_poly(poly):
-    """A vectorised evaluator: powers computed once per variable, one product per term."""
-    terms = [(float(c), [(i, int(e)) for i, e in enumerate(exps) if e])
-             for exps, c in poly.terms()]
-    top = [max((int(e[i]) for e, _ in poly.terms()), default=0)
-           for i in range(poly.context().nvars())]
-
-    def f(arrays):
-        powers = []
-        for a, m in zip(arrays, top, strict=True):
-            p = [None, a]
-            for _ in range(2, m + 1):
-                p.append(p[-1] * a)
-            powers.append(p)
-        total = np.zeros_like(arrays[0])
-        for coeff, factors in terms:
-            if not factors:
-                total += coeff
-                continue
-            term = coeff * powers[factors[0][0]][factors[0][1]]
-            for i, e in factors[1:]:
-                term = term * powers[i][e]
-            total += term
-        return total
-
-    return f
-
-
 class SamplingScan:
     """det A along one working mode at n points, vectorised; sign changes are 'found'."""
 
     def __init__(self, path, mode_label: str) -> None:
         self.range = (float(path.trajectory.range.start), float(path.trajectory.range.end))
-        self.phi = [_numpy_poly(p) for p in path.phi]
-        self.legs = [([_numpy_poly(c) for c in leg.coefficients], sign)
+        self.phi = [numpy_polynomial(p) for p in path.phi]
+        self.legs = [([numpy_polynomial(c) for c in leg.coefficients], sign)
                      for leg, sign in zip(path.legs, mode_label, strict=True)]
-        self.det_a = _numpy_poly(path.projection.model.det_A)
+        self.det_a = numpy_polynomial(path.projection.model.det_A)
 
     def __call__(self, n: int) -> list[float]:
         t = np.linspace(*self.range, n)

@@ -324,6 +324,21 @@ def _plot_all(projection, specs, tolerance: float, out_dir: str, progress) -> li
     return written
 
 
+def _plot_html(projection, specs, out_dir: str):
+    try:
+        import plotly  # noqa: F401
+
+        from singcheck.plots import write_html
+    except ImportError as e:
+        raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
+                        "pip install 'singcheck[html]'") from None
+    from singcheck.certify import certify_path
+    from singcheck.path import build_path
+
+    reports = [certify_path(build_path(projection, s)) for s in specs]
+    return write_html(reports, os.path.join(out_dir, "singcheck.html"))
+
+
 @cli.command(epilog="""\b
 Example:
   singcheck plot robots/orthoglide.yaml trajectories/heart1.yaml --out figures/
@@ -334,8 +349,11 @@ Example:
               help="Directory for the PNG and SVG files (created if needed).")
 @click.option("--backend", type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
               default="auto", envvar="SINGCHECK_BACKEND", show_default=True)
+@click.option("--format", "fmt", type=click.Choice(["files", "html"]), default="files",
+              show_default=True, help="files: PNG and SVG per figure; html: one "
+              "self-contained interactive page (needs singcheck[html]).")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
-def plot(robot, trajectories, out_dir, backend, quiet) -> None:
+def plot(robot, trajectories, out_dir, backend, fmt, quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
     and the working modes in joint space with the joint-limit box (PNG and SVG)."""
@@ -351,6 +369,9 @@ def plot(robot, trajectories, out_dir, backend, quiet) -> None:
         specs = [load_trajectory(p, spec) for p in trajectories]
         engine = CachedBackend(get_backend(backend), EliminationCache())
         projection = project_robot(build_model(spec), engine)
+        if fmt == "html":
+            click.echo(str(_plot_html(projection, specs, out_dir)))
+            return
         for path in _plot_all(projection, specs, 1e-9, out_dir, progress):
             click.echo(str(path))
     except KeyboardInterrupt:

@@ -247,3 +247,69 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
             written.append(target)
         plt.close(fig)
     return written
+
+
+def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
+    """One self-contained interactive page (plotly, its JavaScript inlined once) with
+    the same four figures for every trajectory."""
+    import plotly.graph_objects as go
+
+    from singcheck.atomic import write_atomically
+
+    parts = []
+    first = True
+    for report in reports:
+        d = figure_data(report)
+        robot = report.path.projection.model.name
+        figs = []
+        mu = go.Figure(go.Scatter(x=d.t, y=d.mu, mode="lines", name="μ(t)/max|μ|"))
+        for c in d.candidates:
+            color = _STATUS_STYLE.get(c["status"], ("magenta", "s"))[0]
+            mu.add_trace(go.Scatter(x=[c["t"]], y=[0], mode="markers", name=f"{c['label']} "
+                                    f"{c['status']}", marker={"color": color, "size": 10},
+                                    hovertext=f"t ∈ [{c['interval'][0]:.12g}, "
+                                              f"{c['interval'][1]:.12g}]"))
+        mu.update_layout(title=f"{robot} · {report.name}: μ(t) and its certified roots")
+        figs.append(mu)
+        det = go.Figure()
+        for label in d.feasible:
+            det.add_trace(go.Scatter(x=d.t, y=d.det_a[label], mode="lines", name=label))
+            det.add_trace(go.Scatter(x=d.singular[label], y=[0] * len(d.singular[label]),
+                                     mode="markers", name=f"proven zeros ({label})",
+                                     marker={"color": "red", "size": 10}))
+        det.update_layout(title=f"{robot} · {report.name}: det A along feasible modes")
+        figs.append(det)
+        pose = d.names["pose"]
+        if len(pose) >= 3:
+            ws = go.Figure(go.Scatter3d(x=d.pose[0], y=d.pose[1], z=d.pose[2], mode="lines",
+                                        name="path"))
+            for c in d.candidates:
+                ws.add_trace(go.Scatter3d(x=[c["pose"][0]], y=[c["pose"][1]],
+                                          z=[c["pose"][2]], mode="markers",
+                                          name=f"{c['label']} {c['status']}"))
+        else:
+            ws = go.Figure(go.Scatter(x=d.pose[0], y=d.pose[1], mode="lines", name="path"))
+            for c in d.candidates:
+                ws.add_trace(go.Scatter(x=[c["pose"][0]], y=[c["pose"][1]], mode="markers",
+                                        name=f"{c['label']} {c['status']}"))
+        ws.update_layout(title=f"{robot} · {report.name}: path and singular points")
+        figs.append(ws)
+        js = go.Figure()
+        names = d.names["joints"]
+        for label, values in d.joints.items():
+            width = 6 if label in d.feasible else 2
+            if len(names) >= 3:
+                js.add_trace(go.Scatter3d(x=values[0], y=values[1], z=values[2],
+                                          mode="lines", name=label, line={"width": width}))
+            else:
+                js.add_trace(go.Scatter(x=values[0], y=values[1], mode="lines", name=label,
+                                        line={"width": width}))
+        js.update_layout(title=f"{robot} · {report.name}: working modes in joint space")
+        figs.append(js)
+        for fig in figs:
+            parts.append(fig.to_html(full_html=False, include_plotlyjs=first))
+            first = False
+    page = ("<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>singcheck figures"
+            "</title></head><body>\n" + "\n".join(parts) + "\n</body></html>\n")
+    write_atomically(target, page)
+    return Path(target)

@@ -64,3 +64,15 @@ def test_plot_and_run_plot_commands(tmp_path):
                     str(tmp_path / "run"), "--backend", "flint", "-q")
     assert run.returncode == 0
     assert (tmp_path / "run" / "helix-workspace.svg").stat().st_size > 1000
+
+
+def test_html_page_is_self_contained_and_holds_every_figure(tmp_path):
+    out = singcheck("plot", ORTHO, str(TRAJECTORIES / "heart1.yaml"),
+                    str(TRAJECTORIES / "helix.yaml"), "--out", str(tmp_path), "--format",
+                    "html", "--backend", "flint")
+    assert out.returncode == 0, out.stderr
+    page = (tmp_path / "singcheck.html").read_text()
+    assert page.count('class="plotly-graph-div"') == 8
+    assert "<script src=" not in page.replace('<script src="data', "")  # JS inlined
+    assert "s3 real" in page and "s1 spurious" in page
+    assert (tmp_path / "singcheck.html").stat().st_mode & 0o044  # readable by others

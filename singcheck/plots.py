@@ -127,7 +127,8 @@ def _det_figure(plt, d: FigureData, title: str):
     for label in d.feasible:
         ax.plot(d.t, d.det_a[label], lw=1, label=f"mode {label}")
         ts = d.singular[label]
-        ax.plot(ts, [0] * len(ts), "o", color="red", ms=7, label=f"proven zeros ({label})")
+        if ts:
+            ax.plot(ts, [0] * len(ts), "o", color="red", ms=7, label=f"proven zeros ({label})")
     ax.axhline(0, color="grey", lw=0.5)
     ax.set_xlabel(d.names["parameter"][0])
     ax.set_ylabel("det A")

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import os
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import click
 
@@ -98,6 +100,21 @@ class Progress:
         return self.console.status(message)
 
 
+@contextmanager
+def exit_codes() -> Iterator[None]:
+    """The one place where library errors become exit codes (and Ctrl-C becomes 130)."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        _fail("interrupted", ExitCode.INTERRUPTED)
+    except SpecError as e:
+        _fail(str(e), ExitCode.USAGE)
+    except BackendError as e:
+        _fail(str(e), ExitCode.BACKEND)
+    except SingcheckError as e:
+        _fail(str(e), ExitCode.UNKNOWN)
+
+
 def _fail(message: str, code: ExitCode) -> None:
     click.echo(f"singcheck: error: {message}", err=True)
     sys.exit(int(code))
@@ -156,17 +173,9 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     singularity-free, singular, infeasible or unknown.
     """
     progress = Progress(quiet)
-    try:
+    with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
                     verbose, progress, jobs, plot_dir)
-    except KeyboardInterrupt:
-        _fail("interrupted", ExitCode.INTERRUPTED)
-    except SpecError as e:
-        _fail(str(e), ExitCode.USAGE)
-    except BackendError as e:
-        _fail(str(e), ExitCode.BACKEND)
-    except SingcheckError as e:
-        _fail(str(e), ExitCode.UNKNOWN)
     sys.exit(int(code))
 
 
@@ -282,7 +291,7 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
     """Print the robot's formulas: det A, det B, ξ(X), ε(ρ), the workspace boundary and
     joint-limit surfaces; with a TRAJECTORY, φ(t) and every joint's parametrisation
     ρ(t) = P(t) ± √Q(t)/k (the paper's form, in s = sin t and c = cos t)."""
-    try:
+    with exit_codes():
         from singcheck.cas import get_backend
         from singcheck.formulas import render
         from singcheck.model import build_model
@@ -299,12 +308,6 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
         path = build_path(projection, traj) if traj else None
         click.echo(render(projection, epsilon, path, "json" if fmt == "json" else
                           "latex" if as_latex else "text"), nl=False)
-    except KeyboardInterrupt:
-        _fail("interrupted", ExitCode.INTERRUPTED)
-    except SpecError as e:
-        _fail(str(e), ExitCode.USAGE)
-    except BackendError as e:
-        _fail(str(e), ExitCode.BACKEND)
 
 
 def _plot_all(projection, specs, tolerance: float, out_dir: str, progress) -> list:
@@ -358,7 +361,7 @@ def plot(robot, trajectories, out_dir, backend, fmt, quiet) -> None:
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
     and the working modes in joint space with the joint-limit box (PNG and SVG)."""
     progress = Progress(quiet)
-    try:
+    with exit_codes():
         from singcheck.cache import CachedBackend, EliminationCache
         from singcheck.cas import get_backend
         from singcheck.model import build_model
@@ -374,12 +377,6 @@ def plot(robot, trajectories, out_dir, backend, fmt, quiet) -> None:
             return
         for path in _plot_all(projection, specs, 1e-9, out_dir, progress):
             click.echo(str(path))
-    except KeyboardInterrupt:
-        _fail("interrupted", ExitCode.INTERRUPTED)
-    except SpecError as e:
-        _fail(str(e), ExitCode.USAGE)
-    except BackendError as e:
-        _fail(str(e), ExitCode.BACKEND)
 
 
 @cli.command()

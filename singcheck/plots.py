@@ -287,12 +287,19 @@ def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
             for c in d.candidates:
                 ws.add_trace(go.Scatter3d(x=[c["pose"][0]], y=[c["pose"][1]],
                                           z=[c["pose"][2]], mode="markers",
-                                          name=f"{c['label']} {c['status']}"))
+                                          name=f"{c['label']} {c['status']}",
+                                          marker={"color": _STATUS_STYLE.get(
+                                              c["status"], ("magenta",))[0]}))
+            ws.update_layout(scene={"xaxis_title": pose[0], "yaxis_title": pose[1],
+                                    "zaxis_title": pose[2]})
         else:
             ws = go.Figure(go.Scatter(x=d.pose[0], y=d.pose[1], mode="lines", name="path"))
             for c in d.candidates:
                 ws.add_trace(go.Scatter(x=[c["pose"][0]], y=[c["pose"][1]], mode="markers",
-                                        name=f"{c['label']} {c['status']}"))
+                                        name=f"{c['label']} {c['status']}",
+                                        marker={"color": _STATUS_STYLE.get(
+                                            c["status"], ("magenta",))[0]}))
+            ws.update_layout(xaxis_title=pose[0], yaxis_title=pose[1])
         ws.update_layout(title=f"{robot} · {report.name}: path and singular points")
         figs.append(ws)
         js = go.Figure()
@@ -306,6 +313,11 @@ def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
                 js.add_trace(go.Scatter(x=values[0], y=values[1], mode="lines", name=label,
                                         line={"width": width}))
         js.update_layout(title=f"{robot} · {report.name}: working modes in joint space")
+        if len(names) >= 3:
+            js.update_layout(scene={"xaxis_title": names[0], "yaxis_title": names[1],
+                                    "zaxis_title": names[2]})
+        else:
+            js.update_layout(xaxis_title=names[0], yaxis_title=names[1])
         figs.append(js)
         for fig in figs:
             parts.append(fig.to_html(full_html=False, include_plotlyjs=first))

@@ -5,9 +5,9 @@ one root of ``poly(t, sin t, cos t)``, proves every gap between them root-free, 
 reports whatever it cannot prove as :class:`Undecided` with a reason.  Three methods:
 
 * **exact univariate** (no sin/cos): the squarefree factors of the polynomial in t
-  over Z; FLINT's ``arb_fmpz_poly_complex_roots`` certifies that each real-root ball
-  isolates one root (it returns real roots first, with imaginary part exactly zero).
-  The balls become rational intervals with a sign change, refined by exact bisection.
+  over Z; Descartes' rule of signs with Vincent–Collins–Akritas bisection (exact
+  integer arithmetic) gives rational intervals each holding exactly one root, with a
+  sign change at their ends, refined by bisection on exact signs.
 * **tangent half-angle** (sin/cos only): u = tan(t/2), s = 2u/(1+u²),
   c = (1-u²)/(1+u²) turn μ into M(u) = (1+u²)^d μ ∈ Q[u]; its real roots are isolated
   as above and mapped to t = 2·atan(u) + 2kπ with Arb's rigorous ``atan``; t ≡ π

@@ -31,6 +31,9 @@ from singcheck.trig import TRIG, LinearInPi, T, cos_multiple, reduce_trig, sin_m
 
 MAX_EXPONENT = 64
 MAX_LENGTH = 10_000
+MAX_DEGREE = 256  # of any intermediate polynomial
+MAX_TERMS = 100_000
+MAX_BITS = 20_000  # of any intermediate rational's numerator or denominator
 FUNCTIONS = ("sin", "cos")
 
 
@@ -240,7 +243,8 @@ class _Compiler:
         if k == "pow":
             e = _exponent(node.args[1], _constant_of(args[1]) if not isinstance(
                 args[1], Fraction) else args[1])
-            return args[0] ** e
+            _check_power(args[0], e, node)
+            return _checked(args[0] ** e, node)
         a, b = args
         if k == "add":
             return a + b if isinstance(a, Fraction) and isinstance(b, Fraction) \
@@ -249,8 +253,11 @@ class _Compiler:
             return a - b if isinstance(a, Fraction) and isinstance(b, Fraction) \
                 else self.lift(a) - self.lift(b)
         if k == "mul":
-            return a * b if isinstance(a, Fraction) and isinstance(b, Fraction) \
-                else self.lift(a) * self.lift(b)
+            if not (isinstance(a, Fraction) or isinstance(b, Fraction)) and \
+                    a.total_degree() + b.total_degree() > MAX_DEGREE:
+                raise ExprError(f"the expression's degree exceeds {MAX_DEGREE}", node.column)
+            return _checked(a * b if isinstance(a, Fraction) and isinstance(b, Fraction)
+                            else self.lift(a) * self.lift(b), node)
         if k == "div":
             d = _constant_of(b)
             if d is None:
@@ -262,6 +269,34 @@ class _Compiler:
                 return a / d
             return a / fmpq(d.numerator, d.denominator)
         raise AssertionError(k)  # pragma: no cover
+
+
+def _check_power(base, e: int, node: Node) -> None:
+    """Refuse a power before computing it when its size would explode."""
+    if isinstance(base, Fraction):
+        bits = max(abs(base.numerator).bit_length(), base.denominator.bit_length())
+        if bits * e > MAX_BITS:
+            raise ExprError(f"the number {base}^{e} is too large", node.column)
+    elif base.total_degree() * e > MAX_DEGREE:
+        raise ExprError(f"the expression's degree exceeds {MAX_DEGREE}", node.column)
+    elif len(base) > 1 and e > 1:
+        from math import comb
+
+        nvars = sum(1 for d in base.degrees() if d)
+        if comb(nvars + base.total_degree() * e, nvars) > MAX_TERMS and \
+                min(len(base), e + 1) ** min(e, 12) > MAX_TERMS:
+            raise ExprError(f"the expanded expression would have more than {MAX_TERMS} terms",
+                            node.column)
+
+
+def _checked(value, node: Node):
+    if isinstance(value, Fraction):
+        if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) > MAX_BITS:
+            raise ExprError("a number in the expression is too large", node.column)
+    elif len(value) > MAX_TERMS:
+        raise ExprError(f"the expanded expression has more than {MAX_TERMS} terms",
+                        node.column)
+    return value
 
 
 def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmpq_mpoly],
@@ -292,6 +327,9 @@ def compile_trajectory_coordinate(node: Node, parameter: str,
 
     def call(n: Node):
         k = _multiple_of(n.args[0], parameter)
+        if abs(k) > MAX_DEGREE:
+            raise ExprError(f"the multiple {k} of {parameter} is larger than {MAX_DEGREE}",
+                            n.column)
         return sin_multiple(k) if n.value == "sin" else cos_multiple(k)
 
     compiler = _Compiler(TRIG, {**parameters, parameter: T}, call, what="trajectory")
@@ -331,5 +369,6 @@ def compile_constant(node: Node) -> LinearInPi:
         if base.pi_coefficient or e.pi_coefficient:
             raise ExprError("powers of pi are not allowed: use a + b*pi", node.column)
         n = _exponent(node.args[1], e.rational)
+        _check_power(base.rational, n, node)
         return LinearInPi(base.rational ** n)
     raise ExprError("only numbers, pi, + - * / and ^ are allowed here", node.column)

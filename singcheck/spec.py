@@ -155,7 +155,7 @@ def _compose(text: str, path: str):
         raise SpecError(f"not valid YAML: {str(e).splitlines()[0]}", path=path) from None
     if node is None:
         raise SpecError("the file is empty", path=path, line=1)
-    _refuse_tags(node, _Doc(path))
+    _refuse_tags(node, _Doc(path), set())
     return node
 
 
@@ -163,7 +163,12 @@ _PLAIN_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "null",
                                                   "map", "seq")}
 
 
-def _refuse_tags(node, doc: _Doc) -> None:
+def _refuse_tags(node, doc: _Doc, seen: set[int]) -> None:
+    """Refuse YAML tags, and aliases (``*name``): a node reached twice is an alias, and
+    nested aliases are how a small file expands into an enormous one."""
+    if id(node) in seen:
+        raise doc.error(node, None, "YAML aliases (*name) are not allowed in specs")
+    seen.add(id(node))
     if node.tag not in _PLAIN_TAGS:
         raise doc.error(node, None, f"YAML tags like {node.tag} are not allowed")
     children = []
@@ -173,7 +178,7 @@ def _refuse_tags(node, doc: _Doc) -> None:
     elif isinstance(node, yaml.SequenceNode):
         children = node.value
     for child in children:
-        _refuse_tags(child, doc)
+        _refuse_tags(child, doc, seen)
 
 
 def _read(path: str | os.PathLike) -> str:

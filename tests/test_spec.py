@@ -145,6 +145,7 @@ BAD_TRAJECTORIES = [
     (TRAJ.replace("cos(t)", "tan(t)"), 5, "pose.x", "unknown function 'tan'"),
     (TRAJ.replace("cos(t)", "cos(s)"), 5, "pose.x", "integer multiple of t"),
     (TRAJ.replace("cos(t)", "u"), 5, "pose.x", "undeclared name 'u'"),
+    (TRAJ.replace("cos(t)", "cos(100000*t)"), 5, "pose.x", "larger than 256"),
     (TRAJ.replace("  y: sin(t)\n", ""), 4, "pose", "missing coordinate(s) y"),
     (TRAJ + "  z: 1\n", 7, "pose.z", "not a pose variable"),
     (TRAJ.replace("parameter: t", "parameter: x"), 2, "parameter", "already a name"),
@@ -187,3 +188,23 @@ def test_bundled_specs_all_load():
 
     for path in ROBOTS.glob("*.yaml"):
         build_model(load_robot(path))
+
+
+BOMBS = [
+    # nested aliases: a few lines that would expand to an enormous document
+    ("a: &a [x, x, x, x, x, x, x, x]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a]\n"
+     "c: [*b, *b, *b, *b, *b, *b, *b, *b]\n", "aliases"),
+    (ROBOT.replace("(x - p)^2", "(((x - p)^64)^64)^64"), "degree exceeds"),
+    (ROBOT.replace("(x - p)^2", "(x + y + p + q + 1)^60"), "more than 100000 terms"),
+    (ROBOT.replace("{l: 2}", "{l: ((9^64)^64)^64}"), "too large"),
+]
+
+
+@pytest.mark.parametrize("text, phrase", BOMBS, ids=[p for _, p in BOMBS])
+def test_specs_cannot_blow_up_memory_or_time(text, phrase):
+    import time
+
+    start = time.monotonic()
+    with pytest.raises(SpecError, match=phrase):
+        parse_robot(text, "bomb.yaml")
+    assert time.monotonic() - start < 5

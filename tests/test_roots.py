@@ -136,7 +136,7 @@ def test_pi_endpoint_is_exact():
 def test_descartes_isolation_agrees_with_flint_complex_roots():
     import random
 
-    from singcheck.roots import _real_roots_exact
+    from singcheck.rational_roots import real_roots_exact
 
     rng = random.Random(11)
     for _ in range(40):
@@ -145,7 +145,7 @@ def test_descartes_isolation_agrees_with_flint_complex_roots():
         f *= fmpz_poly([rng.randint(-5, 5), rng.randint(1, 3)])  # a rational root
         if rng.random() < 0.3:
             f *= fmpz_poly([0, 1])  # a root at 0
-        ours = _real_roots_exact(fmpq_poly(f))
+        ours = real_roots_exact(fmpq_poly(f))
         flint_real = sorted(float(r.real.mid()) for r, _ in f.complex_roots() if r.imag == 0)
         assert len(ours) == len(flint_real)
         for (rr, _), x in zip(ours, flint_real, strict=True):

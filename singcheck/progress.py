@@ -1,0 +1,73 @@
+"""Progress for people, on stderr: notes, a spinner, a bar for batches (rich).
+
+Silent with ``--quiet``; plain lines when stderr is not a terminal (CI logs).
+"""
+
+from __future__ import annotations
+
+
+class Progress:
+    """Progress notes on stderr (silent with --quiet)."""
+
+    def __init__(self, quiet: bool) -> None:
+        from rich.console import Console
+
+        self.quiet = quiet
+        self.console = Console(stderr=True, highlight=False, soft_wrap=True)
+
+    def note(self, message: str) -> None:
+        if not self.quiet:
+            self.console.print(f"[dim]singcheck:[/dim] {message}")
+
+    def bar(self, total: int):
+        """A context giving ``advance(name, verdict)``: a bar on a terminal, else notes."""
+        from contextlib import contextmanager
+
+        @contextmanager
+        def plain():
+            done = [0]
+            step = max(1, total // 10)
+
+            def advance(name: str, verdict: str) -> None:
+                done[0] += 1
+                if total <= 20:
+                    self.note(f"[{done[0]}/{total}] {name}: {verdict}")
+                elif done[0] % step == 0 or done[0] == total:
+                    self.note(f"certified {done[0]}/{total} trajectories")
+
+            yield advance
+
+        @contextmanager
+        def rich_bar():
+            from rich.progress import (
+                BarColumn,
+                MofNCompleteColumn,
+                Progress,
+                TextColumn,
+                TimeRemainingColumn,
+            )
+
+            with Progress(TextColumn("certifying"), BarColumn(), MofNCompleteColumn(),
+                          TimeRemainingColumn(), console=self.console, transient=True) as bar:
+                task = bar.add_task("certify", total=total)
+
+                def advance(name: str, verdict: str) -> None:
+                    bar.advance(task)
+
+                yield advance
+            self.note(f"certified {total} trajectories")
+
+        if self.quiet:
+            @contextmanager
+            def silent():
+                yield lambda name, verdict: None
+            return silent()
+        return rich_bar() if self.console.is_terminal and total > 1 else plain()
+
+    def status(self, message: str):
+        from contextlib import nullcontext
+
+        if self.quiet or not self.console.is_terminal:
+            self.note(message)
+            return nullcontext()
+        return self.console.status(message)

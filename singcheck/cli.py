@@ -356,6 +356,16 @@ def cache_clear() -> None:
     click.echo(f"removed {EliminationCache().clear()} entries")
 
 
+def _register_space_commands() -> None:
+    from singcheck.cli_spaces import jointspace, workspace
+
+    cli.add_command(workspace)
+    cli.add_command(jointspace)
+
+
+_register_space_commands()
+
+
 def main() -> None:
     """Console-script entry point: never lets a traceback reach the user."""
     try:

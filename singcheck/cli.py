@@ -162,10 +162,18 @@ _WORKER: dict = {}
 def _certify_index(i: int) -> dict:
     from singcheck.certify import certify_path
     from singcheck.path import build_path
-    from singcheck.report import trajectory_json
+    from singcheck.path_regions import path_in_workspace
+    from singcheck.report import trajectory_json, workspace_json
 
     projection, specs, tolerance = _WORKER["projection"], _WORKER["specs"], _WORKER["tolerance"]
-    return trajectory_json(certify_path(build_path(projection, specs[i]), tolerance))
+    path = build_path(projection, specs[i])
+    report = certify_path(path, tolerance)
+    doc = trajectory_json(report)
+    doc["workspace"] = workspace_json(path_in_workspace(path, tolerance))
+    if doc["verdict"] == "infeasible" and doc["workspace"]["exit_time_interval"]:
+        lo, hi = doc["workspace"]["exit_time_interval"]
+        doc["reason"] += f"; the path leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"
+    return doc
 
 
 def certify_all(projection, specs, tolerance: float, jobs: int, progress) -> list[dict]:
@@ -277,11 +285,13 @@ def _plot_html(projection, specs, out_dir: str):
 
 
 @cli.command(epilog="""\b
-Example:
+Examples:
   singcheck plot robots/orthoglide.yaml trajectories/heart1.yaml --out figures/
+  singcheck plot robots/orthoglide.yaml --regions workspace --slice z=1 --out figures/
+  singcheck plot robots/skew-biglide.yaml --regions workspace --out figures/
 """)
 @click.argument("robot", type=click.Path(dir_okay=False))
-@click.argument("trajectories", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.argument("trajectories", nargs=-1, type=click.Path(dir_okay=False))
 @click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False),
               help="Directory for the PNG and SVG files (created if needed).")
 @click.option("--backend", type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
@@ -289,13 +299,28 @@ Example:
 @click.option("--format", "fmt", type=click.Choice(["files", "html"]), default="files",
               show_default=True, help="files: PNG and SVG per figure; html: one "
               "self-contained interactive page (needs singcheck[html]).")
+@click.option("--regions", "spaces", multiple=True,
+              type=click.Choice(["workspace", "jointspace"]),
+              help="Also draw the regions of that space coloured by their number of "
+              "solutions (a plane: a planar robot, or --slice on a spatial one).")
+@click.option("--slice", "slices", multiple=True, metavar="AXIS=VALUE",
+              help="For --regions: fix an axis to an exact rational (repeatable).")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
-def plot(robot, trajectories, out_dir, backend, fmt, quiet) -> None:
+def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
-    and the working modes in joint space with the joint-limit box (PNG and SVG)."""
+    and the working modes in joint space with the joint-limit box (PNG and SVG).
+    With --regions, draw a plane of the workspace or joint space coloured by the
+    exact number of solutions of each region."""
     progress = Progress(quiet)
     with exit_codes():
+        if not trajectories and not spaces:
+            raise click.UsageError("give at least one TRAJECTORY, or --regions SPACE")
+        for space in spaces:
+            for path in _plot_regions(space, robot, slices, backend, out_dir, progress):
+                click.echo(str(path))
+        if not trajectories:
+            return
         from singcheck.cache import CachedBackend, EliminationCache
         from singcheck.cas import get_backend
         from singcheck.model import build_model
@@ -311,6 +336,26 @@ def plot(robot, trajectories, out_dir, backend, fmt, quiet) -> None:
             return
         for path in _plot_all(projection, specs, 1e-9, out_dir, progress):
             click.echo(str(path))
+
+
+def _plot_regions(space, robot, slices, backend, out_dir, progress) -> list:
+    from singcheck.cli_spaces import compute
+    from singcheck.space_analysis import SliceError
+
+    try:
+        from singcheck.region_plots import write_region_figure
+    except ImportError as e:  # pragma: no cover - the plot extra is missing
+        raise SpecError(f"plotting needs matplotlib and numpy ({e.name} is missing): "
+                        "pip install 'singcheck[plot]'") from None
+    try:
+        analysis, _ = compute(space, robot, slices, "auto", False, backend, 600, False,
+                              progress)
+    except SliceError as e:
+        raise click.BadParameter(str(e), param_hint="--slice") from None
+    if len(analysis.axes) != 2:
+        raise click.BadParameter(f"the {space} has {len(analysis.axes)} free axes; fix all "
+                                 "but two with --slice", param_hint="--slice")
+    return write_region_figure(analysis, out_dir)
 
 
 @cli.command()

@@ -72,6 +72,37 @@ def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
     }
 
 
+def workspace_json(w) -> dict[str, Any]:
+    """The path against the workspace's regions (:mod:`singcheck.path_regions`)."""
+    return {
+        "one_region": w.one_region,
+        "region": w.region,
+        "crossings": [{"t_interval": _interval(c.t), "surfaces": list(c.surfaces)}
+                      for c in w.crossings],
+        "ik_counts": [s.count for s in w.stretches],
+        "exit_time_interval": None if w.exit_time is None else _interval(w.exit_time),
+        "undecided": w.undecided,
+    }
+
+
+def workspace_line(w: dict[str, Any]) -> str:
+    """One sentence for the table report."""
+    counts = w["ik_counts"]
+    if w["one_region"] is None:
+        return "workspace: crossings not all decided: " + "; ".join(w["undecided"])
+    if w["one_region"]:
+        where = f"region {w['region']}" if w["region"] else "one region of the workspace"
+        return (f"workspace: the whole path lies in {where} "
+                f"({counts[0]} IK solution(s) inside the joint limits all along)")
+    text = (f"workspace: the path crosses the discriminant variety {len(w['crossings'])} "
+            f"time(s); IK solutions inside the limits along it: "
+            + " → ".join("?" if c is None else str(c) for c in counts))
+    if w["exit_time_interval"]:
+        lo, hi = w["exit_time_interval"]
+        text += f"; it leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"
+    return text
+
+
 def robot_json(projection: RobotProjection) -> dict[str, Any]:
     model = projection.model
     return {"name": model.name, "path": model.spec.path, "joints": list(model.joints),
@@ -151,5 +182,7 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
             lo, hi = u["t_interval"]
             console.print(f"  undecided for {t['parameter']} in [{lo:.9g}, {hi:.9g}]: "
                           f"{u['reason']}")
+        if t.get("workspace"):
+            console.print(workspace_line(t["workspace"]))
         style = _VERDICT_STYLE.get(t["verdict"], "bold")
         console.print(f"verdict [{style}]{t['verdict']}[/{style}]: {t['reason']}\n")

@@ -159,6 +159,47 @@ def projection_rows() -> list[dict]:
     return rows
 
 
+def space_rows() -> list[dict]:
+    """Workspace / joint-space analyses (issue 6): decomposition, counts, regions."""
+    from fractions import Fraction
+
+    from singcheck.space_analysis import (
+        JOINTSPACE,
+        WORKSPACE,
+        analyse,
+        jointspace_variety,
+        select_surfaces,
+        workspace_variety,
+    )
+
+    backend = get_backend("flint")
+    rows = []
+    for robot, space, fixed in (("orthoglide", WORKSPACE, {}),
+                                ("orthoglide", WORKSPACE, {"z": Fraction(1)}),
+                                ("orthoglide", JOINTSPACE, {}),
+                                ("orthoglide", JOINTSPACE, {"rho3": Fraction(2)}),
+                                ("skew-biglide", WORKSPACE, {})):
+        model = build_model(load_robot(ROOT / "robots" / f"{robot}.yaml"))
+        components = (workspace_variety(project_robot(model, backend)) if space == WORKSPACE
+                      else jointspace_variety(model, backend))
+        free = len(model.pose) - len(fixed)
+        components, _ = select_surfaces(components, space, "auto", free)
+        last = {}
+
+        def work(model=model, space=space, components=components, fixed=fixed, last=last):
+            last["a"] = analyse(space, model, components, fixed)
+
+        ts = times(work, 3)
+        a = last["a"]
+        where = ", ".join(f"{k}={v}" for k, v in fixed.items()) or "full"
+        rows.append({"robot": robot, "space": space, "slice": where, "cells": len(a.cells),
+                     "regions": None if a.regions is None else len(a.regions.regions),
+                     "counts": sorted({c.count for c in a.cells if c.within_limits},
+                                      key=lambda c: -1 if c is None else c),
+                     **{k: round(v, 4) for k, v in a.timings.items()}, **stats(ts)})
+    return rows
+
+
 def cli_rows() -> list[dict]:
     exe = [sys.executable, "-m", "singcheck"]
     with tempfile.TemporaryDirectory() as cache:
@@ -253,6 +294,14 @@ def main() -> None:
         else:
             print(f"  {r['backend']:10} median {ms(r['median_s'])} ms  min {ms(r['min_s'])} "
                   f"ms  max {ms(r['max_s'])} ms")
+    results["spaces"] = spaces = space_rows()
+    print("\nworkspace / joint-space analysis (in-process, flint backend, median of 3)")
+    for r in spaces:
+        regions = "" if r["regions"] is None else f", {r['regions']} regions"
+        print(f"  {r['robot']:13} {r['space']:10} {r['slice']:8} {r['cells']:4} cells"
+              f"{regions}, counts {r['counts']}: median {ms(r['median_s'])} ms "
+              f"(CAD {ms(r['decomposition_s'])}, counts {ms(r['counting_s'])}, regions "
+              f"{ms(r['regions_s'])})")
     results["command_line"] = cli = cli_rows()
     print("\ncommand line")
     for r in cli:

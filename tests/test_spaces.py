@@ -1,0 +1,243 @@
+"""Workspace / joint-space analysis: open CAD, exact counts, regions, the path's region."""
+
+from __future__ import annotations
+
+import json
+from fractions import Fraction
+
+import mpmath
+import pytest
+from flint import fmpq_mpoly_ctx
+
+from singcheck.cad import open_cad, simplest_between
+from singcheck.regions import connect_regions
+from singcheck.solution_counts import direct_kinematics_count, inverse_kinematics_count
+from singcheck.space_analysis import (
+    JOINTSPACE,
+    LIMIT,
+    WORKSPACE,
+    SliceError,
+    analyse,
+    jointspace_variety,
+    select_surfaces,
+    workspace_variety,
+)
+from tests.conftest import ROBOTS, TRAJECTORIES
+from tests.test_cli import singcheck
+
+XY = fmpq_mpoly_ctx.get(("x", "y"), "lex")
+X, Y = XY.gens()
+
+
+# -- the decomposition --------------------------------------------------------------
+
+
+@pytest.mark.parametrize(("lo", "hi", "simplest"), [
+    (Fraction(1, 3), Fraction(1, 2), Fraction(2, 5)),
+    (Fraction(2), Fraction(3), Fraction(5, 2)),
+    (Fraction(-5, 2), Fraction(-2), Fraction(-7, 3)),
+    (Fraction(-1), Fraction(1), Fraction(0)),
+    (None, Fraction(-3, 2), Fraction(-2)),
+])
+def test_simplest_rational_between(lo, hi, simplest):
+    assert simplest_between(lo, hi) == simplest
+
+
+def test_circle_and_line_cells_avoid_the_curves():
+    cad = open_cad([X**2 + Y**2 - 1, Y - X])
+    # critical x: ±1, ±1/√2 → 5 columns with 2, 4, 4, 4, 2 sectors
+    assert len(cad.cells) == 16
+    for cell in cad.cells:
+        x, y = cell.sample
+        assert x * x + y * y != 1 and y != x
+
+
+@pytest.mark.parametrize(("curve", "regions", "proven"), [
+    # two ovals of one irreducible curve: the outside and each oval (same signs inside)
+    (Y**2 - (X**2 - 1) * (4 - X**2), 3, False),
+    # a lemniscate: the outside and two lobes
+    ((X**2 + Y**2)**2 - 2 * (X**2 - Y**2), 3, False),
+    # two concentric circles cut by a line: 6 components, all with distinct signs
+    ((X**2 + Y**2 - 1) * (X**2 + Y**2 - 9) * (X - Y), 6, True),
+])
+def test_regions_are_the_connected_components(curve, regions, proven):
+    result = connect_regions(open_cad([curve]))
+    assert len(result.regions) == regions
+    assert result.components_proven is proven
+
+
+# -- the paper's statements ---------------------------------------------------------
+
+
+def _counts(analysis, inside_only=True) -> set:
+    return {c.count for c in analysis.cells if c.within_limits or not inside_only}
+
+
+def test_orthoglide_workspace_has_regions_with_1_and_8_ik_solutions(orthoglide_projection):
+    model = orthoglide_projection.model
+    components, left_out = select_surfaces(workspace_variety(orthoglide_projection),
+                                           WORKSPACE, "auto", 3)
+    assert left_out == ["ξ(X): some working mode is singular"]
+    analysis = analyse(WORKSPACE, model, components)
+    assert _counts(analysis) == {0, 1, 8}  # the paper's Fig. 1(b): 1 and 8, never 2
+    eight = next(c for c in analysis.cells if c.count == 8)
+    assert inverse_kinematics_count(model, eight.cell.sample) == 8
+
+
+def test_orthoglide_without_limits_has_8_working_modes_and_2_assembly_modes(
+        orthoglide, orthoglide_projection):
+    ws = [c for c in workspace_variety(orthoglide_projection, parallel=False)
+          if c.kind != LIMIT]
+    assert max(_counts(analyse(WORKSPACE, orthoglide, ws, use_limits=False))) == 8
+    from singcheck.cas import get_backend
+
+    js = [c for c in jointspace_variety(orthoglide, get_backend("flint")) if c.kind != LIMIT]
+    js, _ = select_surfaces(js, JOINTSPACE, "counts", 3)
+    assert max(_counts(analyse(JOINTSPACE, orthoglide, js, use_limits=False))) == 2
+
+
+def test_orthoglide_joint_space_has_a_region_with_2_dk_solutions(orthoglide):
+    from singcheck.cas import get_backend
+
+    components = jointspace_variety(orthoglide, get_backend("flint"))
+    analysis = analyse(JOINTSPACE, orthoglide, components, {"rho3": Fraction(2)})
+    inside = {analysis.region_count(c.region) for c in analysis.cells if c.within_limits}
+    assert inside == {0, 2}
+    assert all(c.count is not None for c in analysis.cells)
+
+
+def test_direct_kinematics_counts(orthoglide):
+    assert direct_kinematics_count(orthoglide, (1, 1, 1)).count == 2
+    assert direct_kinematics_count(orthoglide, (4, 4, 4)).count == 0
+    # three spheres with one centre: infinitely many poses, honestly undecided
+    assert direct_kinematics_count(orthoglide, (0, 0, 0)).count is None
+
+
+def _ik_count_mp(model, pose) -> int:
+    """An independent count: 50-digit floats and the quadratic formula."""
+    mpmath.mp.dps = 50
+    x, y, z = (mpmath.mpf(q.numerator) / q.denominator for q in map(Fraction, pose))
+    total = 1
+    for i in range(3):
+        rest = [v for j, v in enumerate((x, y, z)) if j != i]
+        d = 4 - rest[0] ** 2 - rest[1] ** 2
+        if d < 0:
+            return 0
+        own = (x, y, z)[i]
+        total *= sum(1 for r in (own + mpmath.sqrt(d), own - mpmath.sqrt(d)) if 0 <= r <= 4)
+    return total
+
+
+def test_slice_counts_agree_with_an_independent_count(orthoglide_projection):
+    model = orthoglide_projection.model
+    analysis = analyse(WORKSPACE, model, workspace_variety(orthoglide_projection),
+                       {"z": Fraction(1)})
+    assert len(analysis.cells) > 50
+    for c in analysis.cells:
+        assert c.count == _ik_count_mp(model, (*c.cell.sample, 1))
+    # every cell of one region has one count
+    for r in analysis.regions.regions:
+        assert analysis.region_count(r.number) is not None
+
+
+def test_a_slice_inside_a_surface_is_refused(orthoglide):
+    from singcheck.cas import get_backend
+
+    components = jointspace_variety(orthoglide, get_backend("flint"))
+    with pytest.raises(SliceError, match="lies inside the surface rho1 = 0"):
+        analyse(JOINTSPACE, orthoglide, components, {"rho1": Fraction(0)})
+
+
+# -- the trajectory and the regions ---------------------------------------------------
+
+
+def _path(projection, name):
+    from singcheck.path import build_path
+    from singcheck.spec import load_trajectory
+
+    return build_path(projection, load_trajectory(TRAJECTORIES / f"{name}.yaml",
+                                                  projection.model.spec))
+
+
+def test_heart2_lies_in_one_named_region_heart1_crosses_xi(orthoglide_projection):
+    from singcheck.path_regions import path_in_workspace
+
+    heart2 = path_in_workspace(_path(orthoglide_projection, "heart2"))
+    assert heart2.one_region is True
+    assert heart2.region.startswith("R") and heart2.region.endswith("plane z = 1")
+    assert [s.count for s in heart2.stretches] == [1]
+    heart1 = path_in_workspace(_path(orthoglide_projection, "heart1"))
+    assert heart1.one_region is False
+    assert [c.surfaces for c in heart1.crossings] == [("parallel singularity ξ",)] * 4
+
+
+def test_leaving_the_workspace_is_infeasible_with_a_certified_exit_time(
+        orthoglide_projection):
+    from singcheck.certify import certify_path
+    from singcheck.path_regions import path_in_workspace
+
+    path = _path(orthoglide_projection, "leaves-workspace")
+    assert certify_path(path).verdict == "infeasible"
+    w = path_in_workspace(path)
+    # leg 2 stops reaching at x² + z² = 4, i.e. 3 sin t = √3
+    exact = mpmath.asin(1 / mpmath.sqrt(3))
+    lo, hi = float(w.exit_time.lower()), float(w.exit_time.upper())
+    assert lo <= exact <= hi and hi - lo < 1e-6
+    assert w.stretches[0].count == 1 and w.stretches[1].count == 0
+
+
+# -- the command line -----------------------------------------------------------------
+
+
+@pytest.mark.slow
+def test_cli_workspace_slice_json():
+    out = singcheck("workspace", str(ROBOTS / "orthoglide.yaml"), "--slice", "z=1",
+                    "--backend", "flint", "--format", "json", "-q")
+    assert out.returncode == 0, out.stderr
+    doc = json.loads(out.stdout)
+    assert doc["space"] == "workspace" and doc["slice"] == {"z": "1"}
+    assert set(doc["counts"]) == {"0", "1", "8"}
+    assert {c["kind"] for c in doc["discriminant_variety"]} == {
+        "serial singularity", "parallel singularity", "joint limit"}
+    assert all(c["region"] is not None for c in doc["cells"])
+
+
+@pytest.mark.parametrize(("arg", "message"), [
+    ("w=1", "w is not one of the axes"),
+    ("z=pi", "must be rational"),
+    ("z", "write AXIS=VALUE"),
+])
+def test_cli_bad_slices_exit_2(arg, message):
+    out = singcheck("workspace", str(ROBOTS / "orthoglide.yaml"), "--slice", arg,
+                    "--backend", "flint", "-q")
+    assert out.returncode == 2
+    assert message in out.stderr and "Traceback" not in out.stderr
+
+
+@pytest.mark.slow
+def test_cli_run_states_the_region():
+    out = singcheck("run", str(ROBOTS / "orthoglide.yaml"),
+                    str(TRAJECTORIES / "heart2.yaml"), "--backend", "flint", "-q")
+    assert out.returncode == 0, out.stderr
+    assert "the whole path lies in region R" in out.stdout
+
+
+def test_region_figure_colours_by_exact_counts(orthoglide_projection, tmp_path):
+    import numpy as np
+
+    from singcheck.region_plots import count_image, write_region_figure
+
+    analysis = analyse(WORKSPACE, orthoglide_projection.model,
+                       workspace_variety(orthoglide_projection), {"z": Fraction(1)})
+    image, _ = count_image(analysis, size=60)
+    assert set(np.unique(image).tolist()) == {0.0, 1.0, 8.0}  # no pixel left unknown
+    files = write_region_figure(analysis, tmp_path)
+    assert [f.suffix for f in files] == [".png", ".svg"]
+    assert files[0].read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_plot_regions_needs_a_plane(tmp_path):
+    out = singcheck("plot", str(ROBOTS / "orthoglide.yaml"), "--regions", "workspace",
+                    "--out", str(tmp_path), "--backend", "flint", "-q")
+    assert out.returncode == 2
+    assert "fix all but two with --slice" in out.stderr

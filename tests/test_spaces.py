@@ -241,3 +241,23 @@ def test_cli_plot_regions_needs_a_plane(tmp_path):
                     "--out", str(tmp_path), "--backend", "flint", "-q")
     assert out.returncode == 2
     assert "fix all but two with --slice" in out.stderr
+
+
+def test_planar_robot_workspace_regions():
+    from singcheck.cas import get_backend
+    from singcheck.model import build_model
+    from singcheck.projection import project_robot
+    from singcheck.spec import load_robot
+
+    model = build_model(load_robot(ROBOTS / "skew-biglide.yaml"))
+    projection = project_robot(model, get_backend("flint"))
+    analysis = analyse(WORKSPACE, model, workspace_variety(projection))
+    # two legs, two branches each: 4 IK solutions at most, every count in between met
+    assert _counts(analysis) == {0, 1, 2, 4}
+    assert analysis.regions is not None and len(analysis.regions.regions) > 10
+    for r in analysis.regions.regions:
+        assert analysis.region_count(r.number) is not None
+    # spot check: a cell with 4 solutions, recounted from the leg polynomials
+    four = next(c for c in analysis.cells if c.count == 4)
+    assert inverse_kinematics_count(model, four.cell.sample) == 4
+    assert inverse_kinematics_count(model, four.cell.sample, use_limits=False) == 4

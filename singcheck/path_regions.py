@@ -199,10 +199,7 @@ def locate_region(path: PathModel) -> str | None:
     if plane is None:
         return None
     fixed, free = plane
-    from singcheck.space_analysis import WORKSPACE, analyse, workspace_variety
-
-    model = path.projection.model
-    analysis = analyse(WORKSPACE, model, workspace_variety(path.projection), fixed)
+    analysis = _plane_analysis(path.projection, fixed)
     if analysis.regions is None:
         return None
     where = "" if not fixed else " " + ", ".join(f"{k} = {v}" for k, v in fixed.items())
@@ -213,6 +210,21 @@ def locate_region(path: PathModel) -> str | None:
             region = analysis.regions.region_of(cell)
             return f"R{region.number} of the workspace plane{where}"
     return None
+
+
+_PLANES: dict = {}
+
+
+def _plane_analysis(projection, fixed: dict[str, Fraction]):
+    """The plane's decomposition, computed once per robot and plane in a process (a
+    batch of paths in one plane shares it)."""
+    from singcheck.space_analysis import WORKSPACE, analyse, workspace_variety
+
+    key = (id(projection), tuple(sorted(fixed.items())))
+    if key not in _PLANES:
+        _PLANES[key] = (projection, analyse(WORKSPACE, projection.model,
+                                            workspace_variety(projection), fixed))
+    return _PLANES[key][1]
 
 
 def _exact(p, values: dict[str, Fraction]) -> Fraction:

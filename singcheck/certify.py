@@ -76,6 +76,7 @@ class TrajectoryReport:
     modes: list[WorkingMode]
     root_method: str
     undecided: list = field(default_factory=list)  # (t ball, reason) left unproven
+    mu_roots_complete: bool = False  # every root of μ isolated (the candidates are all)
 
     @property
     def name(self) -> str:
@@ -192,7 +193,7 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
                  if not _clear_undecided(path, modes, b)]
     verdict, reason = _verdict(modes, candidates, undecided)
     return TrajectoryReport(path, verdict, reason, candidates, modes, isolation.method,
-                            undecided)
+                            undecided, not isolation.undecided)
 
 
 def _verdict(modes, candidates, undecided) -> tuple[str, str]:

@@ -169,7 +169,8 @@ def _certify_index(i: int) -> dict:
     path = build_path(projection, specs[i])
     report = certify_path(path, tolerance)
     doc = trajectory_json(report)
-    doc["workspace"] = workspace_json(path_in_workspace(path, tolerance))
+    mu_roots = [c.t for c in report.candidates] if report.mu_roots_complete else None
+    doc["workspace"] = workspace_json(path_in_workspace(path, tolerance, mu_roots=mu_roots))
     if doc["verdict"] == "infeasible" and doc["workspace"]["exit_time_interval"]:
         lo, hi = doc["workspace"]["exit_time_interval"]
         doc["reason"] += f"; the path leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"

@@ -71,7 +71,7 @@ def path_surfaces(path: PathModel) -> list[tuple[str, object]]:
             out.append((f"serial singularity of leg {joint}", leg.discriminant))
         for bound, value in zip(("min", "max"), limits.get(joint, ()), strict=False):
             out.append((f"{joint} = {value} ({bound})", leg.limit_polynomial(value)))
-    out.append(("parallel singularity ξ", path.mu))
+    out.append((XI, path.mu))
     return out
 
 
@@ -112,11 +112,18 @@ def ik_count_at(path: PathModel, t: arb) -> int | None:
     return None
 
 
-def _crossings(path: PathModel, tolerance: float) -> tuple[list[Crossing], list[str]]:
+XI = "parallel singularity ξ"
+
+
+def _crossings(path: PathModel, tolerance: float,
+               mu_roots: list[arb] | None) -> tuple[list[Crossing], list[str]]:
     interval = path.trajectory.range
     events: list[tuple[arb, str]] = []
     undecided = []
     for label, poly in path_surfaces(path):
+        if label == XI and mu_roots is not None:
+            events += [(t, label) for t in mu_roots]
+            continue
         try:
             iso = isolate_real_roots(poly, interval, tolerance)
         except IdenticallyZeroError:
@@ -135,10 +142,14 @@ def _crossings(path: PathModel, tolerance: float) -> tuple[list[Crossing], list[
     return merged, undecided
 
 
-def path_in_workspace(path: PathModel, tolerance: float = 1e-9,
-                      name_region: bool = True) -> PathInWorkspace:
-    """Where the path crosses the discriminant variety, and its IK count in between."""
-    crossings, undecided = _crossings(path, tolerance)
+def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: bool = True,
+                      mu_roots: list[arb] | None = None) -> PathInWorkspace:
+    """Where the path crosses the discriminant variety, and its IK count in between.
+
+    ``mu_roots``: the certified roots of μ already isolated by the certification (every
+    one of them, none undecided), so that they are not isolated twice.
+    """
+    crossings, undecided = _crossings(path, tolerance, mu_roots)
     points = gap_points(path.trajectory.range, [c.t for c in crossings])
     stretches = [Stretch(p, ik_count_at(path, p)) for p in points]
     result = PathInWorkspace(crossings, stretches, undecided)

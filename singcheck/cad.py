@@ -30,6 +30,7 @@ from itertools import combinations
 
 from flint import fmpq, fmpq_mpoly, fmpq_poly
 
+from singcheck.elimination import coefficient_in
 from singcheck.rational_roots import RationalRoot, real_roots_exact
 
 
@@ -55,17 +56,6 @@ class OpenCAD:
 
 # ---------------------------------------------------------------------------------
 # exact polynomial helpers
-
-
-def coefficient_in(f: fmpq_mpoly, var_index: int, degree: int) -> fmpq_mpoly:
-    """The coefficient of ``x_var^degree`` in ``f`` (a polynomial in the other variables)."""
-    terms = {}
-    for exps, coeff in f.terms():
-        if exps[var_index] == degree:
-            e = list(exps)
-            e[var_index] = 0
-            terms[tuple(e)] = coeff
-    return f.context().from_dict(terms)
 
 
 def irreducible_factors(polys) -> list[fmpq_mpoly]:

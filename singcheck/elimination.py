@@ -58,6 +58,18 @@ def restrict(p: fmpq_mpoly, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
     return ctx.from_dict(out)
 
 
+def coefficient_in(f: fmpq_mpoly, var_index: int, degree: int) -> fmpq_mpoly:
+    """The coefficient of ``x_var^degree`` in ``f`` (a polynomial in the other variables,
+    still in ``f``'s context)."""
+    terms = {}
+    for exps, coeff in f.terms():
+        if exps[var_index] == degree:
+            e = list(exps)
+            e[var_index] = 0
+            terms[tuple(e)] = coeff
+    return f.context().from_dict(terms)
+
+
 def squarefree_part(p: fmpq_mpoly) -> fmpq_mpoly:
     """The product of the distinct irreducible factors of ``p``, made monic (exact).
 

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
+from singcheck.elimination import coefficient_in
 from singcheck.errors import UnsupportedRobotError
 
 if TYPE_CHECKING:
@@ -119,7 +120,7 @@ def _legs(spec: RobotSpec) -> tuple[Leg, ...]:
             raise UnsupportedRobotError(
                 f"is of degree {degree} in {joint}; singcheck supports legs of degree 1 or 2 "
                 "in their joint (prismatic or distance legs)", path=spec.path, line=line, key=key)
-        if not _leading_coefficient(f, j, degree).is_constant():
+        if not coefficient_in(f, j, degree).is_constant():
             raise UnsupportedRobotError(
                 f"the coefficient of {joint}^{degree} depends on the pose; singcheck needs it "
                 "constant so that the joint is integral over the pose (exact projection)",
@@ -128,23 +129,12 @@ def _legs(spec: RobotSpec) -> tuple[Leg, ...]:
     return tuple(found[j] for j in joints)
 
 
-def _leading_coefficient(f: fmpq_mpoly, var_index: int, degree: int) -> fmpq_mpoly:
-    ctx = f.context()
-    terms = {}
-    for exps, coeff in f.terms():
-        if exps[var_index] == degree:
-            e = list(exps)
-            e[var_index] = 0
-            terms[tuple(e)] = coeff
-    return ctx.from_dict(terms)
-
-
 def leg_coefficients(leg: Leg) -> tuple[fmpq_mpoly, ...]:
     """``(a, b, c)`` with ``constraint = a·ρ² + b·ρ + c`` (``(b, c)`` for a linear leg).
 
     Each coefficient is a polynomial in the pose variables (still in the robot's context).
     """
-    return tuple(_leading_coefficient(leg.constraint, leg.joint_index, d)
+    return tuple(coefficient_in(leg.constraint, leg.joint_index, d)
                  for d in range(leg.degree, -1, -1))
 
 

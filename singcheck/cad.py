@@ -49,10 +49,6 @@ class OpenCAD:
     levels: tuple[tuple[fmpq_mpoly, ...], ...]  # levels[k]: factors in x_1..x_{k+1}
     cells: tuple[Cell, ...]
 
-    def polynomials_at(self, level: int, point) -> list[fmpq_poly]:
-        """The level's factors with x_1..x_level set to the rationals ``point``."""
-        return [specialize(p, self.variables, point) for p in self.levels[level]]
-
 
 # ---------------------------------------------------------------------------------
 # exact polynomial helpers
@@ -72,18 +68,21 @@ def irreducible_factors(polys) -> list[fmpq_mpoly]:
     return sorted(seen.values(), key=str)
 
 
-def specialize(p: fmpq_mpoly, variables, point) -> fmpq_poly:
-    """``p`` with its first ``len(point)`` variables set to rationals, as a univariate
-    polynomial in the next variable (``p`` must not involve later ones)."""
-    k = len(point)
-    values = {variables[i]: fmpq(q.numerator, q.denominator) for i, q in enumerate(point)}
-    q = p.subs(values) if values else p
+def as_univariate(q: fmpq_mpoly, var_index: int) -> fmpq_poly:
+    """``q``, which involves no variable but ``var_index``, as a univariate polynomial."""
     coeffs: dict[int, fmpq] = {}
     for exps, c in q.terms():
-        coeffs[exps[k]] = coeffs.get(exps[k], fmpq(0)) + c
+        coeffs[exps[var_index]] = coeffs.get(exps[var_index], fmpq(0)) + c
     if not coeffs:
         return fmpq_poly([])
     return fmpq_poly([coeffs.get(i, fmpq(0)) for i in range(max(coeffs) + 1)])
+
+
+def specialize(p: fmpq_mpoly, variables, point) -> fmpq_poly:
+    """``p`` with its first ``len(point)`` variables set to rationals, as a univariate
+    polynomial in the next variable (``p`` must not involve later ones)."""
+    values = {variables[i]: fmpq(q.numerator, q.denominator) for i, q in enumerate(point)}
+    return as_univariate(p.subs(values) if values else p, len(point))
 
 
 def project(polys: list[fmpq_mpoly], var_index: int) -> list[fmpq_mpoly]:

@@ -247,13 +247,12 @@ def _exact(p, values: dict[str, Fraction]) -> Fraction:
 def _cell_of(cad, point: list[Fraction]):
     """The open cell holding a rational point, or None when it lies on a root."""
     from singcheck.cad import fiber
-    from singcheck.solution_counts import _compare
 
     index = []
     for k in range(len(point)):
         roots = fiber(cad.levels, cad.variables, tuple(point[:k]))
         q = fmpq(point[k].numerator, point[k].denominator)
-        relations = [_compare(r, q) for r in roots]
+        relations = [r.compare(q) for r in roots]
         if 0 in relations:
             return None
         index.append(sum(1 for r in relations if r < 0))

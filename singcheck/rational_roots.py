@@ -96,6 +96,18 @@ class RationalRoot:
     def ball(self) -> arb:
         return rational_ball(self.lo, self.hi)
 
+    def compare(self, q: fmpq) -> int:
+        """-1, 0, 1 as the root is below, at, above the rational q (exact: the interval
+        is bisected until it lies on one side of q, or q is found to be the root)."""
+        while True:
+            if self.hi < q:
+                return -1
+            if self.lo > q:
+                return 1
+            if self.lo == self.hi or self.poly(q) == 0:
+                return 0
+            self.bisect_to((self.hi - self.lo) / 4)
+
     def pin(self, q: fmpq) -> bool:
         """Collapse to ``q`` when it lies inside the isolating interval and is a root.
 

@@ -22,8 +22,8 @@ from fractions import Fraction
 
 from flint import fmpq, fmpq_poly
 
-from singcheck.cad import Cell, OpenCAD, fiber, sector_samples
-from singcheck.solution_counts import _compare, roots_within
+from singcheck.cad import Cell, OpenCAD, as_univariate, fiber, sector_samples
+from singcheck.solution_counts import roots_within
 
 _ROUNDS = 3
 
@@ -80,17 +80,6 @@ def factor_signs(cad: OpenCAD, point) -> tuple[int, ...]:
     return tuple(out)
 
 
-def _in_y(f, variables, y0: Fraction) -> fmpq_poly:
-    """f(x, y₀) as a polynomial in x."""
-    g = f.subs({variables[1]: _q(y0)})
-    coeffs: dict[int, fmpq] = {}
-    for exps, c in g.terms():
-        coeffs[exps[0]] = coeffs.get(exps[0], fmpq(0)) + c
-    if not coeffs:
-        return fmpq_poly([])
-    return fmpq_poly([coeffs.get(i, fmpq(0)) for i in range(max(coeffs) + 1)])
-
-
 def no_root_between(q: fmpq_poly, a: Fraction, b: Fraction) -> bool:
     """True when q has no root in the closed [a, b] (exact).
 
@@ -120,7 +109,7 @@ def no_root_between(q: fmpq_poly, a: Fraction, b: Fraction) -> bool:
 def segment_is_free(cad: OpenCAD, a: Fraction, b: Fraction, y0: Fraction) -> bool:
     """True when no factor of the variety vanishes on [a, b] × {y₀} (exact)."""
     for f in cad.factors:
-        q = _in_y(f, cad.variables, y0)
+        q = as_univariate(f.subs({cad.variables[1]: _q(y0)}), 0)  # f(x, y₀)
         if q.is_zero():
             return False
         if q.degree() >= 1 and not no_root_between(q, a, b):
@@ -131,7 +120,7 @@ def segment_is_free(cad: OpenCAD, a: Fraction, b: Fraction, y0: Fraction) -> boo
 def _locate(roots, y0: Fraction) -> int:
     """The sector index of y₀ among separated roots (y₀ must not be a root)."""
     q = _q(y0)
-    return sum(1 for r in roots if _compare(r, q) < 0)
+    return sum(1 for r in roots if r.compare(q) < 0)
 
 
 def _brackets(base, i: int, round_: int) -> tuple[Fraction, Fraction]:

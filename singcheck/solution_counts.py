@@ -23,7 +23,6 @@ from flint import fmpq, fmpq_poly
 
 from singcheck.cad import separated_roots
 from singcheck.model import RobotModel, leg_coefficients
-from singcheck.rational_roots import RationalRoot
 
 _COORDINATE_CHANGES = ((), (1,), (1, -2), (3, 1, -1), (2, -3, 5, 1))
 
@@ -33,20 +32,6 @@ def _fmpq(q) -> fmpq:
     return fmpq(q.numerator, q.denominator)
 
 
-def _compare(root: RationalRoot, q: fmpq) -> int:
-    """-1, 0, 1 as the root is below, at, above the rational q (exact)."""
-    while True:
-        if root.hi < q:
-            return -1
-        if root.lo > q:
-            return 1
-        if root.lo == root.hi:
-            return 0
-        if root.poly(q) == 0:
-            return 0
-        root.bisect_to((root.hi - root.lo) / 4)
-
-
 def roots_within(p: fmpq_poly, limits: tuple | None) -> int:
     """The number of distinct real roots of ``p`` in the closed range ``limits``
     (all real roots when ``limits`` is None)."""
@@ -54,7 +39,7 @@ def roots_within(p: fmpq_poly, limits: tuple | None) -> int:
     if limits is None:
         return len(roots)
     lo, hi = (_fmpq(v) for v in limits)
-    return sum(1 for r in roots if _compare(r, lo) >= 0 and _compare(r, hi) <= 0)
+    return sum(1 for r in roots if r.compare(lo) >= 0 and r.compare(hi) <= 0)
 
 
 def leg_polynomial_at(model: RobotModel, leg, pose_point) -> fmpq_poly:

@@ -21,6 +21,7 @@ What is proven, and how:
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 
@@ -83,32 +84,30 @@ def _inside(v: arb, lo: arb, hi: arb) -> bool | None:
     return None
 
 
+def _leg_count(leg, t: arb, bounds) -> int | None:
+    """Real branches of one leg inside its limits at t (None if not decided)."""
+    n = 0
+    for value in leg.branches(t).values():
+        if value is None:
+            return None
+        if isinstance(value, acb):
+            continue  # a complex branch
+        inside = True if bounds is None else _inside(
+            value, fraction_ball(bounds[0]), fraction_ball(bounds[1]))
+        if inside is None:
+            return None
+        n += inside
+    return n
+
+
 def ik_count_at(path: PathModel, t: arb) -> int | None:
     """IK solutions inside the limits at the exact time t (None if not decided)."""
     limits = path.projection.model.spec.joint_limits
     for prec in _PRECISIONS:
         with working_precision(prec):
-            total = 1
-            for leg in path.legs:
-                bounds = limits.get(leg.leg.joint)
-                n = 0
-                for value in leg.branches(t).values():
-                    if value is None:
-                        total = None
-                        break
-                    if isinstance(value, acb):
-                        continue
-                    inside = True if bounds is None else _inside(
-                        value, fraction_ball(bounds[0]), fraction_ball(bounds[1]))
-                    if inside is None:
-                        total = None
-                        break
-                    n += inside
-                if total is None:
-                    break
-                total *= n
-            if total is not None:
-                return total
+            counts = [_leg_count(leg, t, limits.get(leg.leg.joint)) for leg in path.legs]
+        if None not in counts:
+            return math.prod(counts)
     return None
 
 

@@ -121,10 +121,19 @@ def _exit_code(verdicts: list[str]) -> ExitCode:
     return ExitCode.SINGULARITY_FREE
 
 
-def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
-         progress, jobs, plot_dir=None):
+def elimination_engine(backend_name: str, timeout: float, no_cache: bool, progress):
+    """The chosen backend (named on stderr when picked by ``auto``), behind the cache."""
     from singcheck.cache import CachedBackend, EliminationCache
     from singcheck.cas import get_backend
+
+    backend = get_backend(backend_name, timeout=timeout)
+    if backend_name == "auto":
+        progress.note(f"backend: {backend.name} {backend.version()} (auto)")
+    return backend if no_cache else CachedBackend(backend, EliminationCache())
+
+
+def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
+         progress, jobs, plot_dir=None):
     from singcheck.model import build_model
     from singcheck.projection import project_robot
     from singcheck.spec import load_robot, load_trajectory
@@ -132,11 +141,7 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     spec = load_robot(robot)
     specs = [load_trajectory(path, spec) for path in trajectories]
     model = build_model(spec)
-    backend = get_backend(backend_name, timeout=timeout)
-    if backend_name == "auto":
-        progress.note(f"backend: {backend.name} {backend.version()} (auto)")
-    if not no_cache:
-        backend = CachedBackend(backend, EliminationCache())
+    backend = elimination_engine(backend_name, timeout, no_cache, progress)
     with progress.status(f"projecting {spec.name} onto its workspace ({backend.name})"):
         projection = project_robot(model, backend)
     degree = projection.singularity_surface.total_degree()

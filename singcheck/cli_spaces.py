@@ -85,19 +85,10 @@ def _options(space: str):
     return decorate
 
 
-def _engine(backend: str, timeout: float, no_cache: bool, progress):
-    from singcheck.cache import CachedBackend, EliminationCache
-    from singcheck.cas import get_backend
-
-    engine = get_backend(backend, timeout=timeout)
-    if backend == "auto":
-        progress.note(f"backend: {engine.name} {engine.version()} (auto)")
-    return engine if no_cache else CachedBackend(engine, EliminationCache())
-
-
 def compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, backend: str,
             timeout: float, no_cache: bool, progress):
     """The analysis and the labels of the surfaces left out (shared with ``plot``)."""
+    from singcheck.cli import elimination_engine
     from singcheck.model import build_model
     from singcheck.projection import project_robot
     from singcheck.space_analysis import (
@@ -111,7 +102,7 @@ def compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, back
 
     fixed = _slices(slices)
     model = build_model(load_robot(robot))
-    engine = _engine(backend, timeout, no_cache, progress)
+    engine = elimination_engine(backend, timeout, no_cache, progress)
     axes = model.pose if space == WORKSPACE else model.joints
     with progress.status(f"computing the discriminant variety of the {space}"):
         if space == WORKSPACE:

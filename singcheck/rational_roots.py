@@ -183,8 +183,10 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     return intervals
 
 
-def real_roots_exact(p: fmpq_poly) -> list[tuple[RationalRoot, int]]:
-    """Isolating rational intervals of the real roots of ``p``, with multiplicities."""
+def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
+                     ) -> list[tuple[RationalRoot, int]]:
+    """Isolating rational intervals of the real roots of ``p``, with multiplicities
+    (only the roots ≥ 0 when ``nonnegative_only``)."""
     if p.degree() < 1:
         return []
     num = fmpz_poly([int(c * p.denom()) for c in p.coeffs()])
@@ -202,6 +204,8 @@ def real_roots_exact(p: fmpq_poly) -> list[tuple[RationalRoot, int]]:
             continue
         for lo, hi in _positive_root_intervals(factor):
             out.append((RationalRoot(f, lo, hi), mult))
+        if nonnegative_only:
+            continue
         mirrored = fmpz_poly([c if i % 2 == 0 else -c
                               for i, c in enumerate(int(c) for c in factor.coeffs())])
         for lo, hi in _positive_root_intervals(mirrored):

@@ -35,6 +35,7 @@ from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
 from singcheck.errors import SingcheckError
 from singcheck.intervals import working_precision
 from singcheck.rational_roots import (
+    RationalRoot,
     bits_for,
     exact_tolerance,
     real_roots_exact,
@@ -158,43 +159,102 @@ def _fraction(q: fmpq):
 
 
 def _half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
-    """M(u) = (1+u²)^d · p(2u/(1+u²), (1-u²)/(1+u²)) and d (p free of t)."""
-    d = max((j + k for (_i, j, k), _ in p.terms()), default=0)
-    def powers(base: fmpq_poly) -> list[fmpq_poly]:
-        out = [fmpq_poly([1])]
-        for _ in range(d):
-            out.append(out[-1] * base)
-        return out
+    """M(u) = (1+u²)^d · p(2u/(1+u²), (1-u²)/(1+u²)) and d (p reduced, free of t).
 
-    two_u, one_minus, one_plus = (powers(fmpq_poly(c)) for c in ([0, 2], [1, 0, -1],
-                                                                  [1, 0, 1]))
-    total = fmpq_poly([])
+    With p = P₀(c) + s·P₁(c), M = H(P₀, d) + 2u·H(P₁, d-1) where
+    H(Σ aₖcᵏ, n) = Σ aₖ (1-u²)ᵏ (1+u²)ⁿ⁻ᵏ, summed by Horner's rule in 1-u²
+    (exact rational arithmetic throughout).
+    """
+    d = max((j + k for (_i, j, k), _ in p.terms()), default=0)
+    by_s: list[dict[int, fmpq]] = [{}, {}]
     for (_i, j, k), c in p.terms():
-        total += c * two_u[j] * one_minus[k] * one_plus[d - j - k]
-    return total, d
+        by_s[j][k] = c
+    one_plus = [fmpq_poly([1])]
+    for _ in range(d):
+        one_plus.append(one_plus[-1] * _ONE_PLUS_U2)
+
+    def homogenised(coeffs: dict[int, fmpq], n: int) -> fmpq_poly:
+        if not coeffs:
+            return fmpq_poly([])
+        top = max(coeffs)
+        r = fmpq_poly([coeffs[top]])
+        for k in range(top - 1, -1, -1):
+            r = r * _ONE_MINUS_U2 + coeffs.get(k, 0) * one_plus[top - k]
+        return r * one_plus[n - top]
+
+    return homogenised(by_s[0], d) + _TWO_U * homogenised(by_s[1], d - 1), d
+
+
+_ONE_PLUS_U2, _ONE_MINUS_U2, _TWO_U = (fmpq_poly(c) for c in ([1, 0, 1], [1, 0, -1], [0, 2]))
+
+
+@dataclass(frozen=True)
+class _HalfAngleRoot:
+    """One real root u₀ of M: ``ball(tol)`` encloses 2·atan(u₀); ``exact`` is u₀ ∈ {0, ±1}."""
+
+    ball: Callable[[float], arb]
+    exact: LinearInPi | None
+    multiplicity: int
+
+
+def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
+    """The real roots of M, isolated exactly after deflation.
+
+    When M(u) = N(u^k) (flint's deflation; even paths give k = 2), the roots of N are
+    isolated instead (degree divided by k): each root v > 0 of N gives u = v^(1/k), and
+    also -v^(1/k) when k is even; v < 0 gives -(-v)^(1/k) when k is odd and nothing
+    real when k is even; v = 0 gives u = 0 with k times the multiplicity.  u is enclosed
+    by Arb's rigorous k-th roots of the interval ends (u ↦ u^k is monotone on each side).
+    """
+    deflated, k = m.numer().deflation()
+    k = max(int(k), 1)
+    out = []
+    # k even: u^k = v has no real root for v < 0, so only v ≥ 0 is isolated
+    for rr, mult in real_roots_exact(fmpq_poly(deflated), nonnegative_only=k % 2 == 0):
+        for q in (fmpq(0), fmpq(1), fmpq(-1)):  # u = 0, ±1 (t = 0, ±π/2) are exact
+            rr.pin(q)
+        if rr.lo == rr.hi == 0:
+            out.append(_HalfAngleRoot(_atan_ball(rr, k, 1), LinearInPi(Fraction(0)), mult * k))
+            continue
+        positive = rr.lo >= 0
+        if not positive and k % 2 == 0:
+            continue
+        signs = (1, -1) if k % 2 == 0 else (1 if positive else -1,)
+        for sign in signs:
+            exact = None
+            if rr.lo == rr.hi and abs(rr.lo) == 1:
+                exact = LinearInPi(Fraction(0), Fraction(sign, 2))
+            out.append(_HalfAngleRoot(_atan_ball(rr, k, sign), exact, mult))
+    return out
+
+
+def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
+    """t = 2·atan(sign·|v|^(1/k)) for the root v of N isolated by ``rr``."""
+
+    def u_bounds(bits: int) -> arb:
+        with working_precision(bits):
+            ends = [arb(abs(q)).root(k) if k > 1 else arb(abs(q)) for q in (rr.lo, rr.hi)]
+            return sign * ends[0].union(ends[1])
+
+    def ball(tol: float) -> arb:
+        width = exact_tolerance(tol) / 4
+        bits = bits_for(tol)
+        rr.bisect_to(width)
+        while k > 1 and rr.lo != rr.hi and float(u_bounds(bits).rad()) > tol / 8:
+            width /= 16
+            rr.bisect_to(width)
+        with working_precision(bits):
+            return 2 * u_bounds(bits).atan()
+
+    return ball
 
 
 def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
     m, _ = _half_angle_polynomial(p)
     at_pi = p.subs({"s": 0, "c": -1})
-    bases: list[tuple[Callable[[float], arb], LinearInPi | None, int]] = []
-    for rr, mult in real_roots_exact(m):
-        for q in (fmpq(0), fmpq(1), fmpq(-1)):  # t = 0, ±π/2: exact, may be range ends
-            rr.pin(q)
-
-        def base(tol: float, rr=rr) -> arb:
-            rr.bisect_to(exact_tolerance(tol) / 4)
-            with working_precision(bits_for(tol)):
-                return 2 * rr.ball().atan()
-
-        exact = None
-        if rr.lo == rr.hi and rr.lo in (fmpq(0), fmpq(1), fmpq(-1)):
-            from fractions import Fraction
-
-            exact = LinearInPi(Fraction(0), Fraction(int(rr.lo.p), 2))
-        bases.append((base, exact, mult))
+    bases: list[tuple[Callable[[float], arb], LinearInPi | None, int | None]] = [
+        (r.ball, r.exact, r.multiplicity) for r in _half_angle_roots(m)]
     if at_pi.is_zero():
-        from fractions import Fraction
 
         def base_pi(tol: float) -> arb:
             with working_precision(bits_for(tol)):

@@ -151,3 +151,67 @@ def test_descartes_isolation_agrees_with_flint_complex_roots():
         for (rr, _), x in zip(ours, flint_real, strict=True):
             rr.bisect_to(fmpq(1, 10**12))
             assert float(rr.lo) - 1e-9 <= x <= float(rr.hi) + 1e-9
+
+
+def _random_trig(rng, degree: int, with_t: bool = False):
+    from singcheck.trig import reduce_trig
+
+    p = 0 * S
+    for _ in range(12):
+        i = rng.randint(0, 2) if with_t else 0
+        j, k = rng.randint(0, degree), rng.randint(0, degree)
+        p += fmpq(rng.randint(-9, 9), rng.randint(1, 9)) * T**i * S**j * C**k
+    return reduce_trig(p)
+
+
+def test_half_angle_polynomial_is_the_substitution():
+    import random
+
+    from singcheck.roots import _half_angle_polynomial
+
+    rng = random.Random(5)
+    for _ in range(20):
+        p = _random_trig(rng, 7)
+        m, d = _half_angle_polynomial(p)
+        for u in (fmpq(0), fmpq(3, 7), fmpq(-5, 2), fmpq(1)):
+            w = 1 + u * u
+            direct = p.subs({"s": 2 * u / w, "c": (1 - u * u) / w}).subs({"t": 0})
+            assert m(u) == w**d * direct.leading_coefficient()
+
+
+@pytest.mark.parametrize("m, expected", [
+    ([-8, 0, 0, 1], [2]),  # u^3 = 8: deflation 3, odd
+    ([8, 0, 0, 1], [-2]),  # u^3 = -8
+    ([-64, 0, 0, 0, 0, 0, 1], [-2, 2]),  # u^6 = 64: deflation 6, even
+    ([0, 0, -2, 0, 1], [-mpmath.sqrt(2), 0, mpmath.sqrt(2)]),  # u^2 (u^2 - 2)
+    ([1, 0, 1], []),  # u^2 = -1: no real root
+])
+def test_deflated_half_angle_roots(m, expected):
+    from singcheck.roots import _half_angle_roots
+
+    roots = sorted(_half_angle_roots(fmpq_poly(m)), key=lambda r: float(r.ball(1e-12).mid()))
+    assert len(roots) == len(expected)
+    for r, u in zip(roots, expected, strict=True):
+        assert contains(r.ball(1e-20), 2 * mpmath.atan(u))
+    if expected and expected[len(expected) // 2] == 0 and len(expected) == 3:
+        assert roots[1].multiplicity == 2 and roots[1].exact is not None
+
+
+def test_trig_evaluation_encloses_the_function():
+    import random
+
+    from singcheck.trig import evaluate_trig
+
+    rng = random.Random(8)
+    for _ in range(20):
+        p = _random_trig(rng, 6, with_t=True)
+        centre, radius = rng.uniform(-3, 3), rng.choice([0.0, 1e-6, 0.1, 0.5])
+        ball = arb(centre, radius)
+        box = evaluate_trig(p, ball)
+        if radius == 0:
+            assert float(box.rad()) < 1e-10
+        for x in (centre + radius * i / 4 for i in range(-4, 5)):
+            x = mpmath.mpf(x)
+            value = sum(mpmath.mpf(int(c.p)) / int(c.q) * x**int(i) * mpmath.sin(x)**int(j)
+                        * mpmath.cos(x)**int(k) for (i, j, k), c in p.terms())
+            assert contains(box, value)

@@ -19,10 +19,11 @@ polynomials: ``cos(k t) = T_k(c)`` and ``sin(k t) = s · U_{k-1}(c)``.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass
 from fractions import Fraction
 
-from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz_poly
+from flint import arb, arb_poly, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz_poly
 
 #: Q[t, s, c]; exponents are (t, s, c).
 TRIG = fmpq_mpoly_ctx.get(("t", "s", "c"), "lex")
@@ -30,18 +31,33 @@ T, S, C = TRIG.gens()
 
 
 def reduce_trig(p: fmpq_mpoly) -> fmpq_mpoly:
-    """The representative of ``p`` modulo ``s² + c² - 1`` with degree ≤ 1 in s."""
+    """The representative of ``p`` modulo ``s² + c² - 1`` with degree ≤ 1 in s.
+
+    s^j = s^(j mod 2)·(1 - c²)^(j div 2): terms are grouped by (t-power, s-parity,
+    j div 2) so that each power of 1 - c² multiplies one polynomial in c.
+    """
     if p.degrees()[1] < 2:
         return p
-    one_minus_c2 = 1 - C**2
-    out = TRIG.from_dict({})
-    powers: dict[int, fmpq_mpoly] = {0: TRIG.from_dict({(0, 0, 0): 1})}
+    groups: dict[int, dict[tuple[int, int, int], fmpq]] = {}
     for (i, j, k), coeff in p.terms():
         half, odd = divmod(j, 2)
-        if half not in powers:
-            powers[half] = one_minus_c2**half
-        out += TRIG.from_dict({(i, odd, k): coeff}) * powers[half]
+        groups.setdefault(half, {})[(i, odd, k)] = coeff
+    out = TRIG.from_dict({})
+    for half, terms in groups.items():
+        out += TRIG.from_dict(terms) * _one_minus_c2(half)
     return out
+
+
+_ONE_MINUS_C2: list[fmpq_mpoly] = []
+
+
+def _one_minus_c2(n: int) -> fmpq_mpoly:
+    """(1 - c²)^n, memoised (the same few powers serve every path)."""
+    if not _ONE_MINUS_C2:
+        _ONE_MINUS_C2.append(TRIG.from_dict({(0, 0, 0): 1}))
+    while len(_ONE_MINUS_C2) <= n:
+        _ONE_MINUS_C2.append(_ONE_MINUS_C2[-1] * (1 - C**2))
+    return _ONE_MINUS_C2[n]
 
 
 def _chebyshev_in_c(poly: fmpz_poly) -> fmpq_mpoly:
@@ -120,8 +136,38 @@ def derivative(p: fmpq_mpoly) -> fmpq_mpoly:
 
 
 def evaluate_trig(p: fmpq_mpoly, t: arb) -> arb:
-    """Rigorous enclosure of ``p(t, sin t, cos t)`` for every t in the ball ``t``."""
-    from singcheck.intervals import evaluate
+    """Rigorous enclosure of ``p(t, sin t, cos t)`` for every t in the ball ``t``.
 
+    ``p`` (reduced) is read as Σᵢ tⁱ (P₀ᵢ(c) + s·P₁ᵢ(c)) with ball-coefficient
+    polynomials in c evaluated by FLINT (Horner, outward rounding), so the result
+    encloses every value of p over the ball; the split is built once per polynomial
+    and working precision (coefficients rounded at that precision) and memoised.
+    """
     s, c = t.sin_cos()
-    return evaluate(p, [t, s, c])
+    total = arb(0)
+    for p0, p1 in reversed(_split(p)):
+        total = total * t + p0(c) + s * p1(c)
+    return total
+
+
+_SPLITS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, list]] = OrderedDict()
+_SPLITS_KEPT = 512
+
+
+def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]]:
+    """[(P₀ᵢ, P₁ᵢ) for i = 0 … deg_t p] as ball polynomials at the current precision."""
+    key = (id(p), ctx.prec)
+    hit = _SPLITS.get(key)
+    if hit is not None and hit[0] is p:  # the entry holds p, so its id is not reused
+        _SPLITS.move_to_end(key)
+        return hit[1]
+    q = reduce_trig(p)
+    dt, _, dc = q.degrees()
+    coeffs = [[[fmpq(0)] * (dc + 1) for _ in range(2)] for _ in range(dt + 1)]
+    for (i, j, k), a in q.terms():
+        coeffs[i][j][k] = a
+    split = [tuple(arb_poly([arb(a) for a in row]) for row in by_t) for by_t in coeffs]
+    _SPLITS[key] = (p, split)
+    if len(_SPLITS) > _SPLITS_KEPT:
+        _SPLITS.popitem(last=False)
+    return split

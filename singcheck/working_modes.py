@@ -86,6 +86,7 @@ def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | Non
 
 
 _PIECES = 8
+_BUDGET = 64  # ball evaluations spent before falling back to a root isolation
 
 
 def _pieces(interval: TimeRange) -> list[arb]:
@@ -97,10 +98,28 @@ def _pieces(interval: TimeRange) -> list[arb]:
     return [a.union(b) for a, b in zip(edges, edges[1:], strict=False)]
 
 
+def _halves(piece: arb) -> tuple[arb, arb]:
+    lo, hi = piece.lower(), piece.upper()
+    mid = piece.mid()
+    return lo.union(mid), mid.union(hi)
+
+
 def _everywhere(predicate, interval: TimeRange) -> bool:
-    """True when ``predicate(ball)`` is proven on every piece of the range: a quick
-    proof by ball arithmetic that spares a root isolation (False means "not proven")."""
-    return all(predicate(piece) for piece in _pieces(interval))
+    """True when ``predicate(ball)`` is proven on balls covering the whole range: a
+    quick proof by ball arithmetic that spares a root isolation (False means "not
+    proven").  A piece where it fails is halved (ball enclosures tighten as pieces
+    shrink) until a budget of evaluations is spent."""
+    todo = _pieces(interval)
+    spent = 0
+    while todo:
+        piece = todo.pop()
+        spent += 1
+        if predicate(piece):
+            continue
+        if spent + len(todo) + 2 > _BUDGET:
+            return False
+        todo += _halves(piece)
+    return True
 
 
 def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float):
@@ -142,7 +161,11 @@ def _inside(value, lo, hi) -> bool | None:
 
 
 def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
-                   tolerance: float) -> BranchFeasibility:
+                   tolerance: float, crossings: dict) -> BranchFeasibility:
+    """Whether this branch stays strictly inside the joint limits along the whole path.
+
+    ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
+    the leg equals it (one polynomial serves both branches)."""
     joint = leg.leg.joint
     lo, hi = (fraction_ball(v) for v in limits)
     bounds = f"[{limits[0]}, {limits[1]}]"
@@ -154,7 +177,9 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
     events: list[arb] = []
     undecided = []
     for value in limits:
-        iso = _isolate(leg.limit_polynomial(value), interval, tolerance)
+        if value not in crossings:
+            crossings[value] = _isolate(leg.limit_polynomial(value), interval, tolerance)
+        iso = crossings[value]
         if iso is None:
             return BranchFeasibility(joint, label, UNKNOWN,
                                      f"a branch of {joint} sits on its limit {value} all along")
@@ -197,12 +222,13 @@ def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibili
         else:
             status, reason, when = FEASIBLE, "", None
         branches = []
+        crossings: dict = {}
         for label in leg.labels:
             if status != FEASIBLE:
                 branches.append(BranchFeasibility(joint, label, status, reason, when))
             elif joint in limits_of:
                 branches.append(_branch_limits(leg, label, interval, limits_of[joint],
-                                               tolerance))
+                                               tolerance, crossings))
             else:
                 branches.append(BranchFeasibility(joint, label, FEASIBLE))
         out.append(branches)

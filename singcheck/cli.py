@@ -81,7 +81,8 @@ def cli() -> None:
 @click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=600,
               show_default=True, help="Wall-clock limit in seconds for each CAS run.")
 @click.option("--no-cache", is_flag=True,
-              help="Neither read nor write the elimination cache (see `singcheck cache`).")
+              help="Neither read nor write the cache of elimination results and region "
+                   "maps (see `singcheck cache`).")
 @click.option("--tolerance", type=click.FloatRange(min=0, min_open=True), default=1e-9,
               show_default=True, help="Width of the certified enclosure of each root in t.")
 @click.option("--format", "fmt", type=click.Choice(["table", "json"]), default="table",
@@ -146,7 +147,12 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         projection = project_robot(model, backend)
     degree = projection.singularity_surface.total_degree()
     progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
-    results = certify_all(projection, specs, tolerance, jobs, progress)
+    region_cache = None
+    if not no_cache:
+        from singcheck.region_map import RegionMapCache
+
+        region_cache = RegionMapCache()
+    results = certify_all(projection, specs, tolerance, jobs, progress, region_cache)
     if plot_dir:
         _plot_all(projection, specs, tolerance, plot_dir, progress)
     code = _exit_code([r["verdict"] for r in results])
@@ -171,20 +177,24 @@ def _certify_index(i: int) -> dict:
     from singcheck.report import trajectory_json, workspace_json
 
     projection, specs, tolerance = _WORKER["projection"], _WORKER["specs"], _WORKER["tolerance"]
+    region_cache = _WORKER.get("region_cache")
     path = build_path(projection, specs[i])
     report = certify_path(path, tolerance)
     doc = trajectory_json(report)
     mu_roots = [c.t for c in report.candidates] if report.mu_roots_complete else None
-    doc["workspace"] = workspace_json(path_in_workspace(path, tolerance, mu_roots=mu_roots))
+    doc["workspace"] = workspace_json(path_in_workspace(path, tolerance, mu_roots=mu_roots,
+                                                        region_cache=region_cache))
     if doc["verdict"] == "infeasible" and doc["workspace"]["exit_time_interval"]:
         lo, hi = doc["workspace"]["exit_time_interval"]
         doc["reason"] += f"; the path leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"
     return doc
 
 
-def certify_all(projection, specs, tolerance: float, jobs: int, progress) -> list[dict]:
+def certify_all(projection, specs, tolerance: float, jobs: int, progress,
+                region_cache=None) -> list[dict]:
     """Certify every trajectory, in ``jobs`` forked processes when there are many."""
-    _WORKER.update(projection=projection, specs=specs, tolerance=tolerance)
+    _WORKER.update(projection=projection, specs=specs, tolerance=tolerance,
+                   region_cache=region_cache)
     n = len(specs)
     results: list[dict | None] = [None] * n
     with progress.bar(n) as advance:

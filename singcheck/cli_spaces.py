@@ -54,8 +54,7 @@ def _options(space: str):
             click.argument("robot", type=click.Path(dir_okay=False)),
             click.option("--slice", "slices", multiple=True, metavar="AXIS=VALUE",
                          help=f"Fix a {axes} axis to an exact rational (repeatable): the "
-                         "decomposition is then of that slice. In a plane, cells are "
-                         "joined into connected regions."),
+                         "decomposition is then of that slice."),
             click.option("--surfaces", type=click.Choice(["auto", "all", "counts"]),
                          default="auto", show_default=True,
                          help="all: the whole discriminant variety; counts: only the "
@@ -179,8 +178,8 @@ Exit status:
 
 @click.command(epilog="""\b
 Examples:
-  singcheck workspace robots/orthoglide.yaml                 # 3-D, counts by cell
-  singcheck workspace robots/orthoglide.yaml --slice z=1     # plane z = 1, regions
+  singcheck workspace robots/orthoglide.yaml                 # 3-D cells and regions
+  singcheck workspace robots/orthoglide.yaml --slice z=1     # the plane z = 1
   singcheck workspace robots/skew-biglide.yaml --format json
 """ + _EXIT)
 @_options("workspace")
@@ -192,9 +191,10 @@ def workspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, fm
     The discriminant variety (serial singularities, the parallel singularity surface
     ξ(X), the joint limits projected) cuts the pose space into open cells (a generic
     cylindrical algebraic decomposition with exact rational sample points); the number
-    of solutions is counted exactly at each sample and holds on the whole cell.  In a
-    plane (a planar robot, or --slice on a spatial one) cells are joined into
-    connected regions by exactly checked segments.
+    of solutions is counted exactly at each sample and holds on the whole cell.  Cells
+    are joined into connected regions by exactly checked segments that avoid the
+    variety; the output says whether the regions are proven to be exactly the
+    connected components.
     """
     _command("workspace", robot, slices, surfaces, no_limits, backend, timeout, no_cache,
              fmt, output, quiet, verbose)
@@ -202,8 +202,8 @@ def workspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, fm
 
 @click.command(epilog="""\b
 Examples:
-  singcheck jointspace robots/orthoglide.yaml                  # 3-D, counts by cell
-  singcheck jointspace robots/orthoglide.yaml --slice rho3=2   # plane rho3 = 2, regions
+  singcheck jointspace robots/orthoglide.yaml                  # 3-D cells and regions
+  singcheck jointspace robots/orthoglide.yaml --slice rho3=2   # the plane rho3 = 2
 """ + _EXIT)
 @_options("jointspace")
 def jointspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, fmt, output,
@@ -214,8 +214,8 @@ def jointspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, f
     The discriminant variety (the serial singularities projected, ε(ρ), the limit
     planes) cuts the joint space into open cells with exact rational samples; at each,
     the real poses are counted from a Gröbner basis in shape position.  Cells outside
-    the joint-limit box are marked so.  In a plane (--slice), cells are joined into
-    connected regions.
+    the joint-limit box are marked so.  Cells are joined into connected regions by
+    exactly checked segments that avoid the variety.
     """
     _command("jointspace", robot, slices, surfaces, no_limits, backend, timeout, no_cache,
              fmt, output, quiet, verbose)

@@ -13,10 +13,12 @@ What is proven, and how:
   against the limits), which is decided because no surface passes through the point.
 * **Exit time.**  The first crossing after which the count is 0 is when the path
   leaves the workspace; its ball is the certified exit time.
-* **Region.**  A path with no crossing lies in one region.  When it lies in a plane
-  (a planar robot, or a pose coordinate that is a rational constant), the plane's
-  decomposition (:mod:`singcheck.space_analysis`) is computed, a rational point of the
-  path is located in a cell exactly, and the cell's region names it.
+* **Region.**  A path with no crossing lies in one region.  The decomposition of the
+  smallest subspace holding it (pose coordinates that are rational constants fixed: a
+  line, a plane, or the whole workspace) is computed (:mod:`singcheck.space_analysis`),
+  a rational point of the path is located in a cell exactly, and the cell's region
+  names it.  In 3-D, ξ is left out of the decomposition (``--surfaces auto``), and the
+  name says so: the region is then one of the count-changing surfaces' complement.
 """
 
 from __future__ import annotations
@@ -142,11 +144,12 @@ def _crossings(path: PathModel, tolerance: float,
 
 
 def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: bool = True,
-                      mu_roots: list[arb] | None = None) -> PathInWorkspace:
+                      mu_roots: list[arb] | None = None, region_cache=None) -> PathInWorkspace:
     """Where the path crosses the discriminant variety, and its IK count in between.
 
     ``mu_roots``: the certified roots of μ already isolated by the certification (every
-    one of them, none undecided), so that they are not isolated twice.
+    one of them, none undecided), so that they are not isolated twice.  ``region_cache``:
+    where region maps are kept between runs (None: computed in this process only).
     """
     crossings, undecided = _crossings(path, tolerance, mu_roots)
     points = gap_points(path.trajectory.range, [c.t for c in crossings])
@@ -158,7 +161,7 @@ def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: boo
                 result.exit_time = crossing.t
                 break
     if name_region and result.one_region:
-        result.region = locate_region(path)
+        result.region = locate_region(path, region_cache)
     return result
 
 
@@ -189,9 +192,8 @@ def _rational_time_points(path: PathModel):
             yield values
 
 
-def _plane(path: PathModel) -> tuple[dict[str, Fraction], tuple[int, ...]] | None:
-    """The fixed pose coordinates (rational constants of φ) and the free axes' indices,
-    when exactly two axes are free."""
+def _subspace(path: PathModel) -> tuple[dict[str, Fraction], tuple[int, ...]]:
+    """The fixed pose coordinates (rational constants of φ) and the free axes' indices."""
     pose = path.projection.model.pose
     fixed, free = {}, []
     for i, (name, p) in enumerate(zip(pose, path.phi, strict=True)):
@@ -200,62 +202,84 @@ def _plane(path: PathModel) -> tuple[dict[str, Fraction], tuple[int, ...]] | Non
             fixed[name] = Fraction(int(c.p), int(c.q))
         else:
             free.append(i)
-    return (fixed, tuple(free)) if len(free) == 2 else None
+    return fixed, tuple(free)
 
 
-def locate_region(path: PathModel) -> str | None:
-    """The name of the plane region holding the path (None when it cannot be located)."""
-    plane = _plane(path)
-    if plane is None:
+def locate_region(path: PathModel, cache=None) -> str | None:
+    """The name of the region holding the path, in the smallest space that holds it
+    (a line, a plane or the whole workspace: φ's constant coordinates are fixed); None
+    when no rational point of the path could be located in an open cell.  ``cache``: a
+    :class:`~singcheck.region_map.RegionMapCache`, or None to compute without storing."""
+    fixed, free = _subspace(path)
+    if not free:
         return None
-    fixed, free = plane
-    analysis = _plane_analysis(path.projection, fixed)
-    if analysis.regions is None:
-        return None
+    regions, left_out = _region_map(path.projection, fixed, len(free), cache)
     where = "" if not fixed else " " + ", ".join(f"{k} = {v}" for k, v in fixed.items())
-    for values in _rational_time_points(path):
-        point = [_exact(path.phi[i], values) for i in free]
-        cell = _cell_of(analysis.cad, point)
-        if cell is not None:
-            region = analysis.regions.region_of(cell)
-            return f"R{region.number} of the workspace plane{where}"
+    kind = {1: "line", 2: "plane"}.get(len(free), "")
+    space = f"the workspace {kind}{where}".replace("  ", " ").rstrip()
+    if left_out:
+        space += " cut by its serial-singularity and joint-limit surfaces only"
+    points = (point for values in _rational_time_points(path)
+              for point in [[_exact(path.phi[i], values) for i in free]])
+    for point in (*points, *_rational_points_near(path, free, regions.factors)):
+        number = regions.region_at(point)
+        if number is not None:
+            return f"R{number} of {space}"
     return None
 
 
-_PLANES: dict = {}
+def _rational_points_near(path: PathModel, free: tuple[int, ...], factors):
+    """Rational points in the same component as a point of the path, for paths whose
+    rational times give irrational poses (t mixed with sin t, cos t).
+
+    At a rational time t₀ the pose is enclosed in a box of balls; when every factor of
+    the decomposition excludes 0 on the whole box (ball arithmetic), the box is a
+    connected set avoiding the variety, so its rational centre lies in the path's
+    component.
+    """
+    from singcheck.intervals import evaluate
+    from singcheck.rational_roots import arb_to_fmpq
+
+    rng = path.trajectory.range
+    lo, hi = rng.start.ball(), rng.end.ball()
+    for k in range(1, 8):
+        t = lo + (hi - lo) * k / 8
+        with working_precision(128):
+            t0 = t.mid()
+            box = [path.pose_at(t0)[i] for i in free]
+            if all(evaluate(f, box).contains(0) is False for f in factors):
+                yield [_fraction(arb_to_fmpq(b.mid())) for b in box]
 
 
-def _plane_analysis(projection, fixed: dict[str, Fraction]):
-    """The plane's decomposition, computed once per robot and plane in a process (a
-    batch of paths in one plane shares it)."""
-    from singcheck.space_analysis import WORKSPACE, analyse, workspace_variety
+def _fraction(q: fmpq) -> Fraction:
+    return Fraction(int(q.p), int(q.q))
 
-    key = (id(projection), tuple(sorted(fixed.items())))
-    if key not in _PLANES:
-        _PLANES[key] = (projection, analyse(WORKSPACE, projection.model,
-                                            workspace_variety(projection), fixed))
-    return _PLANES[key][1]
+
+_SUBSPACES: dict = {}
+
+
+def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache):
+    """The region map of the subspace where ``fixed`` holds and the surfaces left out
+    (``--surfaces auto``): from this process's memo, else the disk cache, else computed
+    (then stored).  A batch of paths in one plane shares it."""
+    from singcheck.region_map import RegionMap
+    from singcheck.space_analysis import WORKSPACE, analyse, select_surfaces, workspace_variety
+
+    memo_key = (id(projection), tuple(sorted(fixed.items())))
+    if memo_key not in _SUBSPACES:
+        components, left_out = select_surfaces(workspace_variety(projection), WORKSPACE,
+                                               "auto", free_axes)
+        key = cache.key([c.polynomial for c in components], fixed) if cache else None
+        regions = cache.load(key) if cache else None
+        if regions is None:
+            regions = RegionMap.of(analyse(WORKSPACE, projection.model, components, fixed))
+            if cache:
+                cache.store(key, regions)
+        _SUBSPACES[memo_key] = (projection, regions, left_out)
+    return _SUBSPACES[memo_key][1:]
 
 
 def _exact(p, values: dict[str, Fraction]) -> Fraction:
     q = p.subs({k: fmpq(v.numerator, v.denominator) for k, v in values.items()})
     c = q.leading_coefficient() if not q.is_zero() else fmpq(0)
     return Fraction(int(c.p), int(c.q))
-
-
-def _cell_of(cad, point: list[Fraction]):
-    """The open cell holding a rational point, or None when it lies on a root."""
-    from singcheck.cad import fiber
-
-    index = []
-    for k in range(len(point)):
-        roots = fiber(cad.levels, cad.variables, tuple(point[:k]))
-        q = fmpq(point[k].numerator, point[k].denominator)
-        relations = [r.compare(q) for r in roots]
-        if 0 in relations:
-            return None
-        index.append(sum(1 for r in relations if r < 0))
-    for cell in cad.cells:
-        if cell.index == tuple(index):
-            return cell
-    return None

@@ -88,7 +88,8 @@ def no_root_between(q: fmpq_poly, a: Fraction, b: Fraction) -> bool:
     (Descartes).  Otherwise the roots are isolated and compared exactly.
     """
     qa, qb = _q(a), _q(b)
-    if q(qa) == 0 or q(qb) == 0:
+    va, vb = q(qa), q(qb)
+    if va == 0 or vb == 0 or (va > 0) != (vb > 0):  # a root at an end, or a sign change
         return False
     d = q.degree()
     num, one_plus = fmpq_poly([qa, qb]), fmpq_poly([1, 1])
@@ -106,10 +107,14 @@ def no_root_between(q: fmpq_poly, a: Fraction, b: Fraction) -> bool:
     return roots_within(q, (a, b)) == 0
 
 
-def segment_is_free(cad: OpenCAD, a: Fraction, b: Fraction, y0: Fraction) -> bool:
-    """True when no factor of the variety vanishes on [a, b] × {y₀} (exact)."""
+def segment_is_free(cad: OpenCAD, point: tuple[Fraction, ...], axis: int,
+                    a: Fraction, b: Fraction) -> bool:
+    """True when no factor of the variety vanishes on the segment that runs along
+    ``axis`` from a to b through ``point`` (whose ``axis`` coordinate is ignored): exact."""
+    values = {v: _q(x) for i, (v, x) in enumerate(zip(cad.variables, point, strict=True))
+              if i != axis}
     for f in cad.factors:
-        q = as_univariate(f.subs({cad.variables[1]: _q(y0)}), 0)  # f(x, y₀)
+        q = as_univariate(f.subs(values), axis)
         if q.is_zero():
             return False
         if q.degree() >= 1 and not no_root_between(q, a, b):
@@ -117,14 +122,17 @@ def segment_is_free(cad: OpenCAD, a: Fraction, b: Fraction, y0: Fraction) -> boo
     return True
 
 
-def _locate(roots, y0: Fraction) -> int:
-    """The sector index of y₀ among separated roots (y₀ must not be a root)."""
+def _locate(roots, y0: Fraction) -> int | None:
+    """The sector index of y₀ among separated roots; None when y₀ is one of them."""
     q = _q(y0)
-    return sum(1 for r in roots if r.compare(q) < 0)
+    relations = [r.compare(q) for r in roots]
+    if 0 in relations:
+        return None
+    return sum(1 for r in relations if r < 0)
 
 
 def _brackets(base, i: int, round_: int) -> tuple[Fraction, Fraction]:
-    """Rationals a < α_i < b, inside the two neighbouring columns, narrower each round."""
+    """Rationals a < α_i < b, inside the two neighbouring sectors, narrower each round."""
     r = base[i]
     if r.lo != r.hi:
         if round_:
@@ -138,45 +146,103 @@ def _brackets(base, i: int, round_: int) -> tuple[Fraction, Fraction]:
     return alpha - delta, alpha + delta
 
 
-def connect_regions(cad: OpenCAD) -> Regions:
-    """Group the cells of a 2-D open CAD into proven-connected regions."""
-    if len(cad.variables) != 2:
-        raise ValueError("regions are computed for plane decompositions")
+def connect_regions(cad: OpenCAD, invariants: dict | None = None) -> Regions:
+    """Group the cells of an open CAD (2-D or more) into proven-connected regions.
+
+    ``invariants`` (cell index → value), when given, holds a quantity proven constant on
+    every connected component of the complement (a solution count): regions whose values
+    differ are then known to be different components.
+    """
+    if len(cad.variables) < 2:
+        raise ValueError("regions are joined in decompositions of two or more axes")
     uf = _UnionFind()
-    for c in cad.cells:
-        uf.find(c.index)
-    base = fiber(cad.levels, cad.variables, ())
-    for i in range(len(base)):
-        _join_across(cad, base, i, uf)
+    indices = {c.index for c in cad.cells}
+    for index in indices:
+        uf.find(index)
+    # the top level's roots are the variety's own factors: no segment crosses them freely
+    memo: dict = {}
+
+    def fibre(point: tuple) -> list:
+        if point not in memo:
+            memo[point] = fiber(cad.levels, cad.variables, point)
+        return memo[point]
+
+    for level in range(len(cad.variables) - 1):
+        prefixes = {(c.index[:level], c.sample[:level]) for c in cad.cells}
+        for prefix_index, prefix_sample in sorted(prefixes):
+            base = fibre(prefix_sample)
+            for i in range(len(base)):
+                _join_across(cad, fibre, indices, prefix_index, prefix_sample, base, i, uf)
+    return _regions_of(cad, uf, invariants or {})
+
+
+def _regions_of(cad: OpenCAD, uf: _UnionFind, invariants: dict) -> Regions:
     groups: dict = {}
     for c in cad.cells:
         groups.setdefault(uf.find(c.index), []).append(c)
     regions = []
     for n, members in enumerate(sorted(groups.values(), key=lambda m: m[0].index), 1):
         regions.append(Region(n, tuple(members), factor_signs(cad, members[0].sample)))
-    seen: dict = {}
-    clashes = 0
+    by_signs: dict = {}
     for r in regions:
-        clashes += r.signs in seen
-        seen.setdefault(r.signs, r)
+        by_signs.setdefault(r.signs, []).append(invariants.get(r.cells[0].index))
+    clashes = 0
+    for values in by_signs.values():
+        known = {v for v in values if v is not None}
+        clashes += len(values) - 1 if None in values else len(values) - len(known)
     reason = "" if not clashes else (
-        f"{clashes} region(s) share the factor signs of another one: they may be parts of "
-        "one connected component that no checked segment joined")
+        f"{clashes} region(s) share the factor signs (and solution count) of another one: "
+        "they may be parts of one connected component that no checked segment joined")
     return Regions(tuple(regions), clashes == 0, reason)
 
 
-def _join_across(cad: OpenCAD, base, i: int, uf: _UnionFind) -> None:
-    """Join the cells of columns i and i+1 through free segments across α_i."""
+def _join_across(cad: OpenCAD, fibre, indices: set, prefix_index: tuple,
+                 prefix_sample: tuple, base, i: int, uf: _UnionFind) -> None:
+    """Join the cells over sector i and sector i+1 of ``base`` (the fibre over the prefix
+    cell's sample at the next level) through free segments across its root α_i."""
+    level = len(prefix_sample)
+    # the cells on either side that still have to be joined across α_i
+    waiting = [{c for c in indices if c[:level + 1] == prefix_index + (j,)} for j in (i, i + 1)]
     for round_ in range(_ROUNDS):
         a, b = _brackets(base, i, round_)
-        left, right = (fiber(cad.levels, cad.variables, (x,)) for x in (a, b))
-        joined_left, joined_right = set(), set()
-        for y0 in sorted(set(sector_samples(left)) | set(sector_samples(right))):
-            if not segment_is_free(cad, a, b, y0):
+        for rest in _candidate_rests(cad, fibre, prefix_sample, a, b):
+            point = (*prefix_sample, a, *rest)
+            if not segment_is_free(cad, point, level, a, b):
                 continue
-            j, k = _locate(left, y0), _locate(right, y0)
-            uf.union((i, j), (i + 1, k))
-            joined_left.add(j)
-            joined_right.add(k)
-        if len(joined_left) == len(left) + 1 and len(joined_right) == len(right) + 1:
+            lo = _index_of(fibre, prefix_index + (i,), prefix_sample + (a,), rest)
+            hi = _index_of(fibre, prefix_index + (i + 1,), prefix_sample + (b,), rest)
+            if lo in indices and hi in indices:
+                uf.union(lo, hi)
+                waiting[0].discard(lo)
+                waiting[1].discard(hi)
+                if not waiting[0] and not waiting[1]:
+                    return
+
+
+def _candidate_rests(cad: OpenCAD, fibre, prefix: tuple, a: Fraction, b: Fraction):
+    """Coordinates for the levels above the crossing: at each level, the sector samples
+    of the fibres over the two ends (a point on a root of either is skipped, since
+    it lies on no open cell there)."""
+    def extend(rest: tuple):
+        if len(prefix) + 1 + len(rest) == len(cad.variables):
+            yield rest
             return
+        fibres = [fibre((*prefix, end, *rest)) for end in (a, b)]
+        for y0 in sorted(set(sector_samples(fibres[0])) | set(sector_samples(fibres[1]))):
+            if all(_locate(f, y0) is not None for f in fibres):
+                yield from extend((*rest, y0))
+
+    yield from extend(())
+
+
+def _index_of(fibre, head: tuple, point: tuple, rest: tuple) -> tuple | None:
+    """The cell index of ``point + rest`` whose first levels are known to be ``head``."""
+    index = list(head)
+    current = tuple(point)
+    for y0 in rest:
+        k = _locate(fibre(current), y0)
+        if k is None:
+            return None
+        index.append(k)
+        current += (y0,)
+    return tuple(index)

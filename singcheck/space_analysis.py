@@ -231,7 +231,8 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
                                    not use_limits or _within(model, point)))
     timings["counting_s"] = time.perf_counter() - start
     start = time.perf_counter()
-    regions = _regions(cad)
+    regions = _regions(cad, {c.cell.index: (c.count, c.within_limits) for c in cells
+                             if c.count is not None})
     timings["regions_s"] = time.perf_counter() - start
     if regions is not None:
         number = {c.index: r.number for r in regions.regions for c in r.cells}
@@ -240,14 +241,13 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     return SpaceAnalysis(space, model.name, free, fixed, sliced, cad, cells, regions, timings)
 
 
-def _regions(cad: OpenCAD) -> Regions | None:
-    """Connected regions: every cell of a line, joined cells of a plane (None in 3-D)."""
+def _regions(cad: OpenCAD, counts: dict) -> Regions:
+    """Connected regions: every cell of a line, else cells joined by free segments
+    (``counts``, constant on each component, help prove regions distinct)."""
     if len(cad.variables) == 1 or not cad.factors:
         return Regions(tuple(Region(i + 1, (c,), factor_signs(cad, c.sample))
                              for i, c in enumerate(cad.cells)), True, "")
-    if len(cad.variables) == 2:
-        return connect_regions(cad)
-    return None
+    return connect_regions(cad, counts)
 
 
 def _trivial_cad(free: tuple[str, ...]) -> OpenCAD:

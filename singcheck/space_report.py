@@ -86,8 +86,6 @@ def render(console, doc: dict[str, Any], verbose: bool = False) -> None:
         "outside the joint limits"
     if doc["regions"] is not None:
         _regions_table(console, doc, outside, verbose)
-    else:
-        _cells_table(console, doc, outside)
     counts = ", ".join(f"{k} ({v['cells']} cells" + (f", {v['regions']} regions" if
                                                       "regions" in v else "") + ")"
                        for k, v in doc["counts"].items())
@@ -119,23 +117,3 @@ def _regions_table(console, doc, outside: str, verbose: bool) -> None:
     console.print(table)
     if hidden:
         console.print(f"  {hidden} region(s) {outside} not listed (-v lists them)")
-
-
-def _cells_table(console, doc, outside: str) -> None:
-    from rich.table import Table
-
-    table = Table(title="cells by number of solutions (regions are joined in plane "
-                        "decompositions: use --slice)", title_justify="left")
-    for col in ("solutions", "cells", *[f"sample {a}" for a in doc["axes"]]):
-        table.add_column(col, justify="right")
-    first: dict = {}
-    for c in doc["cells"]:
-        if c["within_limits"]:
-            first.setdefault(c["count"], c)
-    for count, cell in sorted(first.items(), key=lambda kv: (kv[0] is None, kv[0] or 0)):
-        n = doc["counts"]["unknown" if count is None else str(count)]["cells"]
-        table.add_row("unknown" if count is None else str(count), str(n),
-                      *[cell["sample"][a] for a in doc["axes"]])
-    console.print(table)
-    if doc["space"] == JOINTSPACE:
-        console.print(f"  cells {outside} not counted in this table")

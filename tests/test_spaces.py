@@ -66,6 +66,35 @@ def test_regions_are_the_connected_components(curve, regions, proven):
     assert result.components_proven is proven
 
 
+XYZ = fmpq_mpoly_ctx.get(("x", "y", "z"), "lex")
+X3, Y3, Z3 = XYZ.gens()
+
+
+@pytest.mark.parametrize(("surfaces", "regions", "proven"), [
+    # a sphere cut by a plane: the two half-balls and the two outer half-spaces
+    ([X3**2 + Y3**2 + Z3**2 - 1, Z3], 4, True),
+    # a torus: inside the tube and outside (joined around the hole, across columns)
+    ([(X3**2 + Y3**2 + Z3**2 + 3)**2 - 16 * (X3**2 + Y3**2)], 2, True),
+    # a cylinder through a sphere: in both, in the cylinder above / below the sphere,
+    # the shell between them, outside both; above and below share their signs
+    ([X3**2 + Y3**2 - 1, X3**2 + Y3**2 + Z3**2 - 4], 5, False),
+])
+def test_regions_in_three_dimensions(surfaces, regions, proven):
+    result = connect_regions(open_cad(surfaces))
+    assert len(result.regions) == regions
+    assert result.components_proven is proven
+
+
+def test_a_count_that_differs_separates_regions_with_the_same_signs():
+    cad = open_cad([Y**2 - (X**2 - 1) * (4 - X**2)])  # two ovals, same signs inside
+    plain = connect_regions(cad)
+    assert not plain.components_proven
+    # an invariant (a solution count) that differs between the two ovals proves them apart
+    oval = {c.index: (1 if c.sample[0] > 0 else 2) if len(r.cells) < len(cad.cells) // 2
+            else 0 for r in plain.regions for c in r.cells}
+    assert connect_regions(cad, oval).components_proven
+
+
 # -- the paper's statements ---------------------------------------------------------
 
 
@@ -184,6 +213,38 @@ def test_leaving_the_workspace_is_infeasible_with_a_certified_exit_time(
     lo, hi = float(w.exit_time.lower()), float(w.exit_time.upper())
     assert lo <= exact <= hi and hi - lo < 1e-6
     assert w.stretches[0].count == 1 and w.stretches[1].count == 0
+
+
+@pytest.mark.slow
+def test_orthoglide_3d_workspace_has_one_region_with_1_and_one_with_8(orthoglide_projection):
+    components, _ = select_surfaces(workspace_variety(orthoglide_projection), WORKSPACE,
+                                    "auto", 3)
+    analysis = analyse(WORKSPACE, orthoglide_projection.model, components)
+    inside = [analysis.region_count(r.number) for r in analysis.regions.regions
+              if analysis.region_count(r.number)]
+    assert sorted(inside) == [1, 8]  # the paper's Fig. 1(b), as regions of the 3-D space
+
+
+@pytest.mark.slow
+def test_helix_is_named_in_the_3d_workspace_and_the_map_is_cached(
+        orthoglide_projection, tmp_path):
+    from singcheck import path_regions
+    from singcheck.region_map import RegionMapCache
+
+    cache = RegionMapCache(tmp_path)
+    helix = _path(orthoglide_projection, "helix")
+    path_regions._SUBSPACES.clear()
+    first = path_regions.path_in_workspace(helix, region_cache=cache)
+    assert first.one_region and first.region.startswith("R")
+    assert first.region.endswith("of the workspace cut by its serial-singularity and "
+                                 "joint-limit surfaces only")
+    (entry,) = (tmp_path / "regions").glob("*.json")
+    path_regions._SUBSPACES.clear()
+    assert path_regions.path_in_workspace(helix, region_cache=cache).region == first.region
+    entry.write_text(entry.read_text().replace('"cells"', '"cels"'))  # damaged: recomputed
+    path_regions._SUBSPACES.clear()
+    assert path_regions.path_in_workspace(helix, region_cache=cache).region == first.region
+    path_regions._SUBSPACES.clear()
 
 
 # -- the command line -----------------------------------------------------------------

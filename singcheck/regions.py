@@ -1,18 +1,23 @@
-"""Connected regions of a plane decomposition: joining open cells across columns.
+"""Connected regions of an open CAD: joining open cells across critical values.
 
 The paper's third step ("connection of the cells belonging to the same connected
-component").  For a 2-D open CAD, cells of one column are separated by sections of the
-variety, so only cells of neighbouring columns can join.  Around each critical value α
-between two columns, rationals a < α < b are taken inside the two columns (α's
-isolating interval, narrowed round after round); for candidate heights y₀ (the sector
-samples of the fibres at a and b), the horizontal segment [a, b] × {y₀} is checked
-exactly to meet none of the variety's factors (no root of f(x, y₀) in [a, b]).  When it
-is free, the cell holding (a, y₀) and the cell holding (b, y₀) are in one region.
+component"), in any dimension.  At each level k below the top, over the sample of
+every cell of the first k axes, the next axis is cut by the real roots α of the
+level's projection factors.  Around each α, rationals a < α < b are taken inside the
+two neighbouring sectors (α's isolating interval, narrowed round after round); for
+candidate points above (the sector samples of the fibres over both ends, level after
+level), the segment from a to b along axis k is checked exactly to meet none of the
+variety's factors (no root of f restricted to it in [a, b]).  When it is free, the
+cells holding its two ends are in one region.  Cells of one stack at the top level are
+separated by the variety's own sections, so only lower levels are crossed.
 
 What is proven: every region is connected (a chain of free segments and connected cells
-links any two of its cells).  The regions are exactly the connected components when no
-two of them share the same signs of the variety's factors (a component has one sign
-vector, since no factor vanishes on it); ``components_proven`` says whether that holds.
+links any two of its cells).  The regions are exactly the connected components when
+every two of them differ in something constant on a component: the sign of a factor of
+the variety (none vanishes on a component), the side of a *wall* (a factor in one
+variable x_k gives hyperplanes x_k = α that no component crosses), or an invariant the
+caller proves constant (the solution counts); ``components_proven`` says whether that
+holds.
 """
 
 from __future__ import annotations
@@ -22,7 +27,7 @@ from fractions import Fraction
 
 from flint import fmpq, fmpq_poly
 
-from singcheck.cad import Cell, OpenCAD, as_univariate, fiber, sector_samples
+from singcheck.cad import Cell, OpenCAD, as_univariate, fiber, sector_samples, separated_roots
 from singcheck.solution_counts import roots_within
 
 _ROUNDS = 3
@@ -183,17 +188,36 @@ def _regions_of(cad: OpenCAD, uf: _UnionFind, invariants: dict) -> Regions:
     regions = []
     for n, members in enumerate(sorted(groups.values(), key=lambda m: m[0].index), 1):
         regions.append(Region(n, tuple(members), factor_signs(cad, members[0].sample)))
+    walls = _walls(cad)
     by_signs: dict = {}
     for r in regions:
-        by_signs.setdefault(r.signs, []).append(invariants.get(r.cells[0].index))
+        key = (r.signs, _slabs(walls, r.cells[0].sample))
+        by_signs.setdefault(key, []).append(invariants.get(r.cells[0].index))
     clashes = 0
     for values in by_signs.values():
         known = {v for v in values if v is not None}
         clashes += len(values) - 1 if None in values else len(values) - len(known)
     reason = "" if not clashes else (
-        f"{clashes} region(s) share the factor signs (and solution count) of another one: "
-        "they may be parts of one connected component that no checked segment joined")
+        f"{clashes} region(s) share the factor signs, the side of every wall and the "
+        "solution count of another one: they may be parts of one connected component "
+        "that no checked segment joined")
     return Regions(tuple(regions), clashes == 0, reason)
+
+
+def _walls(cad: OpenCAD) -> list[tuple[int, list]]:
+    """Factors in a single variable x_k: their real roots α are hyperplanes x_k = α of the
+    variety, which no connected set off the variety crosses.  (axis, separated roots)."""
+    out = []
+    for f in cad.factors:
+        axes = [k for k, d in enumerate(f.degrees()) if d > 0]
+        if len(axes) == 1:
+            out.append((axes[0], separated_roots(as_univariate(f, axes[0]))))
+    return out
+
+
+def _slabs(walls, sample) -> tuple[int | None, ...]:
+    """For each wall, how many of its hyperplanes lie below the sample (exact)."""
+    return tuple(_locate(roots, sample[axis]) for axis, roots in walls)
 
 
 def _join_across(cad: OpenCAD, fibre, indices: set, prefix_index: tuple,

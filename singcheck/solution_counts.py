@@ -65,6 +65,31 @@ def inverse_kinematics_count(model: RobotModel, pose_point, use_limits: bool = T
     return total
 
 
+def ik_root_placement(model: RobotModel, pose_point,
+                      use_limits: bool = True) -> tuple[tuple[int, int, int], ...]:
+    """Per leg, its distinct real joint roots below, inside and above the joint's range
+    at a rational pose (exact; all 'inside' for a joint without limits, or when
+    ``use_limits`` is False).
+
+    Off the serial-singularity and joint-limit surfaces this is constant on every
+    connected set: roots move continuously (the leading coefficient is constant), meet
+    only where the discriminant vanishes and pass a limit only where the leg polynomial
+    vanishes at it.  It refines the IK count (the product of the 'inside' entries).
+    """
+    limits = model.spec.joint_limits if use_limits else {}
+    out = []
+    for leg in model.legs:
+        roots = separated_roots(leg_polynomial_at(model, leg, pose_point))
+        if leg.joint not in limits:
+            out.append((0, len(roots), 0))
+            continue
+        lo, hi = (_fmpq(v) for v in limits[leg.joint])
+        below = sum(1 for r in roots if r.compare(lo) < 0)
+        above = sum(1 for r in roots if r.compare(hi) > 0)
+        out.append((below, len(roots) - below - above, above))
+    return tuple(out)
+
+
 @dataclass(frozen=True)
 class DirectCount:
     count: int | None

@@ -22,6 +22,7 @@ The paper's second half, exactly:
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -34,7 +35,7 @@ from singcheck.errors import SingcheckError
 from singcheck.model import RobotModel
 from singcheck.projection import RobotProjection, joint_space_singularities
 from singcheck.regions import Region, Regions, connect_regions, factor_signs
-from singcheck.solution_counts import direct_kinematics_count, inverse_kinematics_count
+from singcheck.solution_counts import direct_kinematics_count, ik_root_placement
 
 WORKSPACE, JOINTSPACE = "workspace", "jointspace"
 SERIAL, PARALLEL, LIMIT = "serial singularity", "parallel singularity", "joint limit"
@@ -220,19 +221,23 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     timings["decomposition_s"] = time.perf_counter() - start
     start = time.perf_counter()
     cells = []
+    invariants = {}  # cell index -> what is constant on a component (for proofs)
     for cell in cad.cells:
         point = _point(axes, free, cell.sample, fixed)
         if space == WORKSPACE:
-            count = inverse_kinematics_count(model, point, use_limits)
+            placement = ik_root_placement(model, point, use_limits)
+            count = math.prod(inside for _, inside, _ in placement)
             cells.append(CellCount(cell, count, "", True))
+            invariants[cell.index] = placement
         else:
             dk = direct_kinematics_count(model, point)
             cells.append(CellCount(cell, dk.count, dk.reason,
                                    not use_limits or _within(model, point)))
+            if dk.count is not None:
+                invariants[cell.index] = (dk.count, cells[-1].within_limits)
     timings["counting_s"] = time.perf_counter() - start
     start = time.perf_counter()
-    regions = _regions(cad, {c.cell.index: (c.count, c.within_limits) for c in cells
-                             if c.count is not None})
+    regions = _regions(cad, invariants)
     timings["regions_s"] = time.perf_counter() - start
     if regions is not None:
         number = {c.index: r.number for r in regions.regions for c in r.cells}

@@ -59,6 +59,9 @@ def test_circle_and_line_cells_avoid_the_curves():
     ((X**2 + Y**2)**2 - 2 * (X**2 - Y**2), 3, False),
     # two concentric circles cut by a line: 6 components, all with distinct signs
     ((X**2 + Y**2 - 1) * (X**2 + Y**2 - 9) * (X - Y), 6, True),
+    # a grid of lines x = ±√3, y = ±√3: 9 components; the four corners share their
+    # signs, but lie on different sides of the walls
+    ((X**2 - 3) * (Y**2 - 3), 9, True),
 ])
 def test_regions_are_the_connected_components(curve, regions, proven):
     result = connect_regions(open_cad([curve]))
@@ -133,6 +136,16 @@ def test_orthoglide_joint_space_has_a_region_with_2_dk_solutions(orthoglide):
     inside = {analysis.region_count(c.region) for c in analysis.cells if c.within_limits}
     assert inside == {0, 2}
     assert all(c.count is not None for c in analysis.cells)
+
+
+def test_ik_root_placement_against_the_limits(orthoglide):
+    from singcheck.solution_counts import ik_root_placement
+
+    # each leg: ρ = 1 ± √2, one root below 0 and one inside [0, 4]
+    assert ik_root_placement(orthoglide, (1, 1, 1)) == ((1, 1, 0),) * 3
+    # x = 5: leg 1 has ρ1 = 5 ± 2 (3 inside, 7 above); legs 2, 3 unreachable (x² > 4)
+    assert ik_root_placement(orthoglide, (5, 0, 0)) == ((0, 1, 1), (0, 0, 0), (0, 0, 0))
+    assert ik_root_placement(orthoglide, (1, 1, 1), use_limits=False) == ((0, 2, 0),) * 3
 
 
 def test_direct_kinematics_counts(orthoglide):
@@ -223,6 +236,8 @@ def test_orthoglide_3d_workspace_has_one_region_with_1_and_one_with_8(orthoglide
     inside = [analysis.region_count(r.number) for r in analysis.regions.regions
               if analysis.region_count(r.number)]
     assert sorted(inside) == [1, 8]  # the paper's Fig. 1(b), as regions of the 3-D space
+    # every two regions differ in a sign, a wall side or the legs' root placement
+    assert analysis.regions.components_proven
 
 
 @pytest.mark.slow

@@ -139,9 +139,9 @@ def _locate(roots, y0: Fraction) -> int | None:
 def _brackets(base, i: int, round_: int) -> tuple[Fraction, Fraction]:
     """Rationals a < α_i < b, inside the two neighbouring sectors, narrower each round."""
     r = base[i]
-    if r.lo != r.hi:
-        if round_:
-            r.bisect_to((r.hi - r.lo) / 2 ** (8 * round_))
+    if r.lo != r.hi and round_:
+        r.bisect_to((r.hi - r.lo) / 2 ** (8 * round_))
+    if r.lo != r.hi:  # (bisection may have met the root exactly: then it is a point)
         return Fraction(int(r.lo.p), int(r.lo.q)), Fraction(int(r.hi.p), int(r.hi.q))
     alpha = Fraction(int(r.lo.p), int(r.lo.q))
     left = Fraction(int(base[i - 1].hi.p), int(base[i - 1].hi.q)) if i else alpha - 1
@@ -172,13 +172,37 @@ def connect_regions(cad: OpenCAD, invariants: dict | None = None) -> Regions:
             memo[point] = fiber(cad.levels, cad.variables, point)
         return memo[point]
 
+    exact = len(cad.variables) == 2  # complete adjacency is known in the plane only
+    fibres_over_alpha: dict = {}
     for level in range(len(cad.variables) - 1):
         prefixes = {(c.index[:level], c.sample[:level]) for c in cad.cells}
         for prefix_index, prefix_sample in sorted(prefixes):
             base = fibre(prefix_sample)
             for i in range(len(base)):
+                if exact and _join_exactly(cad, base, i, indices, uf, fibres_over_alpha):
+                    continue
+                exact = False
                 _join_across(cad, fibre, indices, prefix_index, prefix_sample, base, i, uf)
-    return _regions_of(cad, uf, invariants or {})
+    regions = _regions_of(cad, uf, invariants or {})
+    if exact:  # every adjacency decided: the regions are the components
+        return Regions(regions.regions, True, "")
+    return regions
+
+
+def _join_exactly(cad: OpenCAD, base, i: int, indices: set, uf: _UnionFind,
+                  memo: dict) -> bool:
+    """Join the columns on either side of the plane's i-th critical value by their exact
+    adjacency (:mod:`singcheck.plane_adjacency`); False when it could not be decided."""
+    from singcheck.plane_adjacency import exact_joins
+
+    pairs = exact_joins(cad, base, i, _brackets, memo)
+    if pairs is None:
+        return False
+    for left, right in pairs:
+        if (i, left) not in indices or (i + 1, right) not in indices:
+            return False
+        uf.union((i, left), (i + 1, right))
+    return True
 
 
 def _regions_of(cad: OpenCAD, uf: _UnionFind, invariants: dict) -> Regions:

@@ -7,7 +7,7 @@ from fractions import Fraction
 
 import mpmath
 import pytest
-from flint import fmpq_mpoly_ctx
+from flint import fmpq, fmpq_mpoly_ctx, fmpq_poly
 
 from singcheck.cad import open_cad, simplest_between
 from singcheck.regions import connect_regions
@@ -53,10 +53,19 @@ def test_circle_and_line_cells_avoid_the_curves():
 
 
 @pytest.mark.parametrize(("curve", "regions", "proven"), [
-    # two ovals of one irreducible curve: the outside and each oval (same signs inside)
-    (Y**2 - (X**2 - 1) * (4 - X**2), 3, False),
-    # a lemniscate: the outside and two lobes
-    ((X**2 + Y**2)**2 - 2 * (X**2 - Y**2), 3, False),
+    # two ovals of one irreducible curve: the outside and each oval (same signs inside,
+    # told apart by the exact adjacency at the critical values)
+    (Y**2 - (X**2 - 1) * (4 - X**2), 3, True),
+    # a lemniscate: the outside and two lobes, which touch only at the node
+    ((X**2 + Y**2)**2 - 2 * (X**2 - Y**2), 3, True),
+    # a cusp y² = x³: inside and outside
+    (Y**2 - X**3, 2, True),
+    # two circles tangent at (1, 0): two insides and the outside
+    ((X**2 + Y**2 - 1) * ((X - 2)**2 + Y**2 - 1), 3, True),
+    # y² = x²(x - 1): the isolated point at the origin does not cut the outside
+    (Y**2 - X**2 * (X - 1), 2, True),
+    # two lines crossing at x = -27/8, a critical value that bisection meets exactly
+    ((Y + 2) * (8 * X - 6 * Y + 15), 4, True),
     # two concentric circles cut by a line: 6 components, all with distinct signs
     ((X**2 + Y**2 - 1) * (X**2 + Y**2 - 9) * (X - Y), 6, True),
     # a grid of lines x = ±√3, y = ±√3: 9 components; the four corners share their
@@ -89,13 +98,39 @@ def test_regions_in_three_dimensions(surfaces, regions, proven):
 
 
 def test_a_count_that_differs_separates_regions_with_the_same_signs():
-    cad = open_cad([Y**2 - (X**2 - 1) * (4 - X**2)])  # two ovals, same signs inside
+    # in 3-D (no exact adjacency): the two ovals turned round the x axis, one
+    # irreducible surface with the same sign inside both
+    cad = open_cad([Y3**2 + Z3**2 - (X3**2 - 1) * (4 - X3**2)])
     plain = connect_regions(cad)
-    assert not plain.components_proven
-    # an invariant (a solution count) that differs between the two ovals proves them apart
-    oval = {c.index: (1 if c.sample[0] > 0 else 2) if len(r.cells) < len(cad.cells) // 2
-            else 0 for r in plain.regions for c in r.cells}
-    assert connect_regions(cad, oval).components_proven
+    assert len(plain.regions) == 3 and not plain.components_proven
+    # an invariant (a solution count) that differs between the two proves them apart
+    count = {c.index: int(c.sample[0] > 0) for r in plain.regions for c in r.cells}
+    assert connect_regions(cad, count).components_proven
+
+
+def test_brackets_step_around_a_critical_value_met_exactly():
+    from singcheck.rational_roots import RationalRoot
+    from singcheck.regions import _brackets
+
+    alpha = Fraction(-27, 8)  # the midpoint of the isolating interval: bisection finds it
+    root = RationalRoot(fmpq_poly([27, 8]), fmpq(-7, 2), fmpq(-13, 4))
+    for round_ in range(3):
+        a, b = _brackets([root], 0, round_)
+        assert a < alpha < b
+
+
+def test_fibre_over_a_critical_value_is_exact():
+    from singcheck.cad import fiber
+    from singcheck.plane_adjacency import WALL, fibre_points
+
+    circle = open_cad([X**2 + Y**2 - 1])
+    base = fiber(circle.levels, circle.variables, ())  # x = ±1
+    (point,) = fibre_points(circle.factors, base[1])  # a double root: one point, y = 0
+    assert point.contains(0)
+    # √2 is a root of both the wall x² - 2 and the circle's discriminant: a wall
+    walls = open_cad([X**2 - 2, X**2 + Y**2 - 2])
+    base = fiber(walls.levels, walls.variables, ())
+    assert all(fibre_points(walls.factors, r) == WALL for r in base)
 
 
 # -- the paper's statements ---------------------------------------------------------

@@ -27,7 +27,7 @@ from singcheck.cad import fiber
 from singcheck.cas.polytext import PolynomialSyntaxError, format_polynomial, parse_polynomial
 
 #: Bump when the decomposition or the joining of regions changes what a number means.
-REGIONS_VERSION = "1"
+REGIONS_VERSION = "2"
 FORMAT = "singcheck-region-map/1"
 
 

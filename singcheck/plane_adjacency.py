@@ -57,6 +57,9 @@ def minimal_polynomial(root: RationalRoot) -> fmpq_poly:
 
 
 class _Field:
+    """Q[x]/(m) for an irreducible m, and polynomials in y over it (Euclid's algorithm
+    with exact remainders; an element is zero exactly when its remainder mod m is)."""
+
     def __init__(self, m: fmpq_poly) -> None:
         self.m = m
 
@@ -65,8 +68,9 @@ class _Field:
 
     def inverse(self, p: fmpq_poly) -> fmpq_poly:
         g, s, _ = p.xgcd(self.m)
-        return self.reduce(s / g.leading_coefficient()) if g.degree() == 0 else \
-            _raise(NotDecided("a zero divisor: m is not irreducible"))
+        if g.degree() != 0:
+            raise NotDecided("a zero divisor: m is not irreducible")
+        return self.reduce(s / g.leading_coefficient())
 
     def trim(self, a: list) -> list:
         while a and a[-1].is_zero():
@@ -94,10 +98,6 @@ class _Field:
         while b:
             a, b = b, self.divmod(a, b)[1]
         return self.monic(a)
-
-
-def _raise(e: Exception):
-    raise e
 
 
 # ---------------------------------------------------------------------------------

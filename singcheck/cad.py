@@ -31,7 +31,7 @@ from itertools import combinations
 from flint import fmpq, fmpq_mpoly, fmpq_poly
 
 from singcheck.elimination import coefficient_in
-from singcheck.rational_roots import RationalRoot, real_roots_exact
+from singcheck.rational_roots import RationalRoot, real_roots_exact, to_fraction
 
 
 @dataclass(frozen=True)
@@ -132,10 +132,6 @@ def simplest_between(lo: Fraction | None, hi: Fraction | None) -> Fraction:
     return whole + 1 / inner
 
 
-def _frac(q: fmpq) -> Fraction:
-    return Fraction(int(q.p), int(q.q))
-
-
 def separated_roots(p: fmpq_poly) -> list[RationalRoot]:
     """The real roots of ``p`` (squarefree part), sorted, with pairwise disjoint closed
     isolating intervals (point intervals for roots met exactly)."""
@@ -163,9 +159,9 @@ def sector_samples(roots: list[RationalRoot]) -> list[Fraction]:
     """
     if not roots:
         return [Fraction(0)]
-    gaps = [(None, _frac(roots[0].lo))]
-    gaps += [(_frac(a.hi), _frac(b.lo)) for a, b in zip(roots, roots[1:], strict=False)]
-    gaps.append((_frac(roots[-1].hi), None))
+    gaps = [(None, to_fraction(roots[0].lo))]
+    gaps += [(to_fraction(a.hi), to_fraction(b.lo)) for a, b in zip(roots, roots[1:], strict=False)]
+    gaps.append((to_fraction(roots[-1].hi), None))
     return [simplest_between(lo, hi) for lo, hi in gaps]
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
-from flint import fmpq_mpoly, fmpq_mpoly_ctx
+from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 
 @dataclass(frozen=True)
@@ -56,6 +56,11 @@ def restrict(p: fmpq_mpoly, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
             raise ValueError(f"{p} still involves an eliminated variable")
         out[tuple(exps[i] for i in keep)] = coeff
     return ctx.from_dict(out)
+
+
+def constant_value(p: fmpq_mpoly) -> fmpq:
+    """The value of a constant polynomial (0 for the zero polynomial), exactly."""
+    return p.leading_coefficient() if not p.is_zero() else fmpq(0)
 
 
 def coefficient_in(f: fmpq_mpoly, var_index: int, degree: int) -> fmpq_mpoly:

@@ -27,10 +27,12 @@ import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 
-from flint import acb, arb, fmpq
+from flint import acb, arb
 
+from singcheck.elimination import constant_value
 from singcheck.intervals import fraction_ball, working_precision
 from singcheck.path import PathModel
+from singcheck.rational_roots import to_fmpq, to_fraction
 from singcheck.roots import IdenticallyZeroError, isolate_real_roots
 from singcheck.trig import uses_t, uses_trig
 from singcheck.working_modes import gap_points
@@ -198,8 +200,7 @@ def _subspace(path: PathModel) -> tuple[dict[str, Fraction], tuple[int, ...]]:
     fixed, free = {}, []
     for i, (name, p) in enumerate(zip(pose, path.phi, strict=True)):
         if p.is_constant():
-            c = p.leading_coefficient() if not p.is_zero() else fmpq(0)
-            fixed[name] = Fraction(int(c.p), int(c.q))
+            fixed[name] = to_fraction(constant_value(p))
         else:
             free.append(i)
     return fixed, tuple(free)
@@ -248,11 +249,7 @@ def _rational_points_near(path: PathModel, free: tuple[int, ...], factors):
             t0 = t.mid()
             box = [path.pose_at(t0)[i] for i in free]
             if all(evaluate(f, box).contains(0) is False for f in factors):
-                yield [_fraction(arb_to_fmpq(b.mid())) for b in box]
-
-
-def _fraction(q: fmpq) -> Fraction:
-    return Fraction(int(q.p), int(q.q))
+                yield [to_fraction(arb_to_fmpq(b.mid())) for b in box]
 
 
 _SUBSPACES: dict = {}
@@ -280,6 +277,5 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache):
 
 
 def _exact(p, values: dict[str, Fraction]) -> Fraction:
-    q = p.subs({k: fmpq(v.numerator, v.denominator) for k, v in values.items()})
-    c = q.leading_coefficient() if not q.is_zero() else fmpq(0)
-    return Fraction(int(c.p), int(c.q))
+    q = p.subs({k: to_fmpq(v) for k, v in values.items()})
+    return to_fraction(constant_value(q))

@@ -33,7 +33,7 @@ from flint import acb, acb_poly, arb, arb_poly, fmpq, fmpq_poly
 
 from singcheck.cad import fiber, simplest_between
 from singcheck.intervals import working_precision
-from singcheck.rational_roots import RationalRoot, arb_to_fmpq
+from singcheck.rational_roots import RationalRoot, arb_to_fmpq, to_fmpq, to_fraction
 
 WALL = "wall"  # the line x = α lies in the variety
 
@@ -185,7 +185,8 @@ def separators(points: list[arb]) -> list[Fraction]:
     """Rationals s₀ < y₁ < s₁ < … < y_k < s_k (k + 1 of them)."""
     if not points:
         return [Fraction(0)]
-    ends = [(_frac(arb_to_fmpq(p.lower())), _frac(arb_to_fmpq(p.upper()))) for p in points]
+    ends = [(to_fraction(arb_to_fmpq(p.lower())), to_fraction(arb_to_fmpq(p.upper())))
+            for p in points]
     out = [simplest_between(None, ends[0][0])]
     out += [simplest_between(lo_hi[1], nxt[0]) for lo_hi, nxt in zip(ends, ends[1:],
                                                                      strict=False)]
@@ -193,8 +194,6 @@ def separators(points: list[arb]) -> list[Fraction]:
     return out
 
 
-def _frac(q: fmpq) -> Fraction:
-    return Fraction(int(q.p), int(q.q))
 
 
 # ---------------------------------------------------------------------------------
@@ -219,10 +218,10 @@ def exact_joins(cad, base, i: int, brackets, memo: dict | None = None
         return None
     if points == WALL:
         return []
-    seps = [fmpq(s.numerator, s.denominator) for s in separators(points)]
+    seps = [to_fmpq(s) for s in separators(points)]
     for round_ in range(6):
         a, b = brackets(base, i, round_)
-        if all(segment_is_free(cad, (a, _frac(s)), 0, a, b) for s in seps):
+        if all(segment_is_free(cad, (a, to_fraction(s)), 0, a, b) for s in seps):
             left, right = (fiber(cad.levels, cad.variables, (x,)) for x in (a, b))
             return [(sum(1 for r in left if r.compare(s) < 0),
                      sum(1 for r in right if r.compare(s) < 0)) for s in seps]

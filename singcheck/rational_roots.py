@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from fractions import Fraction
 
 from flint import arb, arb_poly, fmpq, fmpq_poly, fmpz_poly
 
@@ -27,6 +28,17 @@ def exact_tolerance(x: float) -> fmpq:
         return fmpq(1, 2**1000)
     num, den = x.as_integer_ratio()
     return fmpq(num, den)
+
+
+def to_fraction(q: fmpq) -> Fraction:
+    """An exact FLINT rational as a Python Fraction."""
+    return Fraction(int(q.p), int(q.q))
+
+
+def to_fmpq(x: Fraction | int) -> fmpq:
+    """An exact Python rational (Fraction or int) as a FLINT rational."""
+    x = Fraction(x)
+    return fmpq(x.numerator, x.denominator)
 
 
 def rational_ball(lo: fmpq, hi: fmpq) -> arb:

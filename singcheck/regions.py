@@ -25,9 +25,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-from flint import fmpq, fmpq_poly
+from flint import fmpq_poly
 
 from singcheck.cad import Cell, OpenCAD, as_univariate, fiber, sector_samples, separated_roots
+from singcheck.elimination import constant_value
+from singcheck.rational_roots import to_fmpq, to_fraction
 from singcheck.solution_counts import roots_within
 
 _ROUNDS = 3
@@ -70,17 +72,13 @@ class _UnionFind:
             self.parent[max(ra, rb)] = min(ra, rb)
 
 
-def _q(x: Fraction) -> fmpq:
-    return fmpq(x.numerator, x.denominator)
-
-
 def factor_signs(cad: OpenCAD, point) -> tuple[int, ...]:
     """The exact sign of every factor of the variety at a rational point."""
-    values = {v: _q(Fraction(x)) for v, x in zip(cad.variables, point, strict=True)}
+    values = {v: to_fmpq(Fraction(x)) for v, x in zip(cad.variables, point, strict=True)}
     out = []
     for f in cad.factors:
         value = f.subs(values)
-        c = value.leading_coefficient() if not value.is_zero() else fmpq(0)
+        c = constant_value(value)
         out.append((c > 0) - (c < 0))
     return tuple(out)
 
@@ -92,7 +90,7 @@ def no_root_between(q: fmpq_poly, a: Fraction, b: Fraction) -> bool:
     (1+u)^d · q((a + b·u)/(1+u)), whose positive roots are the roots of q in (a, b)
     (Descartes).  Otherwise the roots are isolated and compared exactly.
     """
-    qa, qb = _q(a), _q(b)
+    qa, qb = to_fmpq(a), to_fmpq(b)
     va, vb = q(qa), q(qb)
     if va == 0 or vb == 0 or (va > 0) != (vb > 0):  # a root at an end, or a sign change
         return False
@@ -116,7 +114,7 @@ def segment_is_free(cad: OpenCAD, point: tuple[Fraction, ...], axis: int,
                     a: Fraction, b: Fraction) -> bool:
     """True when no factor of the variety vanishes on the segment that runs along
     ``axis`` from a to b through ``point`` (whose ``axis`` coordinate is ignored): exact."""
-    values = {v: _q(x) for i, (v, x) in enumerate(zip(cad.variables, point, strict=True))
+    values = {v: to_fmpq(x) for i, (v, x) in enumerate(zip(cad.variables, point, strict=True))
               if i != axis}
     for f in cad.factors:
         q = as_univariate(f.subs(values), axis)
@@ -129,7 +127,7 @@ def segment_is_free(cad: OpenCAD, point: tuple[Fraction, ...], axis: int,
 
 def _locate(roots, y0: Fraction) -> int | None:
     """The sector index of y₀ among separated roots; None when y₀ is one of them."""
-    q = _q(y0)
+    q = to_fmpq(y0)
     relations = [r.compare(q) for r in roots]
     if 0 in relations:
         return None
@@ -142,11 +140,10 @@ def _brackets(base, i: int, round_: int) -> tuple[Fraction, Fraction]:
     if r.lo != r.hi and round_:
         r.bisect_to((r.hi - r.lo) / 2 ** (8 * round_))
     if r.lo != r.hi:  # (bisection may have met the root exactly: then it is a point)
-        return Fraction(int(r.lo.p), int(r.lo.q)), Fraction(int(r.hi.p), int(r.hi.q))
-    alpha = Fraction(int(r.lo.p), int(r.lo.q))
-    left = Fraction(int(base[i - 1].hi.p), int(base[i - 1].hi.q)) if i else alpha - 1
-    right = Fraction(int(base[i + 1].lo.p), int(base[i + 1].lo.q)) \
-        if i + 1 < len(base) else alpha + 1
+        return to_fraction(r.lo), to_fraction(r.hi)
+    alpha = to_fraction(r.lo)
+    left = to_fraction(base[i - 1].hi) if i else alpha - 1
+    right = to_fraction(base[i + 1].lo) if i + 1 < len(base) else alpha + 1
     delta = min(alpha - left, right - alpha) / 2 ** (1 + 8 * round_)
     return alpha - delta, alpha + delta
 

@@ -39,6 +39,7 @@ from singcheck.rational_roots import (
     bits_for,
     exact_tolerance,
     real_roots_exact,
+    to_fraction,
 )
 from singcheck.trig import LinearInPi, TimeRange, reduce_trig, uses_t, uses_trig
 
@@ -144,18 +145,13 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
             rr.bisect_to(exact_tolerance(tol))
             return rr.ball()
 
-        exact = LinearInPi(_fraction(rr.lo)) if rr.lo == rr.hi else None
+        exact = LinearInPi(to_fraction(rr.lo)) if rr.lo == rr.hi else None
         where, t = locate_root(make, exact, interval, tolerance)
         if where is None:
             undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
         elif where:
             roots.append(RealRoot(make(tolerance), mult, make))
     return RootIsolation(tuple(roots), tuple(undecided), EXACT)
-
-
-def _fraction(q: fmpq):
-
-    return Fraction(int(q.p), int(q.q))
 
 
 def _half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:

@@ -17,19 +17,15 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from fractions import Fraction
 
 from flint import fmpq, fmpq_poly
 
 from singcheck.cad import separated_roots
+from singcheck.elimination import constant_value
 from singcheck.model import RobotModel, leg_coefficients
+from singcheck.rational_roots import to_fmpq
 
 _COORDINATE_CHANGES = ((), (1,), (1, -2), (3, 1, -1), (2, -3, 5, 1))
-
-
-def _fmpq(q) -> fmpq:
-    q = Fraction(q)
-    return fmpq(q.numerator, q.denominator)
 
 
 def roots_within(p: fmpq_poly, limits: tuple | None) -> int:
@@ -38,17 +34,17 @@ def roots_within(p: fmpq_poly, limits: tuple | None) -> int:
     roots = separated_roots(p)
     if limits is None:
         return len(roots)
-    lo, hi = (_fmpq(v) for v in limits)
+    lo, hi = (to_fmpq(v) for v in limits)
     return sum(1 for r in roots if r.compare(lo) >= 0 and r.compare(hi) <= 0)
 
 
 def leg_polynomial_at(model: RobotModel, leg, pose_point) -> fmpq_poly:
     """The leg's polynomial in its joint at a rational pose (exact)."""
-    values = {v: _fmpq(q) for v, q in zip(model.pose, pose_point, strict=True)}
+    values = {v: to_fmpq(q) for v, q in zip(model.pose, pose_point, strict=True)}
     coeffs = []
     for c in leg_coefficients(leg):
         value = c.subs(values) if values else c
-        coeffs.append(value.leading_coefficient() if not value.is_zero() else fmpq(0))
+        coeffs.append(constant_value(value))
     return fmpq_poly(coeffs[::-1])
 
 
@@ -83,7 +79,7 @@ def ik_root_placement(model: RobotModel, pose_point,
         if leg.joint not in limits:
             out.append((0, len(roots), 0))
             continue
-        lo, hi = (_fmpq(v) for v in limits[leg.joint])
+        lo, hi = (to_fmpq(v) for v in limits[leg.joint])
         below = sum(1 for r in roots if r.compare(lo) < 0)
         above = sum(1 for r in roots if r.compare(hi) > 0)
         out.append((below, len(roots) - below - above, above))
@@ -101,7 +97,7 @@ def direct_kinematics_count(model: RobotModel, joint_point) -> DirectCount:
     import sympy
 
     pose = sympy.symbols(model.pose)
-    values = {j: _fmpq(q) for j, q in zip(model.joints, joint_point, strict=True)}
+    values = {j: to_fmpq(q) for j, q in zip(model.joints, joint_point, strict=True)}
     system = [_to_sympy(f.subs(values), pose, model) for f in model.constraints]
     last = pose[-1]
     for change in _COORDINATE_CHANGES:

@@ -177,13 +177,14 @@ def _certify_index(i: int) -> dict:
     from singcheck.report import trajectory_json, workspace_json
 
     projection, specs, tolerance = _WORKER["projection"], _WORKER["specs"], _WORKER["tolerance"]
-    region_cache = _WORKER.get("region_cache")
+    region_cache, notify = _WORKER.get("region_cache"), _WORKER.get("notify")
     path = build_path(projection, specs[i])
     report = certify_path(path, tolerance)
     doc = trajectory_json(report)
     mu_roots = [c.t for c in report.candidates] if report.mu_roots_complete else None
     doc["workspace"] = workspace_json(path_in_workspace(path, tolerance, mu_roots=mu_roots,
-                                                        region_cache=region_cache))
+                                                        region_cache=region_cache,
+                                                        notify=notify))
     if doc["verdict"] == "infeasible" and doc["workspace"]["exit_time_interval"]:
         lo, hi = doc["workspace"]["exit_time_interval"]
         doc["reason"] += f"; the path leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"
@@ -194,7 +195,7 @@ def certify_all(projection, specs, tolerance: float, jobs: int, progress,
                 region_cache=None) -> list[dict]:
     """Certify every trajectory, in ``jobs`` forked processes when there are many."""
     _WORKER.update(projection=projection, specs=specs, tolerance=tolerance,
-                   region_cache=region_cache)
+                   region_cache=region_cache, notify=progress.note)
     n = len(specs)
     results: list[dict | None] = [None] * n
     with progress.bar(n) as advance:

@@ -146,12 +146,14 @@ def _crossings(path: PathModel, tolerance: float,
 
 
 def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: bool = True,
-                      mu_roots: list[arb] | None = None, region_cache=None) -> PathInWorkspace:
+                      mu_roots: list[arb] | None = None, region_cache=None,
+                      notify=None) -> PathInWorkspace:
     """Where the path crosses the discriminant variety, and its IK count in between.
 
     ``mu_roots``: the certified roots of μ already isolated by the certification (every
     one of them, none undecided), so that they are not isolated twice.  ``region_cache``:
-    where region maps are kept between runs (None: computed in this process only).
+    where region maps are kept between runs (None: computed in this process only);
+    ``notify(message)`` is told before a decomposition is computed (it takes seconds).
     """
     crossings, undecided = _crossings(path, tolerance, mu_roots)
     points = gap_points(path.trajectory.range, [c.t for c in crossings])
@@ -163,7 +165,7 @@ def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: boo
                 result.exit_time = crossing.t
                 break
     if name_region and result.one_region:
-        result.region = locate_region(path, region_cache)
+        result.region = locate_region(path, region_cache, notify)
     return result
 
 
@@ -206,7 +208,7 @@ def _subspace(path: PathModel) -> tuple[dict[str, Fraction], tuple[int, ...]]:
     return fixed, tuple(free)
 
 
-def locate_region(path: PathModel, cache=None) -> str | None:
+def locate_region(path: PathModel, cache=None, notify=None) -> str | None:
     """The name of the region holding the path, in the smallest space that holds it
     (a line, a plane or the whole workspace: φ's constant coordinates are fixed); None
     when no rational point of the path could be located in an open cell.  ``cache``: a
@@ -214,7 +216,7 @@ def locate_region(path: PathModel, cache=None) -> str | None:
     fixed, free = _subspace(path)
     if not free:
         return None
-    regions, left_out = _region_map(path.projection, fixed, len(free), cache)
+    regions, left_out = _region_map(path.projection, fixed, len(free), cache, notify)
     where = "" if not fixed else " " + ", ".join(f"{k} = {v}" for k, v in fixed.items())
     kind = {1: "line", 2: "plane"}.get(len(free), "")
     space = f"the workspace {kind}{where}".replace("  ", " ").rstrip()
@@ -255,7 +257,8 @@ def _rational_points_near(path: PathModel, free: tuple[int, ...], factors):
 _SUBSPACES: dict = {}
 
 
-def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache):
+def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
+                notify=None):
     """The region map of the subspace where ``fixed`` holds and the surfaces left out
     (``--surfaces auto``): from this process's memo, else the disk cache, else computed
     (then stored).  A batch of paths in one plane shares it."""
@@ -269,6 +272,10 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache):
         key = cache.key([c.polynomial for c in components], fixed) if cache else None
         regions = cache.load(key) if cache else None
         if regions is None:
+            if notify:
+                where = ", ".join(f"{k} = {v}" for k, v in fixed.items()) or "in 3-D"
+                notify(f"decomposing the workspace ({where}) into regions, once"
+                       + (" (then kept in the cache)" if cache else ""))
             regions = RegionMap.of(analyse(WORKSPACE, projection.model, components, fixed))
             if cache:
                 cache.store(key, regions)

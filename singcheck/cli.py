@@ -338,15 +338,13 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> N
                 click.echo(str(path))
         if not trajectories:
             return
-        from singcheck.cache import CachedBackend, EliminationCache
-        from singcheck.cas import get_backend
         from singcheck.model import build_model
         from singcheck.projection import project_robot
         from singcheck.spec import load_robot, load_trajectory
 
         spec = load_robot(robot)
         specs = [load_trajectory(p, spec) for p in trajectories]
-        engine = CachedBackend(get_backend(backend), EliminationCache())
+        engine = elimination_engine(backend, 600, False, progress)
         projection = project_robot(build_model(spec), engine)
         if fmt == "html":
             click.echo(str(_plot_html(projection, specs, out_dir)))

@@ -321,7 +321,8 @@ Examples:
               help="Also draw the regions of that space coloured by their number of "
               "solutions (a plane: a planar robot, or --slice on a spatial one).")
 @click.option("--slice", "slices", multiple=True, metavar="AXIS=VALUE",
-              help="For --regions: fix an axis to an exact rational (repeatable).")
+              help="For --regions: fix an axis to an exact rational (repeatable); a pose "
+              "axis slices the workspace, a joint the joint space.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
@@ -333,8 +334,8 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> N
     with exit_codes():
         if not trajectories and not spaces:
             raise click.UsageError("give at least one TRAJECTORY, or --regions SPACE")
-        for space in spaces:
-            for path in _plot_regions(space, robot, slices, backend, out_dir, progress):
+        for space, own in _slices_by_space(robot, spaces, slices).items():
+            for path in _plot_regions(space, robot, own, backend, out_dir, progress):
                 click.echo(str(path))
         if not trajectories:
             return
@@ -351,6 +352,29 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> N
             return
         for path in _plot_all(projection, specs, 1e-9, out_dir, progress):
             click.echo(str(path))
+
+
+def _slices_by_space(robot, spaces, slices) -> dict[str, list[str]]:
+    """Each --slice goes to the spaces having its axis (pose axes: the workspace; joints:
+    the joint space); a slice that fits none of the requested spaces is an error."""
+    from singcheck.model import build_model
+    from singcheck.spec import load_robot
+
+    if not spaces:
+        return {}
+    model = build_model(load_robot(robot))
+    axes = {"workspace": model.pose, "jointspace": model.joints}
+    out: dict[str, list[str]] = {space: [] for space in dict.fromkeys(spaces)}
+    for text in slices:
+        axis = text.split("=", 1)[0].strip()
+        owners = [space for space in out if axis in axes[space]]
+        if not owners:
+            names = ", ".join(a for space in out for a in axes[space])
+            raise click.BadParameter(f"{axis} is not an axis of the requested space(s) "
+                                     f"({names})", param_hint="--slice")
+        for space in owners:
+            out[space].append(text)
+    return out
 
 
 def _plot_regions(space, robot, slices, backend, out_dir, progress) -> list:

@@ -372,3 +372,16 @@ def test_planar_robot_workspace_regions():
     four = next(c for c in analysis.cells if c.count == 4)
     assert inverse_kinematics_count(model, four.cell.sample) == 4
     assert inverse_kinematics_count(model, four.cell.sample, use_limits=False) == 4
+
+
+@pytest.mark.slow
+def test_cli_plot_slices_go_to_the_space_owning_their_axis(tmp_path):
+    both = singcheck("plot", str(ROBOTS / "orthoglide.yaml"), "--regions", "workspace",
+                     "--regions", "jointspace", "--slice", "z=1", "--slice", "rho3=2",
+                     "--out", str(tmp_path), "--backend", "flint", "-q")
+    assert both.returncode == 0, both.stderr
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == [
+        "orthoglide-jointspace-rho3=2.png", "orthoglide-workspace-z=1.png"]
+    wrong = singcheck("plot", str(ROBOTS / "orthoglide.yaml"), "--regions", "workspace",
+                      "--slice", "rho3=2", "--out", str(tmp_path), "--backend", "flint", "-q")
+    assert wrong.returncode == 2 and "rho3 is not an axis" in wrong.stderr

@@ -182,11 +182,44 @@ def projection_levels(polys: list[fmpq_mpoly]) -> tuple[tuple[fmpq_mpoly, ...], 
 
 
 def fiber(levels, variables, point: tuple[Fraction, ...]) -> list[RationalRoot]:
-    """The separated real roots, over ``point``, of the next level's factors."""
+    """The separated real roots, over ``point``, of the next level's factors.
+
+    Each factor's roots are isolated on its own (smaller degrees) and the intervals of
+    different factors are bisected apart.  Where two factors share a root (a point off
+    the open cells, e.g. on a lower section) they never come apart: the squarefree
+    product is isolated instead.
+    """
+    polys = [specialize(p, variables, point) for p in levels[len(point)]]
+    polys = [q for q in polys if q.degree() >= 1]
+    roots = [r for q in polys for r, _ in real_roots_exact(q)]
+    apart = _bisect_apart(roots)
+    if apart is not None:
+        return apart
     product = fmpq_poly([1])
-    for p in levels[len(point)]:
-        product *= specialize(p, variables, point)
+    for q in polys:
+        product *= q
     return separated_roots(product)
+
+
+def _bisect_apart(roots: list[RationalRoot], rounds: int = 60) -> list[RationalRoot] | None:
+    """The roots sorted with pairwise disjoint closed intervals, or None when two of
+    them could not be separated (they may be one root of two factors)."""
+    for _ in range(rounds):
+        roots.sort(key=lambda r: r.lo)
+        clash = set()
+        for i, r in enumerate(roots):
+            for s in roots[i + 1:]:
+                if s.lo > r.hi:
+                    break
+                clash.update((id(r), id(s)))
+                if r.lo == r.hi and s.lo == s.hi:
+                    return None  # the same rational root of two factors
+        if not clash:
+            return roots
+        for r in roots:
+            if id(r) in clash and r.lo != r.hi:
+                r.bisect_to((r.hi - r.lo) / 2)
+    return None
 
 
 def lift(levels, variables, point: tuple[Fraction, ...]) -> list[Fraction]:

@@ -173,13 +173,17 @@ def connect_regions(cad: OpenCAD, invariants: dict | None = None) -> Regions:
     fibres_over_alpha: dict = {}
     for level in range(len(cad.variables) - 1):
         prefixes = {(c.index[:level], c.sample[:level]) for c in cad.cells}
+        over: dict = {}  # the cells over each sector of this level
+        for c in cad.cells:
+            over.setdefault(c.index[:level + 1], set()).add(c.index)
         for prefix_index, prefix_sample in sorted(prefixes):
             base = fibre(prefix_sample)
             for i in range(len(base)):
                 if exact and _join_exactly(cad, base, i, indices, uf, fibres_over_alpha):
                     continue
                 exact = False
-                _join_across(cad, fibre, indices, prefix_index, prefix_sample, base, i, uf)
+                _join_across(cad, fibre, indices, over, prefix_index, prefix_sample, base, i,
+                             uf)
     regions = _regions_of(cad, uf, invariants or {})
     if exact:  # every adjacency decided: the regions are the components
         return Regions(regions.regions, True, "")
@@ -241,13 +245,13 @@ def _slabs(walls, sample) -> tuple[int | None, ...]:
     return tuple(_locate(roots, sample[axis]) for axis, roots in walls)
 
 
-def _join_across(cad: OpenCAD, fibre, indices: set, prefix_index: tuple,
+def _join_across(cad: OpenCAD, fibre, indices: set, over: dict, prefix_index: tuple,
                  prefix_sample: tuple, base, i: int, uf: _UnionFind) -> None:
     """Join the cells over sector i and sector i+1 of ``base`` (the fibre over the prefix
     cell's sample at the next level) through free segments across its root α_i."""
     level = len(prefix_sample)
     # the cells on either side that still have to be joined across α_i
-    waiting = [{c for c in indices if c[:level + 1] == prefix_index + (j,)} for j in (i, i + 1)]
+    waiting = [set(over.get(prefix_index + (j,), ())) for j in (i, i + 1)]
     for round_ in range(_ROUNDS):
         a, b = _brackets(base, i, round_)
         for rest in _candidate_rests(cad, fibre, prefix_sample, a, b):

@@ -1,9 +1,11 @@
 """make bench: singcheck against the sampling check, same inputs, one process.
 
 Prints tables (contender, median, min, max, ratio to singcheck, found the true
-singularities?) and writes bench/results.json.  The sampling contender is what people
-use today: evaluate det A along the working mode at N points of the path (vectorised
-NumPy) and look for sign changes.  It is fast, and it can miss singularities.
+singularities?) and writes bench/results.json.  On each path singcheck and the sampling
+scans run round-robin, so a noisy spell of the machine falls on all of them alike.  The
+sampling contender is what people use today: evaluate det A along the working mode at N
+points of the path (vectorised NumPy) and look for sign changes.  It is fast, and it can
+miss singularities.
 """
 
 from __future__ import annotations
@@ -42,6 +44,18 @@ def times(fn, repeat: int = REPEAT) -> list[float]:
         start = time.perf_counter()
         fn()
         out.append(time.perf_counter() - start)
+    return out
+
+
+def interleaved(fns: list, repeat: int = REPEAT) -> list[list[float]]:
+    """Times of several contenders run round-robin (one run of each per round), so that
+    a noisy spell of the machine falls on all of them alike; one list per contender."""
+    out: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeat):
+        for fn, ts in zip(fns, out, strict=True):
+            start = time.perf_counter()
+            fn()
+            ts.append(time.perf_counter() - start)
     return out
 
 
@@ -105,16 +119,18 @@ def compare(robot: str, trajectory: str) -> list[dict]:
     report = certify_path(build_path(projection, spec))
     mode = next(m.label for m in report.modes if m.feasible)
     truth = truth_of(report, mode)
-    rows = [{"case": f"{robot}/{trajectory}", "contender": "singcheck (certified)",
-             **stats(times(lambda: certify_path(build_path(projection, spec)))),
-             "found": True, "verdict": report.verdict, "singular_times": truth}]
     scan = SamplingScan(build_path(projection, spec), mode)
     width = scan.range[1] - scan.range[0]
-    for n in (10**3, 10**4, 10**5):
+    sizes = (10**3, 10**4, 10**5)
+    timings = interleaved([lambda: certify_path(build_path(projection, spec)),
+                           *[lambda n=n: scan(n) for n in sizes]])
+    rows = [{"case": f"{robot}/{trajectory}", "contender": "singcheck (certified)",
+             **stats(timings[0]), "found": True, "verdict": report.verdict,
+             "singular_times": truth}]
+    for n, ts in zip(sizes, timings[1:], strict=True):
         found = scan(n)
         rows.append({"case": f"{robot}/{trajectory}", "contender": f"NumPy sampling, {n:.0e}",
-                     **stats(times(lambda n=n: scan(n))),
-                     "found": found_all(found, truth, 2 * width / (n - 1)),
+                     **stats(ts), "found": found_all(found, truth, 2 * width / (n - 1)),
                      "sign_changes": len(found)})
     if (robot, trajectory) == ("orthoglide", "heart1"):
         rows += backend_rows(projection.model, spec, truth)

@@ -277,12 +277,17 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
     return RootIsolation(tuple(roots), tuple(undecided), HALF_ANGLE)
 
 
-def _periods(t0: arb, interval: TimeRange) -> range:
-    """Every k for which t0 + 2kπ may meet the range (a superset)."""
+def _periods(t0: arb, interval: TimeRange) -> list[int]:
+    """Every k for which t0 + 2kπ may meet the range (a superset: a k is dropped only
+    when the float estimate misses the range by far more than rounding and the ball's
+    radius could account for)."""
     two_pi = 2 * math.pi
-    lo = math.floor((float(interval.start) - float(t0.mid())) / two_pi) - 1
-    hi = math.ceil((float(interval.end) - float(t0.mid())) / two_pi) + 1
-    return range(lo, hi + 1)
+    x, start, end = float(t0.mid()), float(interval.start), float(interval.end)
+    margin = float(t0.rad()) + 1e-6 * (1 + abs(x) + abs(start) + abs(end))
+    lo = math.floor((start - x) / two_pi) - 1
+    hi = math.ceil((end - x) / two_pi) + 1
+    return [k for k in range(lo, hi + 1)
+            if start - margin <= x + two_pi * k <= end + margin]
 
 
 def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,

@@ -202,6 +202,10 @@ def certify_all(projection, specs, tolerance: float, jobs: int, progress,
         if jobs > 1 and n > 4:
             import multiprocessing
 
+            from singcheck.path_regions import prepare_region_maps
+
+            prepare_region_maps(projection, specs, region_cache, progress.note)
+
             with multiprocessing.get_context("fork").Pool(jobs) as pool:
                 for i, result in enumerate(pool.imap(_certify_index, range(n),
                                                      chunksize=max(1, n // (jobs * 16)))):

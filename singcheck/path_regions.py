@@ -208,6 +208,23 @@ def _subspace(path: PathModel) -> tuple[dict[str, Fraction], tuple[int, ...]]:
     return fixed, tuple(free)
 
 
+def prepare_region_maps(projection, specs, cache=None, notify=None) -> None:
+    """Compute, in this process, the region map of every subspace that several of the
+    trajectories lie in (forked workers then inherit it instead of each computing it)."""
+    from collections import Counter
+
+    pose = projection.model.pose
+    shared = Counter()
+    for spec in specs:
+        polys = [spec.pose[v] for v in pose]
+        fixed = tuple((v, to_fraction(constant_value(p)))
+                      for v, p in zip(pose, polys, strict=True) if p.is_constant())
+        shared[fixed] += 1
+    for fixed, n in shared.items():
+        if n > 1 and len(fixed) < len(pose):
+            _region_map(projection, dict(fixed), len(pose) - len(fixed), cache, notify)
+
+
 def locate_region(path: PathModel, cache=None, notify=None) -> str | None:
     """The name of the region holding the path, in the smallest space that holds it
     (a line, a plane or the whole workspace: φ's constant coordinates are fixed); None

@@ -385,3 +385,20 @@ def test_cli_plot_slices_go_to_the_space_owning_their_axis(tmp_path):
     wrong = singcheck("plot", str(ROBOTS / "orthoglide.yaml"), "--regions", "workspace",
                       "--slice", "rho3=2", "--out", str(tmp_path), "--backend", "flint", "-q")
     assert wrong.returncode == 2 and "rho3 is not an axis" in wrong.stderr
+
+
+def test_a_plane_shared_by_several_paths_is_decomposed_once_up_front(orthoglide_projection):
+    from singcheck import path_regions
+    from singcheck.spec import load_trajectory
+
+    specs = [load_trajectory(TRAJECTORIES / f"{n}.yaml", orthoglide_projection.model.spec)
+             for n in ("heart1", "heart2", "helix")]
+    notes: list[str] = []
+    path_regions._SUBSPACES.clear()
+    path_regions.prepare_region_maps(orthoglide_projection, specs, notify=notes.append)
+    # the hearts share z = 1; the helix is alone in 3-D and left to its own run
+    assert notes == ["decomposing the workspace (z = 1) into regions, once"]
+    heart2 = path_regions.path_in_workspace(_path(orthoglide_projection, "heart2"),
+                                            notify=notes.append)
+    assert heart2.region.startswith("R") and len(notes) == 1  # reused, not recomputed
+    path_regions._SUBSPACES.clear()

@@ -106,6 +106,12 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     modes are singular, whether each candidate is real or spurious for the feasible
     mode(s), the working modes with their feasibility, and the verdict:
     singularity-free, singular, infeasible or unknown.
+
+    It also places the path in the workspace: the certified times where it crosses
+    the serial-singularity, ξ and joint-limit surfaces, the number of IK solutions
+    inside the limits between them, the region holding the whole path when it stays in
+    one (its decomposition is computed once and cached), and the certified time at which
+    a path leaves the workspace.
     """
     progress = Progress(quiet)
     with exit_codes():

@@ -52,6 +52,31 @@ def _digest(*parts: str) -> str:
     return h.hexdigest()
 
 
+def read_entry(path: Path, fmt: str, key: str) -> dict:
+    """The payload of a cache entry written by :func:`write_entry`.
+
+    Raises ``ValueError`` when its format, key or checksum disagree (a damaged or foreign
+    file); ``OSError`` (``FileNotFoundError`` for a miss) and JSON errors pass through.
+    """
+    entry = json.loads(path.read_text(encoding="utf-8"))
+    payload = entry["payload"]
+    if entry.get("format") != fmt or entry.get("key") != key or \
+            entry.get("sha256") != _digest(json.dumps(payload, sort_keys=True)):
+        raise ValueError("checksum or key mismatch")
+    return payload
+
+
+def write_entry(path: Path, fmt: str, key: str, payload: dict) -> None:
+    """Write a cache entry carrying its payload's checksum, atomically; a cache that
+    cannot be written is only slower, never wrong, so write errors are ignored."""
+    entry = {"format": fmt, "key": key, "payload": payload,
+             "sha256": _digest(json.dumps(payload, sort_keys=True))}
+    try:
+        write_atomically(path, json.dumps(entry))
+    except OSError:
+        return
+
+
 @dataclass
 class CacheStats:
     hits: int = 0
@@ -71,13 +96,8 @@ class EliminationCache:
         return self.directory / key[:2] / f"{key}.json"
 
     def load(self, key: str, request: EliminationRequest) -> EliminationResult | None:
-        path = self._path(key)
         try:
-            entry = json.loads(path.read_text(encoding="utf-8"))
-            payload = entry["payload"]
-            if entry.get("format") != FORMAT or entry.get("key") != key or \
-                    entry.get("sha256") != _digest(json.dumps(payload, sort_keys=True)):
-                raise ValueError("checksum or key mismatch")
+            payload = read_entry(self._path(key), FORMAT, key)
             polys = tuple(restrict(parse_polynomial(text, request.context),
                                    request.kept_context())
                           for text in payload["polynomials"])
@@ -101,12 +121,7 @@ class EliminationCache:
             # in the request's full ring, so they parse back without ambiguity
             "polynomials": [format_polynomial(_widen(p, ctx)) for p in result.polynomials],
         }
-        entry = {"format": FORMAT, "key": key, "payload": payload,
-                 "sha256": _digest(json.dumps(payload, sort_keys=True))}
-        try:
-            write_atomically(self._path(key), json.dumps(entry))
-        except OSError:
-            return  # a cache that cannot be written is only slower, never wrong
+        write_entry(self._path(key), FORMAT, key, payload)
 
     def entries(self) -> list[Path]:
         if not self.directory.exists():

@@ -15,8 +15,6 @@ SHA-256 of its payload: a damaged entry is ignored and recomputed, never trusted
 
 from __future__ import annotations
 
-import hashlib
-import json
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
@@ -79,10 +77,6 @@ class RegionMap:
                    {tuple(int(i) for i in index): int(n) for index, n in payload["cells"]})
 
 
-def _digest(text: str) -> str:
-    return hashlib.sha256(text.encode("utf-8")).hexdigest()
-
-
 class RegionMapCache:
     """Region maps on disk, one JSON file per (variety, slice)."""
 
@@ -93,31 +87,23 @@ class RegionMapCache:
 
     @staticmethod
     def key(polynomials, fixed: dict[str, Fraction]) -> str:
-        parts = [REGIONS_VERSION, *(f"{k}={v}" for k, v in sorted(fixed.items())),
-                 *sorted(format_polynomial(p) for p in polynomials)]
-        return _digest("\n".join(parts))
+        from singcheck.cache import _digest
+
+        return _digest(REGIONS_VERSION, *(f"{k}={v}" for k, v in sorted(fixed.items())),
+                       *sorted(format_polynomial(p) for p in polynomials))
 
     def _path(self, key: str) -> Path:
         return self.directory / f"{key}.json"
 
     def load(self, key: str) -> RegionMap | None:
+        from singcheck.cache import read_entry
+
         try:
-            entry = json.loads(self._path(key).read_text(encoding="utf-8"))
-            payload = entry["payload"]
-            if entry.get("format") != FORMAT or entry.get("key") != key or \
-                    entry.get("sha256") != _digest(json.dumps(payload, sort_keys=True)):
-                return None
-            return RegionMap.from_payload(payload)
+            return RegionMap.from_payload(read_entry(self._path(key), FORMAT, key))
         except (OSError, ValueError, KeyError, TypeError, PolynomialSyntaxError):
             return None
 
     def store(self, key: str, region_map: RegionMap) -> None:
-        from singcheck.atomic import write_atomically
+        from singcheck.cache import write_entry
 
-        payload = region_map.payload()
-        entry = {"format": FORMAT, "key": key, "payload": payload,
-                 "sha256": _digest(json.dumps(payload, sort_keys=True))}
-        try:
-            write_atomically(self._path(key), json.dumps(entry))
-        except OSError:
-            return  # a cache that cannot be written is only slower, never wrong
+        write_entry(self._path(key), FORMAT, key, region_map.payload())

@@ -222,6 +222,30 @@ def _bisect_apart(roots: list[RationalRoot], rounds: int = 60) -> list[RationalR
     return None
 
 
+def sector_of(roots: list[RationalRoot], y0: Fraction) -> int | None:
+    """The index of the sector holding the rational y₀ among separated roots (exact
+    comparisons); None when y₀ is one of the roots."""
+    q = fmpq(y0.numerator, y0.denominator)
+    relations = [r.compare(q) for r in roots]
+    if 0 in relations:
+        return None
+    return sum(1 for r in relations if r < 0)
+
+
+def cell_index_of(fibre, point: tuple[Fraction, ...], head: tuple[int, ...] = (),
+                  known: int = 0) -> tuple[int, ...] | None:
+    """The index of the open cell holding a rational point, level by level (``fibre``
+    gives the separated roots over a point); the first ``known`` coordinates are known to
+    lie in the sectors ``head``.  None when the point lies on a root (on no open cell)."""
+    index = list(head)
+    for k in range(known, len(point)):
+        sector = sector_of(fibre(tuple(point[:k])), point[k])
+        if sector is None:
+            return None
+        index.append(sector)
+    return tuple(index)
+
+
 def lift(levels, variables, point: tuple[Fraction, ...]) -> list[Fraction]:
     """Sample coordinates of the sectors over ``point`` at the next level."""
     return sector_samples(fiber(levels, variables, point))

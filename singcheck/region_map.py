@@ -19,9 +19,9 @@ from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
-from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
+from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
-from singcheck.cad import fiber
+from singcheck.cad import cell_index_of, fiber
 from singcheck.cas.polytext import PolynomialSyntaxError, format_polynomial, parse_polynomial
 
 #: Bump when the decomposition or the joining of regions changes what a number means.
@@ -42,20 +42,9 @@ class RegionMap:
         numbers = {c.index: r.number for r in analysis.regions.regions for c in r.cells}
         return cls(cad.variables, cad.levels, cad.factors, numbers)
 
-    def cell_index(self, point: list[Fraction]) -> tuple[int, ...] | None:
-        """The index of the open cell holding a rational point (None on a root)."""
-        index = []
-        for k in range(len(point)):
-            roots = fiber(self.levels, self.variables, tuple(point[:k]))
-            q = fmpq(point[k].numerator, point[k].denominator)
-            relations = [r.compare(q) for r in roots]
-            if 0 in relations:
-                return None
-            index.append(sum(1 for r in relations if r < 0))
-        return tuple(index)
-
     def region_at(self, point: list[Fraction]) -> int | None:
-        index = self.cell_index(point)
+        """The region of the open cell holding a rational point (None on a root)."""
+        index = cell_index_of(lambda p: fiber(self.levels, self.variables, p), tuple(point))
         return None if index is None else self.numbers.get(index)
 
     # -- storage ------------------------------------------------------------------

@@ -27,7 +27,16 @@ from fractions import Fraction
 
 from flint import fmpq_poly
 
-from singcheck.cad import Cell, OpenCAD, as_univariate, fiber, sector_samples, separated_roots
+from singcheck.cad import (
+    Cell,
+    OpenCAD,
+    as_univariate,
+    cell_index_of,
+    fiber,
+    sector_of,
+    sector_samples,
+    separated_roots,
+)
 from singcheck.elimination import constant_value
 from singcheck.rational_roots import to_fmpq, to_fraction
 from singcheck.solution_counts import roots_within
@@ -123,15 +132,6 @@ def segment_is_free(cad: OpenCAD, point: tuple[Fraction, ...], axis: int,
         if q.degree() >= 1 and not no_root_between(q, a, b):
             return False
     return True
-
-
-def _locate(roots, y0: Fraction) -> int | None:
-    """The sector index of y₀ among separated roots; None when y₀ is one of them."""
-    q = to_fmpq(y0)
-    relations = [r.compare(q) for r in roots]
-    if 0 in relations:
-        return None
-    return sum(1 for r in relations if r < 0)
 
 
 def _brackets(base, i: int, round_: int) -> tuple[Fraction, Fraction]:
@@ -242,7 +242,7 @@ def _walls(cad: OpenCAD) -> list[tuple[int, list]]:
 
 def _slabs(walls, sample) -> tuple[int | None, ...]:
     """For each wall, how many of its hyperplanes lie below the sample (exact)."""
-    return tuple(_locate(roots, sample[axis]) for axis, roots in walls)
+    return tuple(sector_of(roots, sample[axis]) for axis, roots in walls)
 
 
 def _join_across(cad: OpenCAD, fibre, indices: set, over: dict, prefix_index: tuple,
@@ -258,8 +258,10 @@ def _join_across(cad: OpenCAD, fibre, indices: set, over: dict, prefix_index: tu
             point = (*prefix_sample, a, *rest)
             if not segment_is_free(cad, point, level, a, b):
                 continue
-            lo = _index_of(fibre, prefix_index + (i,), prefix_sample + (a,), rest)
-            hi = _index_of(fibre, prefix_index + (i + 1,), prefix_sample + (b,), rest)
+            known = level + 1  # the ends' sectors up to the crossing level are known
+            lo = cell_index_of(fibre, point, prefix_index + (i,), known)
+            hi = cell_index_of(fibre, (*prefix_sample, b, *rest), prefix_index + (i + 1,),
+                               known)
             if lo in indices and hi in indices:
                 uf.union(lo, hi)
                 waiting[0].discard(lo)
@@ -278,20 +280,7 @@ def _candidate_rests(cad: OpenCAD, fibre, prefix: tuple, a: Fraction, b: Fractio
             return
         fibres = [fibre((*prefix, end, *rest)) for end in (a, b)]
         for y0 in sorted(set(sector_samples(fibres[0])) | set(sector_samples(fibres[1]))):
-            if all(_locate(f, y0) is not None for f in fibres):
+            if all(sector_of(f, y0) is not None for f in fibres):
                 yield from extend((*rest, y0))
 
     yield from extend(())
-
-
-def _index_of(fibre, head: tuple, point: tuple, rest: tuple) -> tuple | None:
-    """The cell index of ``point + rest`` whose first levels are known to be ``head``."""
-    index = list(head)
-    current = tuple(point)
-    for y0 in rest:
-        k = _locate(fibre(current), y0)
-        if k is None:
-            return None
-        index.append(k)
-        current += (y0,)
-    return tuple(index)

@@ -196,11 +196,10 @@ def _rational_time_points(path: PathModel):
             yield values
 
 
-def _subspace(path: PathModel) -> tuple[dict[str, Fraction], tuple[int, ...]]:
+def _subspace(pose: tuple[str, ...], phi) -> tuple[dict[str, Fraction], tuple[int, ...]]:
     """The fixed pose coordinates (rational constants of φ) and the free axes' indices."""
-    pose = path.projection.model.pose
     fixed, free = {}, []
-    for i, (name, p) in enumerate(zip(pose, path.phi, strict=True)):
+    for i, (name, p) in enumerate(zip(pose, phi, strict=True)):
         if p.is_constant():
             fixed[name] = to_fraction(constant_value(p))
         else:
@@ -216,13 +215,11 @@ def prepare_region_maps(projection, specs, cache=None, notify=None) -> None:
     pose = projection.model.pose
     shared = Counter()
     for spec in specs:
-        polys = [spec.pose[v] for v in pose]
-        fixed = tuple((v, to_fraction(constant_value(p)))
-                      for v, p in zip(pose, polys, strict=True) if p.is_constant())
-        shared[fixed] += 1
-    for fixed, n in shared.items():
-        if n > 1 and len(fixed) < len(pose):
-            _region_map(projection, dict(fixed), len(pose) - len(fixed), cache, notify)
+        fixed, free = _subspace(pose, [spec.pose[v] for v in pose])
+        shared[tuple(fixed.items()), len(free)] += 1
+    for (fixed, free), n in shared.items():
+        if n > 1 and free:
+            _region_map(projection, dict(fixed), free, cache, notify)
 
 
 def locate_region(path: PathModel, cache=None, notify=None) -> str | None:
@@ -230,7 +227,7 @@ def locate_region(path: PathModel, cache=None, notify=None) -> str | None:
     (a line, a plane or the whole workspace: φ's constant coordinates are fixed); None
     when no rational point of the path could be located in an open cell.  ``cache``: a
     :class:`~singcheck.region_map.RegionMapCache`, or None to compute without storing."""
-    fixed, free = _subspace(path)
+    fixed, free = _subspace(path.projection.model.pose, path.phi)
     if not free:
         return None
     regions, left_out = _region_map(path.projection, fixed, len(free), cache, notify)
@@ -266,7 +263,8 @@ def _rational_points_near(path: PathModel, free: tuple[int, ...], factors):
         t = lo + (hi - lo) * k / 8
         with working_precision(128):
             t0 = t.mid()
-            box = [path.pose_at(t0)[i] for i in free]
+            pose = path.pose_at(t0)
+            box = [pose[i] for i in free]
             if all(evaluate(f, box).contains(0) is False for f in factors):
                 yield [to_fraction(arb_to_fmpq(b.mid())) for b in box]
 

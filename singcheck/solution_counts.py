@@ -16,6 +16,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from flint import fmpq, fmpq_poly
@@ -50,15 +51,13 @@ def leg_polynomial_at(model: RobotModel, leg, pose_point) -> fmpq_poly:
 
 def inverse_kinematics_count(model: RobotModel, pose_point, use_limits: bool = True) -> int:
     """Real IK solutions inside the joint limits (all of them when ``use_limits`` is
-    False) at a rational pose (exact)."""
-    total = 1
-    limits = model.spec.joint_limits if use_limits else {}
-    for leg in model.legs:
-        total *= roots_within(leg_polynomial_at(model, leg, pose_point),
-                              limits.get(leg.joint))
-        if total == 0:
-            return 0
-    return total
+    False) at a rational pose (exact): the product over legs of their roots inside."""
+    return ik_count(ik_root_placement(model, pose_point, use_limits))
+
+
+def ik_count(placement: tuple[tuple[int, int, int], ...]) -> int:
+    """The IK count from :func:`ik_root_placement`: the product of the legs' roots inside."""
+    return math.prod(inside for _, inside, _ in placement)
 
 
 def ik_root_placement(model: RobotModel, pose_point,

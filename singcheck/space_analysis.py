@@ -22,7 +22,6 @@ The paper's second half, exactly:
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -35,7 +34,7 @@ from singcheck.errors import SingcheckError
 from singcheck.model import RobotModel
 from singcheck.projection import RobotProjection, joint_space_singularities
 from singcheck.regions import Region, Regions, connect_regions, factor_signs
-from singcheck.solution_counts import direct_kinematics_count, ik_root_placement
+from singcheck.solution_counts import direct_kinematics_count, ik_count, ik_root_placement
 
 WORKSPACE, JOINTSPACE = "workspace", "jointspace"
 SERIAL, PARALLEL, LIMIT = "serial singularity", "parallel singularity", "joint limit"
@@ -227,8 +226,7 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
         point = _point(axes, free, cell.sample, fixed)
         if space == WORKSPACE:
             placement = ik_root_placement(model, point, use_limits)
-            count = math.prod(inside for _, inside, _ in placement)
-            cells.append(CellCount(cell, count, "", True))
+            cells.append(CellCount(cell, ik_count(placement), "", True))
             invariants[cell.index] = placement
         else:
             dk = direct_kinematics_count(model, point)

@@ -31,9 +31,9 @@ from fractions import Fraction
 
 from flint import acb, acb_poly, arb, arb_poly, fmpq, fmpq_poly
 
-from singcheck.cad import fiber, simplest_between
+from singcheck.cad import fiber, sector_of, simplest_between
 from singcheck.intervals import working_precision
-from singcheck.rational_roots import RationalRoot, arb_to_fmpq, to_fmpq, to_fraction
+from singcheck.rational_roots import RationalRoot, arb_to_fmpq, to_fraction
 
 WALL = "wall"  # the line x = α lies in the variety
 
@@ -194,8 +194,6 @@ def separators(points: list[arb]) -> list[Fraction]:
     return out
 
 
-
-
 # ---------------------------------------------------------------------------------
 # adjacency across α
 
@@ -218,11 +216,10 @@ def exact_joins(cad, base, i: int, brackets, memo: dict | None = None
         return None
     if points == WALL:
         return []
-    seps = [to_fmpq(s) for s in separators(points)]
+    seps = separators(points)
     for round_ in range(6):
         a, b = brackets(base, i, round_)
-        if all(segment_is_free(cad, (a, to_fraction(s)), 0, a, b) for s in seps):
+        if all(segment_is_free(cad, (a, s), 0, a, b) for s in seps):
             left, right = (fiber(cad.levels, cad.variables, (x,)) for x in (a, b))
-            return [(sum(1 for r in left if r.compare(s) < 0),
-                     sum(1 for r in right if r.compare(s) < 0)) for s in seps]
+            return [(sector_of(left, s), sector_of(right, s)) for s in seps]
     return None

@@ -161,7 +161,6 @@ def connect_regions(cad: OpenCAD, invariants: dict | None = None) -> Regions:
     indices = {c.index for c in cad.cells}
     for index in indices:
         uf.find(index)
-    # the top level's roots are the variety's own factors: no segment crosses them freely
     memo: dict = {}
 
     def fibre(point: tuple) -> list:
@@ -171,6 +170,7 @@ def connect_regions(cad: OpenCAD, invariants: dict | None = None) -> Regions:
 
     exact = len(cad.variables) == 2  # complete adjacency is known in the plane only
     fibres_over_alpha: dict = {}
+    # the top level's roots are the variety's own factors: no segment crosses them freely
     for level in range(len(cad.variables) - 1):
         prefixes = {(c.index[:level], c.sample[:level]) for c in cad.cells}
         over: dict = {}  # the cells over each sector of this level

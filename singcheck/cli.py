@@ -367,6 +367,7 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> N
 def _slices_by_space(robot, spaces, slices) -> dict[str, list[str]]:
     """Each --slice goes to the spaces having its axis (pose axes: the workspace; joints:
     the joint space); a slice that fits none of the requested spaces is an error."""
+    from singcheck.cli_spaces import parse_slice
     from singcheck.model import build_model
     from singcheck.spec import load_robot
 
@@ -376,7 +377,7 @@ def _slices_by_space(robot, spaces, slices) -> dict[str, list[str]]:
     axes = {"workspace": model.pose, "jointspace": model.joints}
     out: dict[str, list[str]] = {space: [] for space in dict.fromkeys(spaces)}
     for text in slices:
-        axis = text.split("=", 1)[0].strip()
+        axis, _ = parse_slice(text)
         owners = [space for space in out if axis in axes[space]]
         if not owners:
             names = ", ".join(a for space in out for a in axes[space])

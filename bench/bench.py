@@ -27,13 +27,13 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 from generate import write  # noqa: E402
 
-from singcheck.cas import get_backend  # noqa: E402
-from singcheck.certify import certify_path  # noqa: E402
-from singcheck.model import build_model  # noqa: E402
-from singcheck.path import build_path  # noqa: E402
-from singcheck.plots import numpy_polynomial  # noqa: E402
-from singcheck.projection import project_robot  # noqa: E402
-from singcheck.spec import load_robot, load_trajectory  # noqa: E402
+from singcheck.certify.classification import certify_path  # noqa: E402
+from singcheck.certify.path import build_path  # noqa: E402
+from singcheck.elimination.cas import get_backend  # noqa: E402
+from singcheck.elimination.projection import project_robot  # noqa: E402
+from singcheck.model.robot import build_model  # noqa: E402
+from singcheck.report.plots import numpy_polynomial  # noqa: E402
+from singcheck.spec.files import load_robot, load_trajectory  # noqa: E402
 
 REPEAT = int(os.environ.get("BENCH_REPEAT", "15"))
 
@@ -179,7 +179,7 @@ def space_rows() -> list[dict]:
     """Workspace / joint-space analyses (issue 6): decomposition, counts, regions."""
     from fractions import Fraction
 
-    from singcheck.space_analysis import (
+    from singcheck.spaces.analysis import (
         JOINTSPACE,
         WORKSPACE,
         analyse,

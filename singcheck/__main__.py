@@ -1,3 +1,3 @@
-from singcheck.cli import main
+from singcheck.cli.commands import main
 
 main()

@@ -13,16 +13,16 @@ TRAJECTORIES = ROOT / "trajectories"
 
 @pytest.fixture(scope="session")
 def orthoglide():
-    from singcheck.model import build_model
-    from singcheck.spec import load_robot
+    from singcheck.model.robot import build_model
+    from singcheck.spec.files import load_robot
 
     return build_model(load_robot(ROBOTS / "orthoglide.yaml"))
 
 
 @pytest.fixture(scope="session")
 def orthoglide_projection(orthoglide):
-    from singcheck.cas import get_backend
-    from singcheck.projection import project_robot
+    from singcheck.elimination.cas import get_backend
+    from singcheck.elimination.projection import project_robot
 
     return project_robot(orthoglide, get_backend("sympy"))
 
@@ -30,9 +30,9 @@ def orthoglide_projection(orthoglide):
 @pytest.fixture(scope="session")
 def certify(orthoglide_projection):
     """certify(name) -> TrajectoryReport for a bundled Orthoglide trajectory (cached)."""
-    from singcheck.certify import certify_path
-    from singcheck.path import build_path
-    from singcheck.spec import load_trajectory
+    from singcheck.certify.classification import certify_path
+    from singcheck.certify.path import build_path
+    from singcheck.spec.files import load_trajectory
 
     cache = {}
 

@@ -7,7 +7,7 @@ import json
 import pytest
 from click.testing import CliRunner
 
-from singcheck import cli
+from singcheck.cli import commands as cli
 from tests.test_cas import _backend
 from tests.test_cli import ORTHO, singcheck, traj
 
@@ -50,7 +50,7 @@ def test_a_warm_cache_runs_no_cas_process(tmp_path, monkeypatch):
     first = CliRunner().invoke(cli.cli, args)
     assert first.exit_code == 1, first.output
 
-    from singcheck.cas import external, process
+    from singcheck.elimination.cas import external, process
 
     def no_cas(*a, **k):
         raise AssertionError("a CAS process was started despite a warm cache")

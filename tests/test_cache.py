@@ -7,8 +7,8 @@ import threading
 
 import pytest
 
-from singcheck.cache import CachedBackend, EliminationCache
-from singcheck.cas import get_backend
+from singcheck.elimination.cache import CachedBackend, EliminationCache
+from singcheck.elimination.cas import get_backend
 from tests.test_cas import XI
 
 

@@ -11,17 +11,18 @@ from pathlib import Path
 import pytest
 from flint import fmpq, fmpq_mpoly_ctx
 
-from singcheck.cas.polytext import (
+from singcheck.algebra.polynomials import squarefree_part
+from singcheck.elimination.cas.polytext import (
     PolynomialSyntaxError,
     format_polynomial,
     from_terms,
     parse_polynomial,
 )
-from singcheck.cas.process import BackendTimeout, run_program
-from singcheck.cas.scripts import macaulay2_script, parse_result, singular_script
-from singcheck.elimination import EliminationRequest, squarefree_part
+from singcheck.elimination.cas.process import BackendTimeout, run_program
+from singcheck.elimination.cas.scripts import macaulay2_script, parse_result, singular_script
+from singcheck.elimination.requests import EliminationRequest
 from singcheck.errors import BackendError
-from singcheck.model import determinant
+from singcheck.model.robot import determinant
 
 HERE = Path(__file__).parent
 DATA = HERE / "data" / "cas"
@@ -154,7 +155,7 @@ def test_a_missing_program_is_a_backend_error():
 # -- live ------------------------------------------------------------------------------
 
 def _backend(name: str):
-    from singcheck.cas import _external, get_backend
+    from singcheck.elimination.cas import _external, get_backend
 
     if _external(name).find() is None:
         message = f"{name} is not installed: `make setup` installs it"
@@ -169,7 +170,7 @@ def test_live_elimination_is_the_papers_surface(name):
     backend = _backend(name)
     (xi,) = backend.eliminate(XI).polynomials
     assert xi.total_degree() == 18
-    from singcheck.cas import get_backend
+    from singcheck.elimination.cas import get_backend
 
     (norm,) = get_backend("sympy").eliminate(XI).polynomials
     assert squarefree_part(xi) == squarefree_part(norm)

@@ -5,13 +5,13 @@ from __future__ import annotations
 import pytest
 from flint import arb, fmpq
 
-from singcheck.cas import get_backend
-from singcheck.certify import certify_path
-from singcheck.intervals import endpoints
-from singcheck.model import build_model
-from singcheck.path import build_path
-from singcheck.projection import project_robot
-from singcheck.spec import parse_robot, parse_trajectory
+from singcheck.algebra.intervals import endpoints
+from singcheck.certify.classification import certify_path
+from singcheck.certify.path import build_path
+from singcheck.elimination.cas import get_backend
+from singcheck.elimination.projection import project_robot
+from singcheck.model.robot import build_model
+from singcheck.spec.files import parse_robot, parse_trajectory
 
 # Two legs on the same rail with different lengths: det A = 4y(q - p), so every working
 # mode is singular where y = 0, and the elimination proof (one vanishing mode) cannot

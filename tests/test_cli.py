@@ -188,7 +188,7 @@ def test_help_teaches_exit_codes_and_examples():
 
 
 def test_ctrl_c_exits_130(monkeypatch, capsys):
-    from singcheck import cli
+    from singcheck.cli import commands as cli
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
@@ -202,7 +202,7 @@ def test_ctrl_c_exits_130(monkeypatch, capsys):
 
 
 def test_an_internal_error_is_one_line_not_a_traceback(monkeypatch, capsys):
-    from singcheck import cli
+    from singcheck.cli import commands as cli
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("boom")
@@ -220,7 +220,7 @@ def test_an_internal_error_is_one_line_not_a_traceback(monkeypatch, capsys):
 def test_floats_in_json_round_outward():
     from flint import arb, fmpq
 
-    from singcheck.intervals import endpoints
+    from singcheck.algebra.intervals import endpoints
 
     lo, hi = endpoints(arb(fmpq(1, 3)))
     assert lo < 1 / 3 < hi or (lo <= 1 / 3 <= hi and lo < hi)

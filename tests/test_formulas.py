@@ -6,11 +6,11 @@ from fractions import Fraction
 
 import pytest
 
-from singcheck.expr import compile_polynomial, parse
-from singcheck.formulas import joint_formula, latex
-from singcheck.path import build_path
-from singcheck.spec import load_trajectory
-from singcheck.trig import TRIG, C, S, T, reduce_trig
+from singcheck.algebra.trig import TRIG, C, S, T, reduce_trig
+from singcheck.certify.path import build_path
+from singcheck.report.formulas import joint_formula, latex
+from singcheck.spec.files import load_trajectory
+from singcheck.spec.grammar import compile_polynomial, parse
 from tests.conftest import TRAJECTORIES
 from tests.test_cli import ORTHO, singcheck
 

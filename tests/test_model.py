@@ -5,10 +5,10 @@ from __future__ import annotations
 import pytest
 from flint import fmpq_mpoly_ctx
 
+from singcheck.elimination.projection import joint_space_singularities
 from singcheck.errors import UnsupportedRobotError
-from singcheck.model import build_model, determinant
-from singcheck.projection import joint_space_singularities
-from singcheck.spec import parse_robot
+from singcheck.model.robot import build_model, determinant
+from singcheck.spec.files import parse_robot
 
 R = fmpq_mpoly_ctx.get(("rho1", "rho2", "rho3", "x", "y", "z"), "lex")
 r1, r2, r3, x, y, z = R.gens()
@@ -27,7 +27,7 @@ def test_det_B_is_the_product_of_the_legs(orthoglide):
 
 
 def test_joint_space_singularities_are_the_papers_epsilon(orthoglide):
-    from singcheck.cas import get_backend
+    from singcheck.elimination.cas import get_backend
 
     eps = joint_space_singularities(orthoglide, get_backend("sympy"))
     J = eps.context()
@@ -119,8 +119,8 @@ def test_robots_outside_the_leg_decoupled_class_are_refused(text, line, phrase):
 
 
 def test_a_wrong_singularity_surface_fails_the_recheck(orthoglide, orthoglide_projection):
+    from singcheck.elimination.projection import recheck_singularity_surface
     from singcheck.errors import BackendError
-    from singcheck.projection import recheck_singularity_surface
 
     xi = orthoglide_projection.singularity_surface_as_computed
     recheck_singularity_surface(orthoglide, xi, "test")  # the right one passes
@@ -130,8 +130,8 @@ def test_a_wrong_singularity_surface_fails_the_recheck(orthoglide, orthoglide_pr
 
 
 def test_the_flint_norm_keeps_factored_jacobians_small():
-    from singcheck.projection import norm_over_legs
-    from singcheck.spec import load_robot
+    from singcheck.elimination.projection import norm_over_legs
+    from singcheck.spec.files import load_robot
     from tests.conftest import ROBOTS
 
     model = build_model(load_robot(ROBOTS / "stacked-orthoglide.yaml"))

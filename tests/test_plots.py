@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from singcheck.plots import FIGURES, figure_data, write_figures
+from singcheck.report.plots import FIGURES, figure_data, write_figures
 from tests.conftest import TRAJECTORIES
 from tests.test_cli import ORTHO, singcheck
 

@@ -9,8 +9,9 @@ import mpmath
 import pytest
 from flint import arb, fmpq, fmpq_poly, fmpz_poly
 
-from singcheck.roots import IdenticallyZeroError, isolate_real_roots
-from singcheck.trig import C, LinearInPi, S, T, TimeRange, cos_multiple, sin_multiple
+from singcheck.algebra.trig import C, LinearInPi, S, T, TimeRange, cos_multiple, sin_multiple
+from singcheck.roots.enclosures import IdenticallyZeroError
+from singcheck.roots.isolation import isolate_real_roots
 
 mpmath.mp.dps = 50
 PI = mpmath.pi
@@ -136,7 +137,7 @@ def test_pi_endpoint_is_exact():
 def test_descartes_isolation_agrees_with_flint_complex_roots():
     import random
 
-    from singcheck.rational_roots import real_roots_exact
+    from singcheck.roots.rational import real_roots_exact
 
     rng = random.Random(11)
     for _ in range(40):
@@ -154,7 +155,7 @@ def test_descartes_isolation_agrees_with_flint_complex_roots():
 
 
 def _random_trig(rng, degree: int, with_t: bool = False):
-    from singcheck.trig import reduce_trig
+    from singcheck.algebra.trig import reduce_trig
 
     p = 0 * S
     for _ in range(12):
@@ -167,7 +168,7 @@ def _random_trig(rng, degree: int, with_t: bool = False):
 def test_half_angle_polynomial_is_the_substitution():
     import random
 
-    from singcheck.roots import _half_angle_polynomial
+    from singcheck.roots.half_angle import _half_angle_polynomial
 
     rng = random.Random(5)
     for _ in range(20):
@@ -187,7 +188,7 @@ def test_half_angle_polynomial_is_the_substitution():
     ([1, 0, 1], []),  # u^2 = -1: no real root
 ])
 def test_deflated_half_angle_roots(m, expected):
-    from singcheck.roots import _half_angle_roots
+    from singcheck.roots.half_angle import _half_angle_roots
 
     roots = sorted(_half_angle_roots(fmpq_poly(m)), key=lambda r: float(r.ball(1e-12).mid()))
     assert len(roots) == len(expected)
@@ -200,7 +201,7 @@ def test_deflated_half_angle_roots(m, expected):
 def test_trig_evaluation_encloses_the_function():
     import random
 
-    from singcheck.trig import evaluate_trig
+    from singcheck.algebra.trig import evaluate_trig
 
     rng = random.Random(8)
     for _ in range(20):

@@ -9,10 +9,7 @@ import mpmath
 import pytest
 from flint import fmpq, fmpq_mpoly_ctx, fmpq_poly
 
-from singcheck.cad import open_cad, simplest_between
-from singcheck.regions import connect_regions
-from singcheck.solution_counts import direct_kinematics_count, inverse_kinematics_count
-from singcheck.space_analysis import (
+from singcheck.spaces.analysis import (
     JOINTSPACE,
     LIMIT,
     WORKSPACE,
@@ -22,6 +19,9 @@ from singcheck.space_analysis import (
     select_surfaces,
     workspace_variety,
 )
+from singcheck.spaces.cad import open_cad, simplest_between
+from singcheck.spaces.regions import connect_regions
+from singcheck.spaces.solution_counts import direct_kinematics_count, inverse_kinematics_count
 from tests.conftest import ROBOTS, TRAJECTORIES
 from tests.test_cli import singcheck
 
@@ -109,8 +109,8 @@ def test_a_count_that_differs_separates_regions_with_the_same_signs():
 
 
 def test_brackets_step_around_a_critical_value_met_exactly():
-    from singcheck.rational_roots import RationalRoot
-    from singcheck.regions import _brackets
+    from singcheck.roots.rational import RationalRoot
+    from singcheck.spaces.regions import _brackets
 
     alpha = Fraction(-27, 8)  # the midpoint of the isolating interval: bisection finds it
     root = RationalRoot(fmpq_poly([27, 8]), fmpq(-7, 2), fmpq(-13, 4))
@@ -120,8 +120,8 @@ def test_brackets_step_around_a_critical_value_met_exactly():
 
 
 def test_fibre_over_a_critical_value_is_exact():
-    from singcheck.cad import fiber
-    from singcheck.plane_adjacency import WALL, fibre_points
+    from singcheck.spaces.cad import fiber
+    from singcheck.spaces.plane_adjacency import WALL, fibre_points
 
     circle = open_cad([X**2 + Y**2 - 1])
     base = fiber(circle.levels, circle.variables, ())  # x = ±1
@@ -156,7 +156,7 @@ def test_orthoglide_without_limits_has_8_working_modes_and_2_assembly_modes(
     ws = [c for c in workspace_variety(orthoglide_projection, parallel=False)
           if c.kind != LIMIT]
     assert max(_counts(analyse(WORKSPACE, orthoglide, ws, use_limits=False))) == 8
-    from singcheck.cas import get_backend
+    from singcheck.elimination.cas import get_backend
 
     js = [c for c in jointspace_variety(orthoglide, get_backend("flint")) if c.kind != LIMIT]
     js, _ = select_surfaces(js, JOINTSPACE, "counts", 3)
@@ -164,7 +164,7 @@ def test_orthoglide_without_limits_has_8_working_modes_and_2_assembly_modes(
 
 
 def test_orthoglide_joint_space_has_a_region_with_2_dk_solutions(orthoglide):
-    from singcheck.cas import get_backend
+    from singcheck.elimination.cas import get_backend
 
     components = jointspace_variety(orthoglide, get_backend("flint"))
     analysis = analyse(JOINTSPACE, orthoglide, components, {"rho3": Fraction(2)})
@@ -174,7 +174,7 @@ def test_orthoglide_joint_space_has_a_region_with_2_dk_solutions(orthoglide):
 
 
 def test_ik_root_placement_against_the_limits(orthoglide):
-    from singcheck.solution_counts import ik_root_placement
+    from singcheck.spaces.solution_counts import ik_root_placement
 
     # each leg: ρ = 1 ± √2, one root below 0 and one inside [0, 4]
     assert ik_root_placement(orthoglide, (1, 1, 1)) == ((1, 1, 0),) * 3
@@ -218,7 +218,7 @@ def test_slice_counts_agree_with_an_independent_count(orthoglide_projection):
 
 
 def test_a_slice_inside_a_surface_is_refused(orthoglide):
-    from singcheck.cas import get_backend
+    from singcheck.elimination.cas import get_backend
 
     components = jointspace_variety(orthoglide, get_backend("flint"))
     with pytest.raises(SliceError, match="lies inside the surface rho1 = 0"):
@@ -229,15 +229,15 @@ def test_a_slice_inside_a_surface_is_refused(orthoglide):
 
 
 def _path(projection, name):
-    from singcheck.path import build_path
-    from singcheck.spec import load_trajectory
+    from singcheck.certify.path import build_path
+    from singcheck.spec.files import load_trajectory
 
     return build_path(projection, load_trajectory(TRAJECTORIES / f"{name}.yaml",
                                                   projection.model.spec))
 
 
 def test_heart2_lies_in_one_named_region_heart1_crosses_xi(orthoglide_projection):
-    from singcheck.path_regions import path_in_workspace
+    from singcheck.spaces.path_regions import path_in_workspace
 
     heart2 = path_in_workspace(_path(orthoglide_projection, "heart2"))
     assert heart2.one_region is True
@@ -250,8 +250,8 @@ def test_heart2_lies_in_one_named_region_heart1_crosses_xi(orthoglide_projection
 
 def test_leaving_the_workspace_is_infeasible_with_a_certified_exit_time(
         orthoglide_projection):
-    from singcheck.certify import certify_path
-    from singcheck.path_regions import path_in_workspace
+    from singcheck.certify.classification import certify_path
+    from singcheck.spaces.path_regions import path_in_workspace
 
     path = _path(orthoglide_projection, "leaves-workspace")
     assert certify_path(path).verdict == "infeasible"
@@ -278,8 +278,8 @@ def test_orthoglide_3d_workspace_has_one_region_with_1_and_one_with_8(orthoglide
 @pytest.mark.slow
 def test_helix_is_named_in_the_3d_workspace_and_the_map_is_cached(
         orthoglide_projection, tmp_path):
-    from singcheck import path_regions
-    from singcheck.region_map import RegionMapCache
+    from singcheck.spaces import path_regions
+    from singcheck.spaces.region_map import RegionMapCache
 
     cache = RegionMapCache(tmp_path)
     helix = _path(orthoglide_projection, "helix")
@@ -336,7 +336,7 @@ def test_cli_run_states_the_region():
 def test_region_figure_colours_by_exact_counts(orthoglide_projection, tmp_path):
     import numpy as np
 
-    from singcheck.region_plots import count_image, write_region_figure
+    from singcheck.report.region_plots import count_image, write_region_figure
 
     analysis = analyse(WORKSPACE, orthoglide_projection.model,
                        workspace_variety(orthoglide_projection), {"z": Fraction(1)})
@@ -355,10 +355,10 @@ def test_cli_plot_regions_needs_a_plane(tmp_path):
 
 
 def test_planar_robot_workspace_regions():
-    from singcheck.cas import get_backend
-    from singcheck.model import build_model
-    from singcheck.projection import project_robot
-    from singcheck.spec import load_robot
+    from singcheck.elimination.cas import get_backend
+    from singcheck.elimination.projection import project_robot
+    from singcheck.model.robot import build_model
+    from singcheck.spec.files import load_robot
 
     model = build_model(load_robot(ROBOTS / "skew-biglide.yaml"))
     projection = project_robot(model, get_backend("flint"))
@@ -388,8 +388,8 @@ def test_cli_plot_slices_go_to_the_space_owning_their_axis(tmp_path):
 
 
 def test_a_plane_shared_by_several_paths_is_decomposed_once_up_front(orthoglide_projection):
-    from singcheck import path_regions
-    from singcheck.spec import load_trajectory
+    from singcheck.spaces import path_regions
+    from singcheck.spec.files import load_trajectory
 
     specs = [load_trajectory(TRAJECTORIES / f"{n}.yaml", orthoglide_projection.model.spec)
              for n in ("heart1", "heart2", "helix")]

@@ -7,10 +7,15 @@ from fractions import Fraction
 import pytest
 from flint import arb, fmpq
 
+from singcheck.algebra.trig import LinearInPi, evaluate_trig
 from singcheck.errors import SpecError
-from singcheck.expr import ExprError, compile_constant, compile_trajectory_coordinate, parse
-from singcheck.spec import load_robot, load_trajectory, parse_robot, parse_trajectory
-from singcheck.trig import LinearInPi, evaluate_trig
+from singcheck.spec.files import load_robot, load_trajectory, parse_robot, parse_trajectory
+from singcheck.spec.grammar import (
+    ExprError,
+    compile_constant,
+    compile_trajectory_coordinate,
+    parse,
+)
 from tests.conftest import ROBOTS, TRAJECTORIES
 
 ROBOT = """\
@@ -184,7 +189,7 @@ def test_expression_errors_carry_a_column():
 
 
 def test_bundled_specs_all_load():
-    from singcheck.model import build_model
+    from singcheck.model.robot import build_model
 
     for path in ROBOTS.glob("*.yaml"):
         build_model(load_robot(path))

@@ -1,0 +1,52 @@
+"""Helpers on exact multivariate polynomials over Q (FLINT ``fmpq_mpoly``).
+
+Moving a polynomial to a smaller ring, its constant value, its coefficient in a power of
+one variable, and its squarefree part: the small exact operations every stage uses.
+"""
+
+from __future__ import annotations
+
+from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
+
+
+def restrict(p: fmpq_mpoly, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
+    """``p`` (free of the dropped variables) re-expressed in the smaller context ``ctx``."""
+    names = p.context().names()
+    keep = [names.index(v) for v in ctx.names()]
+    out = {}
+    for exps, coeff in p.terms():
+        if any(e for i, e in enumerate(exps) if i not in keep):
+            raise ValueError(f"{p} still involves an eliminated variable")
+        out[tuple(exps[i] for i in keep)] = coeff
+    return ctx.from_dict(out)
+
+
+def constant_value(p: fmpq_mpoly) -> fmpq:
+    """The value of a constant polynomial (0 for the zero polynomial), exactly."""
+    return p.leading_coefficient() if not p.is_zero() else fmpq(0)
+
+
+def coefficient_in(f: fmpq_mpoly, var_index: int, degree: int) -> fmpq_mpoly:
+    """The coefficient of ``x_var^degree`` in ``f`` (a polynomial in the other variables,
+    still in ``f``'s context)."""
+    terms = {}
+    for exps, coeff in f.terms():
+        if exps[var_index] == degree:
+            e = list(exps)
+            e[var_index] = 0
+            terms[tuple(e)] = coeff
+    return f.context().from_dict(terms)
+
+
+def squarefree_part(p: fmpq_mpoly) -> fmpq_mpoly:
+    """The product of the distinct irreducible factors of ``p``, made monic (exact).
+
+    It has the same zero set as ``p`` and simple factors, so its roots along a path are
+    the candidates without multiplicity blow-up.
+    """
+    _, factors = p.factor_squarefree()
+    out = p.context().from_dict({(0,) * p.context().nvars(): 1})
+    for f, _mult in factors:
+        out *= f
+    lc = out.leading_coefficient()
+    return out / lc if lc != 0 else out

@@ -1,0 +1,236 @@
+"""singcheck's public Python API: load a robot once, then check trajectories against it.
+
+The command line is one client of these functions; nothing here prints (long steps
+report through an optional ``notify(message)`` callback) and nothing here knows about
+exit codes.  ::
+
+    import singcheck
+    robot = singcheck.load_robot("robots/orthoglide.yaml", backend="auto")
+    traj = singcheck.load_trajectory("trajectories/heart1.yaml", robot)
+    report = singcheck.check(robot, traj)
+    report.verdict          # "singular"
+    report.to_dict()        # the JSON schema's trajectory object
+
+:func:`load_robot` builds the polynomial model and computes the projection once (through
+the elimination cache); :func:`check` reuses it, so checking more trajectories against the
+same :class:`Robot` runs no CAS and reads no cache entry.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from typing import Any
+
+from singcheck.budget import TimeLimitExceeded, deadline
+from singcheck.certify.classification import Candidate, TrajectoryReport, certify_path
+from singcheck.certify.path import PathModel, build_path
+from singcheck.certify.working_modes import WorkingMode
+from singcheck.elimination.projection import RobotProjection, project_robot
+from singcheck.model.robot import RobotModel, build_model
+from singcheck.spec.files import RobotSpec, TrajectorySpec
+from singcheck.spec.files import load_robot as read_robot_spec
+from singcheck.spec.files import load_trajectory as read_trajectory_spec
+
+Notify = Callable[[str], None]
+
+DEFAULT_TOLERANCE = 1e-9
+
+
+def _quiet(message: str) -> None:
+    """The default ``notify``: say nothing."""
+
+
+def elimination_engine(backend: str = "auto", timeout: float = 600.0, cache: bool = True,
+                       notify: Notify = _quiet):
+    """The chosen elimination backend (named through ``notify`` when picked by ``auto``),
+    behind the on-disk cache unless ``cache`` is false."""
+    from singcheck.elimination.cache import CachedBackend, EliminationCache
+    from singcheck.elimination.cas import get_backend
+
+    engine = get_backend(backend, timeout=timeout)
+    if backend == "auto":
+        notify(f"backend: {engine.name} {engine.version()} (auto)")
+    return CachedBackend(engine, EliminationCache()) if cache else engine
+
+
+@dataclass
+class Robot:
+    """A robot spec with its exact model and its projection onto the workspace (ξ(X), the
+    workspace boundary and the joint-limit surfaces), computed once."""
+
+    spec: RobotSpec
+    model: RobotModel
+    projection: RobotProjection
+    region_cache: Any = None  # where region maps persist between runs (None: this process)
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    @property
+    def backend(self) -> str:
+        return self.projection.backend
+
+    @property
+    def singularity_surface(self):
+        """ξ(X), squarefree, exact (an ``fmpq_mpoly`` in the pose variables)."""
+        return self.projection.singularity_surface
+
+
+def robot_from_spec(spec: RobotSpec, backend: str = "auto", *, timeout: float = 600.0,
+                    cache: bool = True, notify: Notify = _quiet, engine=None) -> Robot:
+    """A :class:`Robot` from an already-read spec (``engine``: a ready backend, else one is
+    built from ``backend``, ``timeout`` and ``cache``)."""
+    model = build_model(spec)
+    engine = engine or elimination_engine(backend, timeout, cache, notify)
+    projection = project_robot(model, engine)
+    region_cache = None
+    if cache:
+        from singcheck.spaces.region_map import RegionMapCache
+
+        region_cache = RegionMapCache()
+    return Robot(spec, model, projection, region_cache)
+
+
+def load_robot(path: str, backend: str = "auto", *, timeout: float = 600.0,
+               cache: bool = True, notify: Notify = _quiet) -> Robot:
+    """Read a robot spec (YAML) and project it: the elimination runs here, once (or comes
+    from the cache); raises :class:`~singcheck.errors.SpecError` for a bad file and
+    :class:`~singcheck.errors.BackendError` when the backend is missing or fails."""
+    return robot_from_spec(read_robot_spec(path), backend, timeout=timeout, cache=cache,
+                           notify=notify)
+
+
+def load_trajectory(path: str, robot: Robot) -> TrajectorySpec:
+    """Read a trajectory spec (YAML) for ``robot``: its pose variables are checked."""
+    return read_trajectory_spec(path, robot.spec)
+
+
+@dataclass
+class Report:
+    """The certified answer for one trajectory: a verdict with its proofs."""
+
+    trajectory: TrajectorySpec
+    certificate: TrajectoryReport | None  # None when the time limit stopped it first
+    workspace: Any = None  # the path against the workspace's regions (or None)
+    time_limited: str | None = None  # why the work stopped early, if it did
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def name(self) -> str:
+        return self.trajectory.name
+
+    @property
+    def verdict(self) -> str:
+        """singularity-free, singular, infeasible or unknown."""
+        return self.certificate.verdict if self.certificate else "unknown"
+
+    @property
+    def reason(self) -> str:
+        if self.certificate is None:
+            return f"unknown: {self.time_limited}"
+        return self.certificate.reason
+
+    @property
+    def candidates(self) -> list[Candidate]:
+        """Certified roots of μ(t), each classified per working mode."""
+        return self.certificate.candidates if self.certificate else []
+
+    @property
+    def working_modes(self) -> list[WorkingMode]:
+        return self.certificate.modes if self.certificate else []
+
+    @property
+    def path(self) -> PathModel | None:
+        return self.certificate.path if self.certificate else None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON schema's trajectory object (README, "JSON output")."""
+        from singcheck.report.trajectory import (
+            time_limited_json,
+            trajectory_json,
+            workspace_json,
+        )
+
+        if self.certificate is None:
+            return time_limited_json(self.trajectory, self.reason)
+        doc = trajectory_json(self.certificate)
+        if self.workspace is not None:
+            doc["workspace"] = workspace_json(self.workspace)
+            exit_time = doc["workspace"]["exit_time_interval"]
+            if doc["verdict"] == "infeasible" and exit_time:
+                lo, hi = exit_time
+                doc["reason"] += f"; the path leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"
+        elif self.time_limited:
+            doc["reason"] += f" ({self.time_limited} while naming the workspace region)"
+        return doc
+
+
+def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAULT_TOLERANCE,
+          regions: bool = True, time_limit: float | None = None,
+          notify: Notify = _quiet) -> Report:
+    """Certify one trajectory of ``robot``: candidate singular times, their classification
+    per working mode, the verdict, and (``regions``) where the path lies in the workspace.
+
+    ``time_limit`` (seconds) bounds the whole certification; past it the report's verdict
+    is ``unknown`` with the reason (the region statement alone past it is left out, with
+    the reason).  Prints nothing; ``notify`` hears of long steps.
+    """
+    with deadline(time_limit):
+        try:
+            path = build_path(robot.projection, trajectory)
+            certificate = certify_path(path, tolerance)
+        except TimeLimitExceeded as e:
+            return Report(trajectory, None, time_limited=str(e))
+        if not regions:
+            return Report(trajectory, certificate)
+        from singcheck.spaces.path_regions import path_in_workspace
+
+        mu_roots = ([c.t for c in certificate.candidates]
+                    if certificate.mu_roots_complete else None)
+        try:
+            where = path_in_workspace(path, tolerance, mu_roots=mu_roots,
+                                      region_cache=robot.region_cache, notify=notify)
+        except TimeLimitExceeded as e:
+            return Report(trajectory, certificate, time_limited=str(e))
+        return Report(trajectory, certificate, where)
+
+
+# state inherited by forked workers (set just before the pool starts)
+_WORKER: dict = {}
+
+
+def _check_index(i: int) -> dict:
+    robot, trajectories, options = _WORKER["robot"], _WORKER["trajectories"], _WORKER["options"]
+    return check(robot, trajectories[i], **options).to_dict()
+
+
+def check_batch(robot: Robot, trajectories: list[TrajectorySpec], *,
+                tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
+                time_limit: float | None = None, jobs: int = 1,
+                notify: Notify = _quiet) -> Iterator[dict]:
+    """Certify many trajectories, in ``jobs`` forked processes when there are more than 4;
+    yields each one's JSON trajectory object, in input order, as soon as it is known."""
+    options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
+                   notify=notify)
+    _WORKER.update(robot=robot, trajectories=trajectories, options=options)
+    n = len(trajectories)
+    try:
+        if jobs > 1 and n > 4:
+            import multiprocessing
+
+            if regions:
+                from singcheck.spaces.path_regions import prepare_region_maps
+
+                prepare_region_maps(robot.projection, trajectories, robot.region_cache,
+                                    notify)
+            with multiprocessing.get_context("fork").Pool(jobs) as pool:
+                yield from pool.imap(_check_index, range(n),
+                                     chunksize=max(1, n // (jobs * 16)))
+        else:
+            for i in range(n):
+                yield _check_index(i)
+    finally:
+        _WORKER.clear()
+

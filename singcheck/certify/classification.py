@@ -1,0 +1,230 @@
+"""Candidate singular times, their classification per working mode, and the verdict.
+
+What is proven, and how:
+
+* **Candidates.**  Every time at which some working mode (real or complex) is
+  singular is a real root of μ(t) = ξ(φ(t)), because ξ vanishes on the whole projection
+  of ``{F = 0, det A = 0}``.  Those roots are isolated in certified balls, each holding
+  exactly one root (:mod:`singcheck.roots`); between them μ ≠ 0, so no mode is
+  singular there.
+* **Regular.**  A mode is not singular at a candidate when the ball enclosure of
+  det A(ρ_mode(T), φ(T)) over the candidate's ball T excludes 0.
+* **Singular, by elimination.**  For a leg-decoupled robot the working modes list every
+  complex solution of the inverse kinematics, so μ(τ) = 0 means some mode's det A
+  vanishes at τ.  When every other mode is proven non-zero on T, it is this one.
+* **Singular, exactly.**  At a root known exactly (a point ball, e.g. t = 0) where every
+  enclosure is exact, det A evaluating to an exact 0 is a proof.
+* **Singular, by sign change.**  When det A along a real mode has proven opposite signs
+  at the two ends of T, it vanishes inside T (intermediate values); that zero is a
+  root of μ in T, hence τ itself (T isolates one root).
+* Anything else, after refining T, is ``unknown`` for that mode, with the reason.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from flint import acb, arb
+
+from singcheck.algebra.intervals import excludes_zero, sign, working_precision
+from singcheck.certify.path import PathModel
+from singcheck.certify.working_modes import (
+    FEASIBLE,
+    INFEASIBLE,
+    UNKNOWN,
+    WorkingMode,
+    working_modes,
+)
+from singcheck.roots.enclosures import IdenticallyZeroError, RealRoot
+from singcheck.roots.isolation import isolate_real_roots
+
+SINGULAR, REGULAR = "singular", "regular"
+BY_ELIMINATION = "elimination"
+BY_SIGN_CHANGE = "sign change"
+BY_EXCLUSION = "det A ≠ 0 (ball arithmetic)"
+BY_EXACT_ZERO = "det A = 0 exactly"
+
+VERDICT_FREE = "singularity-free"
+VERDICT_SINGULAR = "singular"
+VERDICT_INFEASIBLE = "infeasible"
+VERDICT_UNKNOWN = "unknown"
+
+
+@dataclass(frozen=True)
+class ModeAtCandidate:
+    mode: str
+    status: str  # singular | regular | unknown
+    proof: str  # how it was decided, or why not
+
+
+@dataclass
+class Candidate:
+    root: RealRoot
+    pose: list[arb]
+    joints: dict[str, dict[str, float | None]]  # feasible mode -> joint -> value
+    modes: list[ModeAtCandidate]
+    status: str = UNKNOWN  # real | spurious | unknown
+
+    @property
+    def t(self) -> arb:
+        return self.root.t
+
+    @property
+    def singular_modes(self) -> list[str]:
+        return [m.mode for m in self.modes if m.status == SINGULAR]
+
+
+@dataclass
+class TrajectoryReport:
+    path: PathModel
+    verdict: str
+    reason: str
+    candidates: list[Candidate]
+    modes: list[WorkingMode]
+    root_method: str
+    undecided: list = field(default_factory=list)  # (t ball, reason) left unproven
+    mu_roots_complete: bool = False  # every root of μ isolated (the candidates are all)
+
+    @property
+    def name(self) -> str:
+        return self.path.trajectory.name
+
+
+def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
+    pose = path.pose_at(t)
+    per_leg = [leg.branches(t) for leg in path.legs]
+    values: dict[str, arb | acb | None] = {}
+    joints: dict[str, list] = {}
+    for mode in modes:
+        js = [per_leg[i][b.label] for i, b in enumerate(mode.branches)]
+        joints[mode.label] = js
+        values[mode.label] = None if any(j is None for j in js) else path.det_A(js, pose)
+    return pose, joints, values
+
+
+def _sign_at(path: PathModel, mode: WorkingMode, point: arb) -> int | None:
+    _, _, values = _mode_values(path, [mode], point)
+    value = values[mode.label]
+    return sign(value) if isinstance(value, arb) else None
+
+
+def _branches_continuous(path: PathModel, t: arb) -> bool:
+    """True when every quadratic leg's discriminant is proven > 0 on the whole ball:
+    then each branch is real and continuous there, as the intermediate value
+    theorem needs."""
+    from singcheck.algebra.trig import evaluate_trig
+
+    return all(leg.discriminant is None or evaluate_trig(leg.discriminant, t) > 0
+               for leg in path.legs)
+
+
+def _decide(path, modes, root: RealRoot):
+    """One attempt at the given enclosure; returns ``{mode: ModeAtCandidate}``."""
+    pose, joints, values = _mode_values(path, modes, root.t)
+    decided: dict[str, ModeAtCandidate] = {}
+    open_modes = []
+    for mode in modes:
+        v = values[mode.label]
+        if v is not None and excludes_zero(v):
+            decided[mode.label] = ModeAtCandidate(mode.label, REGULAR, BY_EXCLUSION)
+        elif v is not None and v.is_exact() and v == 0:
+            # an exactly known root, evaluated without rounding: det A is 0 there
+            decided[mode.label] = ModeAtCandidate(mode.label, SINGULAR, BY_EXACT_ZERO)
+        else:
+            open_modes.append(mode)
+    if len(open_modes) == 1:
+        m = open_modes[0]
+        decided[m.label] = ModeAtCandidate(m.label, SINGULAR, BY_ELIMINATION)
+        open_modes = []
+    if open_modes and not _branches_continuous(path, root.t):
+        return pose, joints, decided
+    for mode in open_modes:
+        lo, hi = _sign_at(path, mode, root.t.lower()), _sign_at(path, mode, root.t.upper())
+        if lo is not None and hi is not None and lo != hi:
+            decided[mode.label] = ModeAtCandidate(mode.label, SINGULAR, BY_SIGN_CHANGE)
+    return pose, joints, decided
+
+
+def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot,
+                       tolerance: float) -> Candidate:
+    """Decide, for every working mode, whether it is singular at this root of μ."""
+    decided: dict[str, ModeAtCandidate] = {}
+    shown_at = None
+    r = root
+    for step, prec in enumerate((53, 128, 256)):
+        if step:
+            r = r.refined(tolerance * 10.0 ** (-8 * step))
+        with working_precision(prec):
+            pose, joints, newly = _decide(path, modes, r)
+        shown_at = shown_at or (pose, joints)
+        for label, verdict in newly.items():
+            decided.setdefault(label, verdict)
+        if len(decided) == len(modes):
+            break
+    pose, joints = shown_at
+    per_mode = [decided.get(m.label) or ModeAtCandidate(
+        m.label, UNKNOWN, "neither det A ≠ 0 nor a zero could be proven at this root")
+        for m in modes]
+    feasible = {m.label for m in modes if m.status == FEASIBLE}
+    states = {pm.status for pm in per_mode if pm.mode in feasible}
+    status = "real" if SINGULAR in states else "unknown" if UNKNOWN in states else "spurious"
+    shown = {m.label: {leg.leg.joint: _mid(v) for leg, v in zip(path.legs, joints[m.label],
+                                                                 strict=True)}
+             for m in modes if m.status == FEASIBLE}
+    return Candidate(root, pose, shown, per_mode, status)
+
+
+def _mid(v) -> float | None:
+    return float(v.mid()) if isinstance(v, arb) else None
+
+
+def _clear_undecided(path, modes, box) -> bool:
+    """True when every feasible mode's det A provably stays away from 0 on the box."""
+    _, _, values = _mode_values(path, [m for m in modes if m.status == FEASIBLE], box.t)
+    return all(v is not None and excludes_zero(v) for v in values.values())
+
+
+def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
+    """The verdict for one trajectory, with everything that supports it."""
+    modes = working_modes(path, tolerance)
+    try:
+        isolation = isolate_real_roots(path.mu, path.trajectory.range, tolerance)
+    except IdenticallyZeroError:
+        return TrajectoryReport(path, VERDICT_UNKNOWN,
+                                "the trajectory lies on the singularity surface ξ(X) = 0, so "
+                                "μ(t) ≡ 0 gives no candidates", [], modes, "none")
+    candidates = [classify_candidate(path, modes, r, tolerance) for r in isolation.roots]
+    for mode in modes:
+        mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
+    undecided = [(b.t, b.reason) for b in isolation.undecided
+                 if not _clear_undecided(path, modes, b)]
+    verdict, reason = _verdict(modes, candidates, undecided)
+    return TrajectoryReport(path, verdict, reason, candidates, modes, isolation.method,
+                            undecided, not isolation.undecided)
+
+
+def _verdict(modes, candidates, undecided) -> tuple[str, str]:
+    feasible = [m for m in modes if m.status == FEASIBLE]
+    unsure = [m for m in modes if m.status == UNKNOWN]
+    singular = [(m.label, c) for c in candidates for m in feasible
+                if m.label in c.singular_modes]
+    if singular:
+        label, c = singular[0]
+        return VERDICT_SINGULAR, (f"working mode {label} is singular at t ≈ "
+                                  f"{float(c.t.mid()):.6g}")
+    if not feasible and not unsure:
+        reasons = sorted({m.reason for m in modes if m.status == INFEASIBLE})
+        return VERDICT_INFEASIBLE, "no working mode stays in the workspace and joint limits: " \
+            + "; ".join(reasons)
+    if unsure:
+        return VERDICT_UNKNOWN, "feasibility of working mode(s) " + ", ".join(
+            f"{m.label} ({m.reason})" for m in unsure) + " could not be proven"
+    open_candidates = [c for c in candidates if c.status == UNKNOWN]
+    if open_candidates:
+        return VERDICT_UNKNOWN, "could not classify the candidate(s) at t ≈ " + ", ".join(
+            f"{float(c.t.mid()):.6g}" for c in open_candidates)
+    if undecided:
+        return VERDICT_UNKNOWN, "root isolation left sub-ranges undecided: " + "; ".join(
+            reason for _, reason in undecided)
+    return VERDICT_FREE, "every feasible working mode (" + ", ".join(
+        m.label for m in feasible) + ") is proven free of parallel singularities"

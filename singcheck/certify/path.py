@@ -1,0 +1,114 @@
+"""A robot's polynomials along one trajectory X = φ(t), as trig polynomials in t.
+
+Composing with φ is exact (``fmpq_mpoly.compose`` into ``Q[t, s, c]`` then
+:func:`~singcheck.trig.reduce_trig`).  The results are:
+
+* ``mu`` = ξ(φ(t)), whose real roots are every candidate singular time,
+* per leg, the coefficients of its constraint in its joint, its discriminant D(t) and
+  its joint-limit polynomials, from which the IK branches ρ = (-b ± √D)/(2a) along the
+  path and their limit crossings are certified.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from flint import acb, arb, fmpq, fmpq_mpoly
+
+from singcheck.algebra.intervals import evaluate, fraction_ball
+from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig
+from singcheck.elimination.projection import RobotProjection
+from singcheck.model.robot import Leg, leg_coefficients
+from singcheck.spec.files import TrajectorySpec
+
+
+def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ...]) -> fmpq_mpoly:
+    """``p(…, X = φ(t))`` for a polynomial in any context whose non-pose variables are absent."""
+    names = p.context().names()
+    args = []
+    for v in names:
+        if v in pose:
+            args.append(phi[pose.index(v)])
+        elif p.degrees()[names.index(v)] > 0:
+            raise ValueError(f"{v} is not a pose variable")
+        else:
+            args.append(TRIG.from_dict({}))
+    return reduce_trig(p.compose(*args, ctx=TRIG))
+
+
+@dataclass(frozen=True)
+class LegAlongPath:
+    """One leg's constraint along the path: ``a ρ² + b(t) ρ + c(t)`` (or ``b ρ + c``)."""
+
+    leg: Leg
+    coefficients: tuple[fmpq_mpoly, ...]  # TRIG polys, highest degree first
+    discriminant: fmpq_mpoly | None  # b² - 4ac for a quadratic leg
+
+    @property
+    def labels(self) -> tuple[str, ...]:
+        """Branch labels: the sign in front of √D, or 'o' for a linear leg."""
+        return ("+", "-") if self.leg.degree == 2 else ("o",)
+
+    def limit_polynomial(self, value) -> fmpq_mpoly:
+        """The constraint with the joint set to ``value``: it vanishes when a branch is there."""
+        out = TRIG.from_dict({})
+        q = fmpq(value.numerator, value.denominator)
+        for c in self.coefficients:
+            out = out * q + c
+        return out
+
+    def branches(self, t: arb) -> dict[str, arb | acb | None]:
+        """Enclosures of each branch's joint value for every t in the ball ``t``.
+
+        A quadratic leg's branches are real where D > 0 (proven) and complex
+        conjugate where D < 0; where the sign of D is not proven both are None.
+        """
+        values = [evaluate_trig(c, t) for c in self.coefficients]
+        if self.leg.degree == 1:
+            b, c = values
+            return {"o": -c / b}
+        a, b, _ = values
+        d = evaluate_trig(self.discriminant, t)
+        if d > 0:
+            root = d.sqrt()
+            return {"+": (-b + root) / (2 * a), "-": (-b - root) / (2 * a)}
+        if d < 0:
+            root = acb(0, (-d).sqrt())
+            return {"+": (-acb(b) + root) / (2 * a), "-": (-acb(b) - root) / (2 * a)}
+        return {"+": None, "-": None}
+
+
+@dataclass(frozen=True)
+class PathModel:
+    projection: RobotProjection
+    trajectory: TrajectorySpec
+    phi: tuple[fmpq_mpoly, ...]  # pose coordinates in the robot's pose order
+    mu: fmpq_mpoly  # ξ(φ(t))
+    legs: tuple[LegAlongPath, ...]
+
+    def pose_at(self, t: arb) -> list[arb]:
+        return [evaluate_trig(x, t) for x in self.phi]
+
+    def det_A(self, joints: list[arb | acb], pose: list[arb]) -> arb | acb:
+        """Enclosure of det A at the given joint and pose enclosures."""
+        return evaluate(self.projection.model.det_A, [*joints, *pose])
+
+
+def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
+    model = projection.model
+    phi = tuple(trajectory.pose[v] for v in model.pose)
+    mu = compose_pose(projection.singularity_surface, phi, model.pose)
+    legs = []
+    for leg in model.legs:
+        coeffs = tuple(compose_pose(c, phi, model.pose) for c in leg_coefficients(leg))
+        disc = None
+        if leg.degree == 2:
+            a, b, c = coeffs
+            disc = reduce_trig(b * b - 4 * a * c)
+        legs.append(LegAlongPath(leg, coeffs, disc))
+    return PathModel(projection, trajectory, phi, mu, tuple(legs))
+
+
+def exact_point(q) -> arb:
+    """The ball of an exact rational time (exact when dyadic)."""
+    return fraction_ball(q)

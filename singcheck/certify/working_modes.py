@@ -1,0 +1,270 @@
+"""Working modes along a path and which of them are feasible, with proofs.
+
+A working mode picks one inverse-kinematics branch per leg (``+``/``-`` in front of √D,
+``o`` for a linear leg), e.g. ``+++`` for the Orthoglide prototype.  A mode is
+*feasible* when each of its branches is real, never meets the leg's other branch, and
+stays inside the joint limits over the whole closed range.  How each part is proven:
+
+1. **Real and separated.**  The roots of the leg's discriminant D(t) on the range are
+   isolated with certified intervals.  No root and D > 0 at one point (ball
+   arithmetic) proves D > 0 on the whole range by continuity: both branches are real
+   and distinct (no serial singularity).  A root means the branches meet: the path
+   reaches the workspace boundary (det B = 0) and the leg's modes are infeasible.
+   A quick proof comes first: D > 0 in ball arithmetic on each of 8 pieces covering
+   the range; only when it fails are the roots of D isolated.
+2. **Inside the limits.**  A branch equals a limit L only at roots of the leg
+   constraint with ρ = L.  Those roots cut the range into open gaps in which the branch
+   is never equal to a limit, so it is inside or outside over each whole gap; one
+   ball evaluation at a point of each gap decides which.  Touching a limit is inside
+   (the limits are closed).  Quick proofs come first: a branch certainly outside the
+   limits at the range start is infeasible, and one certainly inside them on each of
+   8 pieces covering the range is feasible, without isolating any root.
+Whatever cannot be proven makes the branch ``unknown``, with the reason.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from itertools import product
+
+from flint import arb
+
+from singcheck.algebra.intervals import fraction_ball, working_precision
+from singcheck.algebra.trig import TimeRange, evaluate_trig
+from singcheck.budget import checkpoint
+from singcheck.certify.path import LegAlongPath, PathModel
+from singcheck.roots.enclosures import IdenticallyZeroError, RootIsolation
+from singcheck.roots.isolation import isolate_real_roots
+
+FEASIBLE, INFEASIBLE, UNKNOWN = "feasible", "infeasible", "unknown"
+_PRECISIONS = (53, 128, 384)
+
+
+@dataclass(frozen=True)
+class BranchFeasibility:
+    joint: str
+    label: str
+    status: str  # feasible | infeasible | unknown
+    reason: str = ""
+    event_time: arb | None = None  # where it leaves (limit crossing or branch meeting)
+
+
+@dataclass
+class WorkingMode:
+    label: str  # one character per leg, in joint order
+    branches: tuple[BranchFeasibility, ...]
+    status: str
+    reason: str
+    joints_at_start: dict[str, float | None]
+    singular_times: list = field(default_factory=list)  # filled by certification
+
+    @property
+    def feasible(self) -> bool:
+        return self.status == FEASIBLE
+
+
+def gap_points(interval: TimeRange, events: list[arb]) -> list[arb]:
+    """One exact point strictly inside each gap between the events (sorted balls).
+
+    Gaps run from the range start to the first event, between consecutive events,
+    and from the last event to the range end; an empty gap yields no point.
+    """
+    bounds = [interval.start.ball(), *sorted(events, key=lambda b: b.mid()), interval.end.ball()]
+    points = []
+    for left, right in zip(bounds, bounds[1:], strict=False):
+        lo, hi = left.upper(), right.lower()
+        if lo < hi:
+            mid = ((lo + hi) / 2).mid()
+            if lo < mid < hi:
+                points.append(mid)
+    return points
+
+
+def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | None:
+    try:
+        return isolate_real_roots(poly, interval, tolerance)
+    except IdenticallyZeroError:
+        return None
+
+
+_PIECES = 8
+_BUDGET = 64  # ball evaluations spent before falling back to a root isolation
+
+
+def _pieces(interval: TimeRange) -> list[arb]:
+    """Balls covering the closed range (slightly more at irrational ends)."""
+    lo, hi = interval.start.ball().lower(), interval.end.ball().upper()
+    step = (hi - lo) / _PIECES
+    edges = [(lo + step * i).mid() for i in range(_PIECES)] + [hi]
+    edges[0] = lo
+    return [a.union(b) for a, b in zip(edges, edges[1:], strict=False)]
+
+
+def _halves(piece: arb) -> tuple[arb, arb]:
+    lo, hi = piece.lower(), piece.upper()
+    mid = piece.mid()
+    return lo.union(mid), mid.union(hi)
+
+
+def _everywhere(predicate, interval: TimeRange) -> bool:
+    """True when ``predicate(ball)`` is proven on balls covering the whole range: a
+    quick proof by ball arithmetic that spares a root isolation (False means "not
+    proven").  A piece where it fails is halved (ball enclosures tighten as pieces
+    shrink) until a budget of evaluations is spent."""
+    todo = _pieces(interval)
+    spent = 0
+    while todo:
+        piece = todo.pop()
+        checkpoint()
+        spent += 1
+        if predicate(piece):
+            continue
+        if spent + len(todo) + 2 > _BUDGET:
+            return False
+        todo += _halves(piece)
+    return True
+
+
+def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float):
+    """Status of both branches of a quadratic leg with respect to step 1."""
+    joint = leg.leg.joint
+    if _everywhere(lambda t: evaluate_trig(leg.discriminant, t) > 0, interval):
+        return FEASIBLE, "", None
+    iso = _isolate(leg.discriminant, interval, tolerance)
+    if iso is None:
+        return INFEASIBLE, f"the two branches of {joint} coincide along the whole path " \
+            "(serial singularity)", None
+    if iso.roots:
+        t = iso.roots[0].t
+        return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {float(t.mid()):.6g} " \
+            "(serial singularity: the path reaches the workspace boundary)", t
+    for box in iso.undecided:
+        if not evaluate_trig(leg.discriminant, box.t) > 0:
+            return UNKNOWN, f"could not prove that the branches of {joint} stay apart: " \
+                f"{box.reason}", box.t
+    for prec in _PRECISIONS:
+        with working_precision(prec):
+            d = evaluate_trig(leg.discriminant, interval.start.ball())
+        if d > 0:
+            return FEASIBLE, "", None
+        if d < 0:
+            return INFEASIBLE, f"{joint} has no real solution along the path " \
+                "(outside the workspace)", None
+    return UNKNOWN, f"the sign of the discriminant of {joint} could not be decided", None
+
+
+def _inside(value, lo, hi) -> bool | None:
+    if value is None:
+        return None
+    if value > lo and value < hi:
+        return True
+    if value < lo or value > hi:
+        return False
+    return None
+
+
+def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
+                   tolerance: float, crossings: dict) -> BranchFeasibility:
+    """Whether this branch stays strictly inside the joint limits along the whole path.
+
+    ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
+    the leg equals it (one polynomial serves both branches)."""
+    joint = leg.leg.joint
+    lo, hi = (fraction_ball(v) for v in limits)
+    bounds = f"[{limits[0]}, {limits[1]}]"
+    if _inside(leg.branches(interval.start.ball())[label], lo, hi) is False:
+        return BranchFeasibility(joint, label, INFEASIBLE,
+                                 f"{joint} is outside {bounds} from the start")
+    if _everywhere(lambda t: _inside(leg.branches(t)[label], lo, hi) is True, interval):
+        return BranchFeasibility(joint, label, FEASIBLE)
+    events: list[arb] = []
+    undecided = []
+    for value in limits:
+        if value not in crossings:
+            crossings[value] = _isolate(leg.limit_polynomial(value), interval, tolerance)
+        iso = crossings[value]
+        if iso is None:
+            return BranchFeasibility(joint, label, UNKNOWN,
+                                     f"a branch of {joint} sits on its limit {value} all along")
+        events += [r.t for r in iso.roots]
+        undecided += list(iso.undecided)
+    for box in undecided:
+        if _inside(leg.branches(box.t)[label], lo, hi) is not True:
+            return BranchFeasibility(joint, label, UNKNOWN,
+                                     f"limit crossing of {joint} not decided: {box.reason}")
+    events += [box.t for box in undecided]
+    for point in gap_points(interval, events):
+        verdict = None
+        for prec in _PRECISIONS:
+            with working_precision(prec):
+                verdict = _inside(leg.branches(point)[label], lo, hi)
+            if verdict is not None:
+                break
+        if verdict is None:
+            return BranchFeasibility(joint, label, UNKNOWN,
+                                     f"could not place {joint} against its limits at "
+                                     f"t = {float(point):.6g}")
+        if verdict is False:
+            crossing = max((e for e in events if e < point), key=lambda b: b.mid(),
+                           default=None)
+            reason = f"{joint} is outside {bounds} from the start" if crossing is None else \
+                f"{joint} leaves {bounds} at t ≈ {float(crossing.mid()):.6g}"
+            return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing)
+    return BranchFeasibility(joint, label, FEASIBLE)
+
+
+def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibility]]:
+    """Feasibility of every branch of every leg (outer list in joint order)."""
+    interval = path.trajectory.range
+    limits_of = path.projection.model.spec.joint_limits
+    out = []
+    for leg in path.legs:
+        joint = leg.leg.joint
+        if leg.leg.degree == 2:
+            status, reason, when = _leg_reality(leg, interval, tolerance)
+        else:
+            status, reason, when = FEASIBLE, "", None
+        branches = []
+        crossings: dict = {}
+        for label in leg.labels:
+            if status != FEASIBLE:
+                branches.append(BranchFeasibility(joint, label, status, reason, when))
+            elif joint in limits_of:
+                branches.append(_branch_limits(leg, label, interval, limits_of[joint],
+                                               tolerance, crossings))
+            else:
+                branches.append(BranchFeasibility(joint, label, FEASIBLE))
+        out.append(branches)
+    return out
+
+
+def _start_values(path: PathModel) -> list[dict[str, float | None]]:
+    start = path.trajectory.range.start.ball()
+    out = []
+    for leg in path.legs:
+        values = leg.branches(start)
+        out.append({label: (float(v.mid()) if isinstance(v, arb) else None)
+                    for label, v in values.items()})
+    return out
+
+
+def working_modes(path: PathModel, tolerance: float = 1e-9) -> list[WorkingMode]:
+    """Every working mode (sign choice per leg) with its proven feasibility."""
+    per_leg = leg_branches(path, tolerance)
+    starts = _start_values(path)
+    joints = [leg.leg.joint for leg in path.legs]
+    modes = []
+    for choice in product(*per_leg):
+        label = "".join(b.label for b in choice)
+        statuses = {b.status for b in choice}
+        if INFEASIBLE in statuses:
+            status = INFEASIBLE
+        elif UNKNOWN in statuses:
+            status = UNKNOWN
+        else:
+            status = FEASIBLE
+        reason = "; ".join(b.reason for b in choice if b.status == status and b.reason)
+        at_start = {j: starts[i][b.label] for i, (j, b) in enumerate(zip(joints, choice,
+                                                                           strict=True))}
+        modes.append(WorkingMode(label, tuple(choice), status, reason, at_start))
+    return modes

@@ -1,0 +1,383 @@
+"""The ``singcheck`` command group: parse options, call :mod:`singcheck.api`, render.
+
+stdout carries the result (a table, or JSON with ``--format json``); stderr carries
+progress, notes and errors.  Library errors become exit codes in
+:func:`singcheck.cli.exitcodes.exit_codes` and :func:`main`, nowhere else.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import click
+
+from singcheck.cli.exitcodes import ExitCode, exit_codes, fail
+from singcheck.errors import SpecError
+from singcheck.report.progress import Progress
+from singcheck.version import __version__
+
+RUN_EPILOG = """\b
+Examples:
+  singcheck run robots/orthoglide.yaml trajectories/heart1.yaml
+  singcheck run robots/orthoglide.yaml trajectories/*.yaml --format json > report.json
+
+\b
+Exit status:
+  0  every trajectory is proven singularity-free
+  1  some trajectory is singular or infeasible
+  2  bad command line or bad spec file
+  3  some trajectory could not be decided (unknown), none singular
+  4  an elimination backend is missing or failed
+  130 interrupted
+"""
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
+@click.version_option(__version__, prog_name="singcheck")
+def cli() -> None:
+    """Prove whether a parallel robot's trajectory is free of parallel singularities.
+
+    singcheck follows Jha, Chablat, Rouillier & Moroz (IDETC 2015): the robot
+    F(ρ, X) = 0 is projected onto its workspace (ξ(X), eliminating the joints), the
+    trajectory X = φ(t) is substituted, and every real root of μ(t) = ξ(φ(t)) is
+    isolated in a certified interval.  Each candidate is then classified per working
+    mode (inverse-kinematics branch) as a real singularity or a spurious one.
+
+    Answers are proven with exact arithmetic and rigorous ball arithmetic, or reported
+    as "unknown" with the reason; nothing is decided by sampling.
+    """
+
+
+@cli.command(epilog=RUN_EPILOG)
+@click.argument("robot", type=click.Path(dir_okay=False))
+@click.argument("trajectories", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.option("--backend",
+              type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
+              default="auto", envvar="SINGCHECK_BACKEND", show_default=True, show_envvar=True,
+              help="Elimination engine for the robot's projection; auto picks Singular, else "
+                   "Macaulay2, else SymPy (see `singcheck backends`).")
+@click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=600,
+              show_default=True, help="Wall-clock limit in seconds for each CAS run.")
+@click.option("--no-cache", is_flag=True,
+              help="Neither read nor write the cache of elimination results and region "
+                   "maps (see `singcheck cache`).")
+@click.option("--tolerance", type=click.FloatRange(min=0, min_open=True), default=1e-9,
+              show_default=True, help="Width of the certified enclosure of each root in t.")
+@click.option("--format", "fmt", type=click.Choice(["table", "json"]), default="table",
+              show_default=True, help="table for people, json for programs (schema in README).")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, writable=True),
+              help="Write the result to this file (atomically) instead of stdout.")
+@click.option("-j", "--jobs", type=click.IntRange(min=1), default=os.cpu_count() or 1,
+              show_default="number of cores",
+              help="Processes certifying trajectories in parallel (used for more than 4).")
+@click.option("--plot", "plot_dir", type=click.Path(file_okay=False),
+              help="Also write the figures (see `singcheck plot`) to this directory.")
+@click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
+@click.option("-v", "--verbose", is_flag=True,
+              help="Show root enclosures and the proof used for every mode and candidate.")
+def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs, plot_dir,
+        quiet, verbose) -> None:
+    """Certify each TRAJECTORY of ROBOT (YAML spec files).
+
+    For every trajectory it prints the candidate singular times (certified
+    enclosures of the roots of μ(t)), the pose and joints there, which working
+    modes are singular, whether each candidate is real or spurious for the feasible
+    mode(s), the working modes with their feasibility, and the verdict:
+    singularity-free, singular, infeasible or unknown.
+
+    It also places the path in the workspace: the certified times where it crosses
+    the serial-singularity, ξ and joint-limit surfaces, the number of IK solutions
+    inside the limits between them, the region holding the whole path when it stays in
+    one (its decomposition is computed once and cached), and the certified time at which
+    a path leaves the workspace.
+    """
+    progress = Progress(quiet)
+    with exit_codes():
+        code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
+                    verbose, progress, jobs, plot_dir)
+    sys.exit(int(code))
+
+
+def _exit_code(verdicts: list[str]) -> ExitCode:
+    if any(v in ("singular", "infeasible") for v in verdicts):
+        return ExitCode.SINGULAR
+    if any(v == "unknown" for v in verdicts):
+        return ExitCode.UNKNOWN
+    return ExitCode.SINGULARITY_FREE
+
+
+def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
+         progress, jobs, plot_dir=None):
+    from singcheck import api
+    from singcheck.spec.files import load_robot, load_trajectory
+
+    spec = load_robot(robot)
+    specs = [load_trajectory(path, spec) for path in trajectories]
+    engine = api.elimination_engine(backend_name, timeout, not no_cache, progress.note)
+    with progress.status(f"projecting {spec.name} onto its workspace ({engine.name})"):
+        machine = api.robot_from_spec(spec, cache=not no_cache, engine=engine)
+    projection = machine.projection
+    degree = projection.singularity_surface.total_degree()
+    progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
+    results = []
+    with progress.bar(len(specs)) as advance:
+        for doc in api.check_batch(machine, specs, tolerance=tolerance, jobs=jobs,
+                                   notify=progress.note):
+            results.append(doc)
+            advance(doc["name"], doc["verdict"])
+    if plot_dir:
+        _plot_all(machine, specs, tolerance, plot_dir, progress)
+    code = _exit_code([r["verdict"] for r in results])
+    text = _render(projection, results, tolerance, fmt, verbose, code, to_file=bool(output))
+    if output:
+        from singcheck.atomic import write_atomically
+
+        write_atomically(output, text)
+    else:
+        sys.stdout.write(text)
+    return code
+
+
+def _render(projection, results, tolerance, fmt, verbose, code, to_file: bool) -> str:
+    from singcheck.report import trajectory as rep
+
+    if fmt == "json":
+        return rep.to_json(rep.document(projection, results, tolerance, int(code)))
+    from singcheck.report.console import captured
+
+    robot = rep.robot_json(projection)
+    return captured(lambda console: rep.render_tables(console, robot, results, verbose),
+                    interactive=sys.stdout.isatty() and not to_file, width=140)
+
+
+@cli.command(epilog="""\b
+Examples:
+  singcheck project robots/orthoglide.yaml
+  singcheck project robots/orthoglide.yaml trajectories/heart1.yaml --latex
+""")
+@click.argument("robot", type=click.Path(dir_okay=False))
+@click.argument("trajectory", required=False, type=click.Path(dir_okay=False))
+@click.option("--backend", type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
+              default="auto", envvar="SINGCHECK_BACKEND", show_default=True)
+@click.option("--latex", "as_latex", is_flag=True, help="LaTeX (an align* environment).")
+@click.option("--format", "fmt", type=click.Choice(["text", "json"]), default="text",
+              show_default=True)
+@click.option("--no-epsilon", is_flag=True,
+              help="Skip ε(ρ) (a Gröbner elimination of the pose, slow for large robots).")
+def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
+    """Print the robot's formulas: det A, det B, ξ(X), ε(ρ), the workspace boundary and
+    joint-limit surfaces; with a TRAJECTORY, φ(t) and every joint's parametrisation
+    ρ(t) = P(t) ± √Q(t)/k (the paper's form, in s = sin t and c = cos t)."""
+    with exit_codes():
+        from singcheck import api
+        from singcheck.certify.path import build_path
+        from singcheck.elimination.projection import joint_space_singularities
+        from singcheck.report.formulas import render
+        from singcheck.spec.files import load_robot, load_trajectory
+
+        spec = load_robot(robot)
+        traj = load_trajectory(trajectory, spec) if trajectory else None
+        engine = api.elimination_engine(backend, cache=False)
+        machine = api.robot_from_spec(spec, cache=False, engine=engine)
+        epsilon = None if no_epsilon else joint_space_singularities(machine.model, engine)
+        path = build_path(machine.projection, traj) if traj else None
+        click.echo(render(machine.projection, epsilon, path, "json" if fmt == "json" else
+                          "latex" if as_latex else "text"), nl=False)
+
+
+def _plot_all(machine, specs, tolerance: float, out_dir: str, progress) -> list:
+    try:
+        from singcheck.report.plots import write_figures
+    except ImportError as e:
+        raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
+                        "missing): pip install 'singcheck[plot]'") from None
+    from singcheck import api
+
+    written = []
+    for spec in specs:
+        report = api.check(machine, spec, tolerance=tolerance, regions=False)
+        written += write_figures(report.certificate, out_dir)
+    progress.note(f"wrote {len(written)} figure files to {out_dir}")
+    return written
+
+
+def _plot_html(machine, specs, out_dir: str):
+    try:
+        import plotly  # noqa: F401
+
+        from singcheck.report.plots import write_html
+    except ImportError as e:
+        raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
+                        "pip install 'singcheck[html]'") from None
+    from singcheck import api
+
+    reports = [api.check(machine, s, regions=False).certificate for s in specs]
+    return write_html(reports, os.path.join(out_dir, "singcheck.html"))
+
+
+@cli.command(epilog="""\b
+Examples:
+  singcheck plot robots/orthoglide.yaml trajectories/heart1.yaml --out figures/
+  singcheck plot robots/orthoglide.yaml --regions workspace --slice z=1 --out figures/
+  singcheck plot robots/skew-biglide.yaml --regions workspace --out figures/
+""")
+@click.argument("robot", type=click.Path(dir_okay=False))
+@click.argument("trajectories", nargs=-1, type=click.Path(dir_okay=False))
+@click.option("--out", "out_dir", required=True, type=click.Path(file_okay=False),
+              help="Directory for the PNG and SVG files (created if needed).")
+@click.option("--backend", type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
+              default="auto", envvar="SINGCHECK_BACKEND", show_default=True)
+@click.option("--format", "fmt", type=click.Choice(["files", "html"]), default="files",
+              show_default=True, help="files: PNG and SVG per figure; html: one "
+              "self-contained interactive page (needs singcheck[html]).")
+@click.option("--regions", "spaces", multiple=True,
+              type=click.Choice(["workspace", "jointspace"]),
+              help="Also draw the regions of that space coloured by their number of "
+              "solutions (a plane: a planar robot, or --slice on a spatial one).")
+@click.option("--slice", "slices", multiple=True, metavar="AXIS=VALUE",
+              help="For --regions: fix an axis to an exact rational (repeatable); a pose "
+              "axis slices the workspace, a joint the joint space.")
+@click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
+def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> None:
+    """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
+    roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
+    and the working modes in joint space with the joint-limit box (PNG and SVG).
+    With --regions, draw a plane of the workspace or joint space coloured by the
+    exact number of solutions of each region."""
+    progress = Progress(quiet)
+    with exit_codes():
+        if not trajectories and not spaces:
+            raise click.UsageError("give at least one TRAJECTORY, or --regions SPACE")
+        for space, own in _slices_by_space(robot, spaces, slices).items():
+            for path in _plot_regions(space, robot, own, backend, out_dir, progress):
+                click.echo(str(path))
+        if not trajectories:
+            return
+        from singcheck import api
+        from singcheck.spec.files import load_trajectory
+
+        machine = api.load_robot(robot, backend, notify=progress.note)
+        specs = [load_trajectory(p, machine.spec) for p in trajectories]
+        if fmt == "html":
+            click.echo(str(_plot_html(machine, specs, out_dir)))
+            return
+        for path in _plot_all(machine, specs, 1e-9, out_dir, progress):
+            click.echo(str(path))
+
+
+def _slices_by_space(robot, spaces, slices) -> dict[str, list[str]]:
+    """Each --slice goes to the spaces having its axis (pose axes: the workspace; joints:
+    the joint space); a slice that fits none of the requested spaces is an error."""
+    from singcheck.cli.spaces import parse_slice
+    from singcheck.model.robot import build_model
+    from singcheck.spec.files import load_robot
+
+    if not spaces:
+        return {}
+    model = build_model(load_robot(robot))
+    axes = {"workspace": model.pose, "jointspace": model.joints}
+    out: dict[str, list[str]] = {space: [] for space in dict.fromkeys(spaces)}
+    for text in slices:
+        axis, _ = parse_slice(text)
+        owners = [space for space in out if axis in axes[space]]
+        if not owners:
+            names = ", ".join(a for space in out for a in axes[space])
+            raise click.BadParameter(f"{axis} is not an axis of the requested space(s) "
+                                     f"({names})", param_hint="--slice")
+        for space in owners:
+            out[space].append(text)
+    return out
+
+
+def _plot_regions(space, robot, slices, backend, out_dir, progress) -> list:
+    from singcheck.cli.spaces import compute
+    from singcheck.spaces.analysis import SliceError
+
+    try:
+        from singcheck.report.region_plots import write_region_figure
+    except ImportError as e:  # pragma: no cover - the plot extra is missing
+        raise SpecError(f"plotting needs matplotlib and numpy ({e.name} is missing): "
+                        "pip install 'singcheck[plot]'") from None
+    try:
+        analysis, _ = compute(space, robot, slices, "auto", False, backend, 600, False,
+                              progress)
+    except SliceError as e:
+        raise click.BadParameter(str(e), param_hint="--slice") from None
+    if len(analysis.axes) != 2:
+        raise click.BadParameter(f"the {space} has {len(analysis.axes)} free axes; fix all "
+                                 "but two with --slice", param_hint="--slice")
+    return write_region_figure(analysis, out_dir)
+
+
+@cli.command()
+@click.option("--format", "fmt", type=click.Choice(["table", "json"]), default="table",
+              show_default=True)
+def backends(fmt) -> None:
+    """List the elimination backends: found or not, path, version, tested versions."""
+    from singcheck.elimination.cas import describe_backends
+
+    infos = describe_backends()
+    if fmt == "json":
+        import json
+
+        click.echo(json.dumps([info.__dict__ for info in infos], indent=2))
+        return
+    for info in infos:
+        state = "found" if info.found else "missing"
+        click.echo(f"{info.name:10} {state:8} {info.version or '-':10} {info.path or '-'}")
+        click.echo(f"{'':10} tested with {info.tested}" + (f"; {info.note}" if info.note else ""))
+
+
+@cli.group()
+def cache() -> None:
+    """The on-disk cache of elimination results (SINGCHECK_CACHE_DIR moves it)."""
+
+
+@cache.command("info")
+def cache_info() -> None:
+    """Where the cache is, and how many entries and bytes it holds."""
+    from singcheck.elimination.cache import EliminationCache
+
+    c = EliminationCache()
+    entries = c.entries()
+    size = sum(p.stat().st_size for p in entries)
+    click.echo(f"directory: {c.directory}\nentries:   {len(entries)}\nbytes:     {size}")
+
+
+@cache.command("clear")
+def cache_clear() -> None:
+    """Delete every cached elimination result."""
+    from singcheck.elimination.cache import EliminationCache
+
+    click.echo(f"removed {EliminationCache().clear()} entries")
+
+
+def _register_space_commands() -> None:
+    from singcheck.cli.spaces import jointspace, workspace
+
+    cli.add_command(workspace)
+    cli.add_command(jointspace)
+
+
+_register_space_commands()
+
+
+def main() -> None:
+    """Console-script entry point: never lets a traceback reach the user."""
+    try:
+        cli.main(standalone_mode=False)
+    except click.exceptions.Abort:
+        fail("interrupted", ExitCode.INTERRUPTED)
+    except click.ClickException as e:
+        e.show()
+        sys.exit(int(ExitCode.USAGE))
+    except KeyboardInterrupt:
+        fail("interrupted", ExitCode.INTERRUPTED)
+    except SystemExit:
+        raise
+    except Exception as e:  # a bug: say so in one line, keep the traceback for --debug users
+        if os.environ.get("SINGCHECK_DEBUG"):
+            raise
+        fail(f"internal error: {type(e).__name__}: {e} (set SINGCHECK_DEBUG=1 for the "
+              "traceback, and please report it)", ExitCode.INTERNAL)

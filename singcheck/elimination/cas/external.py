@@ -1,0 +1,163 @@
+"""Singular and Macaulay2 as subprocesses: compile → run → parse, then re-check.
+
+Each backend is the same three stages with different pure pieces (the script from
+:mod:`singcheck.cas.scripts`, the argv below) and one shared funnel
+(:func:`singcheck.cas.process.run_program`).  The generated script is written to a
+temporary directory that is removed afterwards; no user init file is read
+(``Singular -q -t --no-rc``, ``M2 --script``).
+"""
+
+from __future__ import annotations
+
+import glob
+import os
+import shutil
+import sys
+import sysconfig
+import tempfile
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+
+from singcheck.elimination.cas.process import run_program
+from singcheck.elimination.cas.scripts import macaulay2_script, parse_result, singular_script
+from singcheck.elimination.requests import EliminationRequest, EliminationResult
+from singcheck.errors import BackendError
+
+DEFAULT_TIMEOUT = 600.0
+
+
+def library_path(filename: str) -> str:
+    """Absolute path of a file of ``backends/`` (installed as ``singcheck.cas_library``)."""
+    return str(resources.files("singcheck.cas_library").joinpath(filename))
+
+
+def _passagemath_singular() -> str | None:
+    """The ``Singular`` binary shipped by PyPI's passagemath-singular, if installed."""
+    roots = {sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]}
+    roots.update(p for p in sys.path if p.endswith("site-packages"))
+    for root in roots:
+        for path in glob.glob(os.path.join(root, "sage_wheels", "bin", "Singular")):
+            if os.access(path, os.X_OK):
+                return path
+    return None
+
+
+@dataclass(frozen=True)
+class ExternalCAS:
+    name: str  # backend name on the command line
+    program: str  # executable looked up on PATH
+    tested_versions: str
+    install_hint: str
+
+    def find(self) -> str | None:
+        found = shutil.which(self.program)
+        if found is None and self.name == "singular":
+            found = _passagemath_singular()
+        return found
+
+    def argv(self, executable: str, script_path: str) -> list[str]:
+        if self.name == "singular":
+            return [executable, "-q", "-t", "--no-rc", script_path]
+        return [executable, "--script", script_path]
+
+    def version_argv(self, executable: str) -> list[str]:
+        return [executable, "--version"]
+
+    def script(self, request: EliminationRequest) -> str:
+        if self.name == "singular":
+            return singular_script(request, library_path("singcheck.lib"))
+        return macaulay2_script(request, library_path("singcheck.m2"))
+
+
+SINGULAR = ExternalCAS(
+    "singular", "Singular", "4.3.1 (Debian bookworm)",
+    "install it with `apt-get install singular` (Debian/Ubuntu), or without root with "
+    "`pip install passagemath-singular` (ships a Singular binary)")
+MACAULAY2 = ExternalCAS(
+    "macaulay2", "M2", "1.21 (Debian bookworm)",
+    "install it with `apt-get install macaulay2` (Debian/Ubuntu)")
+
+
+def _binary_identity(executable: str) -> str:
+    real = os.path.realpath(executable)
+    st = os.stat(real)
+    return f"{real}:{st.st_size}:{st.st_mtime_ns}"
+
+
+@cache
+def cas_version(cas: ExternalCAS, executable: str) -> str:
+    """The CAS version, remembered on disk per binary (path, size, mtime) so that a
+    warm run starts no CAS process at all."""
+    import json
+
+    from singcheck.elimination.cache import cache_dir
+
+    memo = cache_dir() / "versions.json"
+    ident = _binary_identity(executable)
+    try:
+        known = json.loads(memo.read_text(encoding="utf-8"))
+        if isinstance(known.get(ident), str):
+            return known[ident]
+    except (OSError, ValueError, AttributeError):
+        known = {}
+    version = _ask_version(cas, executable)
+    try:
+        from singcheck.atomic import write_atomically
+
+        write_atomically(memo, json.dumps({**(known if isinstance(known, dict) else {}),
+                                           ident: version}))
+    except OSError:
+        pass
+    return version
+
+
+def _ask_version(cas: ExternalCAS, executable: str) -> str:
+    run = run_program(cas.version_argv(executable), timeout=60)
+    text = (run.stdout or run.stderr).strip().splitlines()
+    if not text:
+        raise BackendError(f"{cas.program} --version printed nothing")
+    first = text[0]
+    if cas.name == "singular" and "version" in first:
+        return first.split("version", 1)[1].split("(")[0].strip()
+    return first.strip()
+
+
+class ExternalBackend:
+    """An elimination backend that runs a CAS program once per request."""
+
+    def __init__(self, cas: ExternalCAS, executable: str | None = None,
+                 timeout: float = DEFAULT_TIMEOUT) -> None:
+        self.cas = cas
+        self.name = cas.name
+        found = executable or cas.find()
+        if found is None:
+            raise BackendError(f"backend {cas.name}: {cas.program} was not found; "
+                               f"{cas.install_hint}")
+        self.executable = found
+        self.timeout = timeout
+
+    def version(self) -> str:
+        return cas_version(self.cas, self.executable)
+
+    def script(self, request: EliminationRequest) -> str:
+        return self.cas.script(request)
+
+    def cache_identity(self, request: EliminationRequest) -> str:
+        """What determines the result: the script and the library it loads."""
+        library = "singcheck.lib" if self.name == "singular" else "singcheck.m2"
+        with open(library_path(library), encoding="utf-8") as f:
+            return self.script(request) + "\n" + f.read()
+
+    def eliminate(self, request: EliminationRequest) -> EliminationResult:
+        script = self.script(request)
+        with tempfile.TemporaryDirectory(prefix="singcheck-") as tmp:
+            suffix = "sing" if self.name == "singular" else "m2"
+            path = os.path.join(tmp, f"{request.label}.{suffix}")
+            with open(path, "w", encoding="utf-8") as f:
+                f.write(script)
+            run = run_program(self.cas.argv(self.executable, path), self.timeout, cwd=tmp)
+        polys = parse_result(self.cas.program, run.stdout, run.stderr, request)
+        if run.returncode != 0:
+            raise BackendError(f"{self.cas.program} exited with status {run.returncode}")
+        return EliminationResult(request, polys, f"{self.cas.program} eliminate", self.name)

@@ -1,0 +1,185 @@
+"""The paper's formulas, written out: det A, det B, ξ, ε, the limit surfaces and ρ(t).
+
+Pure functions from the exact model to text (plain or LaTeX) and JSON-ready dicts.  The
+joint-space parametrisation of a working mode is the paper's form
+``ρ_i = P(t) ± (1/k)·√Q(t)`` with P rational and Q an integer polynomial in s = sin t,
+c = cos t (and t): from the leg constraint ``a ρ² + b ρ + c = 0``,
+``P = -b/(2a)`` and ``(b² - 4ac)/(4a²) = Q/k²`` with the smallest such integer k.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+
+from flint import fmpq, fmpq_mpoly
+
+from singcheck.certify.path import PathModel
+
+
+@dataclass(frozen=True)
+class JointFormula:
+    joint: str
+    centre: fmpq_mpoly  # P(t)
+    scale: Fraction  # 1/k (0 for a linear leg)
+    radicand: fmpq_mpoly | None  # Q(t), integer coefficients
+
+    def text(self, sign: str = "±") -> str:
+        if self.radicand is None:
+            return f"{self.joint} = {self.centre}"
+        k = "" if self.scale == 1 else f"{self.scale}*"
+        return f"{self.joint} = {self.centre} {sign} {k}sqrt({self.radicand})"
+
+    def latex(self) -> str:
+        if self.radicand is None:
+            return f"{_latex_name(self.joint)} = {latex(self.centre)}"
+        k = "" if self.scale == 1 else _latex_fraction(self.scale)
+        return (f"{_latex_name(self.joint)} = {latex(self.centre)} \\pm {k}"
+                f"\\sqrt{{{latex(self.radicand)}}}")
+
+
+def _square_part(n: int) -> tuple[int, int]:
+    """(m, r) with n = m² r and r squarefree-ish (trial division; n small here)."""
+    m, r, p = 1, n, 2
+    while p * p <= r:
+        while r % (p * p) == 0:
+            r //= p * p
+            m *= p
+        p += 1 if p == 2 else 2
+    return m, r
+
+
+def joint_formula(path: PathModel, leg_index: int) -> JointFormula:
+    leg = path.legs[leg_index]
+    joint = leg.leg.joint
+    if leg.leg.degree == 1:
+        b, c = leg.coefficients
+        return JointFormula(joint, -c / b.leading_coefficient(), Fraction(0), None)
+    a, b, _ = leg.coefficients
+    a0 = a.leading_coefficient()
+    centre = -b / (2 * a0)
+    r = leg.discriminant / (4 * a0 * a0)  # ρ = centre ± sqrt(r)
+    den = 1
+    for _, coeff in r.terms():
+        den = den * int(fmpq(coeff).q) // math.gcd(den, int(fmpq(coeff).q))
+    m_den, rest = _square_part(den)
+    k = m_den * rest  # k² is a multiple of den
+    q = r * (k * k)
+    content = 0
+    for _, coeff in q.terms():
+        content = math.gcd(content, int(fmpq(coeff).p))
+    m, _ = _square_part(content)
+    return JointFormula(joint, centre, Fraction(m, k), q / (m * m))
+
+
+def _latex_fraction(q: Fraction) -> str:
+    if q.denominator == 1:
+        return str(q.numerator)
+    sign = "-" if q < 0 else ""
+    return f"{sign}\\frac{{{abs(q.numerator)}}}{{{q.denominator}}}"
+
+
+_LATEX_NAMES = {"s": "\\mathbf{s}", "c": "\\mathbf{c}", "t": "t"}
+
+
+def _latex_name(name: str) -> str:
+    if name in _LATEX_NAMES:
+        return _LATEX_NAMES[name]
+    head = name.rstrip("0123456789")
+    digits = name[len(head):]
+    greek = {"rho": "\\rho", "xi": "\\xi", "theta": "\\theta"}.get(head, head)
+    return f"{greek}_{{{digits}}}" if digits else greek
+
+
+def latex(p: fmpq_mpoly) -> str:
+    """A polynomial in LaTeX, highest terms first (``\\frac`` coefficients)."""
+    if p.is_zero():
+        return "0"
+    names = p.context().names()
+    out = []
+    for exps, coeff in p.terms():
+        c = Fraction(int(fmpq(coeff).p), int(fmpq(coeff).q))
+        factors = "".join(
+            _latex_name(v) + (f"^{{{e}}}" if e > 1 else "") for v, e in zip(names, exps,
+                                                                           strict=True) if e)
+        sign = "-" if c < 0 else "+"
+        c = abs(c)
+        coef = "" if c == 1 and factors else _latex_fraction(c)
+        out.append(f"{sign} {coef}{factors}".rstrip())
+    text = " ".join(out)
+    return text[2:] if text.startswith("+ ") else "-" + text[2:]
+
+
+def robot_formulas(projection, epsilon: fmpq_mpoly | None) -> dict:
+    """Every robot-level formula as plain text, keyed for JSON and display."""
+    model = projection.model
+    factors = [(f, int(m)) for f, m in projection.singularity_surface_as_computed.factor()[1]]
+    return {
+        "det_A": model.det_A,
+        "det_B": model.det_B,
+        "singularity_surface": projection.singularity_surface,
+        "singularity_surface_factors": factors,
+        "joint_space_singularities": epsilon,
+        "workspace_boundary": {leg.joint: d for leg, d in
+                               zip(model.legs, projection.workspace_boundary, strict=True)},
+        "joint_limit_surfaces": {f"{s.joint} = {s.value}": s.polynomial
+                                 for s in projection.joint_limit_surfaces},
+    }
+
+
+def render(projection, epsilon, path: PathModel | None, style: str) -> str:
+    """``style``: "text", "latex" or "json"."""
+    import json
+
+    f = robot_formulas(projection, epsilon)
+    model = projection.model
+    joints = [joint_formula(path, i) for i in range(len(path.legs))] if path else []
+    if style == "json":
+        doc = {
+            "robot": model.name, "joints": list(model.joints), "pose": list(model.pose),
+            "det_A": str(f["det_A"]), "det_B": str(f["det_B"]),
+            "singularity_surface": str(f["singularity_surface"]),
+            "singularity_surface_degree": int(f["singularity_surface"].total_degree()),
+            "singularity_surface_factors": [{"factor": str(p), "multiplicity": m}
+                                            for p, m in f["singularity_surface_factors"]],
+            "joint_space_singularities": None if epsilon is None else str(epsilon),
+            "workspace_boundary": {k: str(v) for k, v in f["workspace_boundary"].items()},
+            "joint_limit_surfaces": {k: str(v) for k, v in f["joint_limit_surfaces"].items()},
+        }
+        if path:
+            doc["trajectory"] = {
+                "name": path.trajectory.name,
+                "pose": {v: str(p) for v, p in zip(model.pose, path.phi, strict=True)},
+                "joints": {j.joint: {"centre": str(j.centre), "scale": str(j.scale),
+                                     "radicand": None if j.radicand is None else
+                                     str(j.radicand)} for j in joints},
+                "notation": "s = sin t, c = cos t; joint = centre ± scale·sqrt(radicand)",
+            }
+        return json.dumps(doc, indent=2) + "\n"
+    show = latex if style == "latex" else str
+    eq = " &= " if style == "latex" else " = "
+    nl = " \\\\\n" if style == "latex" else "\n"
+    lines = [f"det A{eq}{show(f['det_A'])}", f"det B{eq}{show(f['det_B'])}",
+             f"xi(X){eq}{show(f['singularity_surface'])}"]
+    if epsilon is not None:
+        lines.append(f"epsilon(rho){eq}{show(epsilon)}")
+    lines += [f"workspace boundary ({j}){eq}{show(d)}"
+              for j, d in f["workspace_boundary"].items()]
+    lines += [f"limit surface ({k}){eq}{show(p)}" for k, p in f["joint_limit_surfaces"].items()]
+    if path:
+        lines += [f"{v}(t){eq}{show(p)}" for v, p in zip(model.pose, path.phi, strict=True)]
+        lines += [j.latex() if style == "latex" else j.text() for j in joints]
+    if style == "latex":
+        body = nl.join(line.replace(" &= ", " &= ", 1) if " &= " in line
+                       else line.replace(" = ", " &= ", 1) for line in lines)
+        return ("% s = sin t, c = cos t\n\\begin{align*}\n" + body + "\n\\end{align*}\n")
+    degrees = ", ".join(f"degree {int(p.total_degree())}" + (f" (power {m})" if m > 1 else "")
+                        for p, m in f["singularity_surface_factors"])
+    header = (f"robot {model.name}: joints {', '.join(model.joints)}; pose "
+              f"{', '.join(model.pose)}\nξ as computed by {projection.backend}: factors of "
+              f"{degrees}; singcheck uses their squarefree product (degree "
+              f"{int(f['singularity_surface'].total_degree())})\n")
+    if path:
+        header += f"trajectory {path.trajectory.name}: s = sin t, c = cos t\n"
+    return header + "\n".join(lines) + "\n"

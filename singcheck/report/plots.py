@@ -1,0 +1,328 @@
+"""The paper's figures, from the same certified report (matplotlib, Agg: no display).
+
+The curves are drawn from floating-point samples, which is fine for a picture; every
+mark on them (candidate roots, their status, singular times, feasible modes) comes
+from the certified :class:`~singcheck.certify.TrajectoryReport`, never from the samples.
+
+Figures (each written as PNG and SVG):
+  1. ``mu``: μ(t) = ξ(φ(t)) with the candidates, real and spurious, labelled.
+  2. ``detA``: det A along each feasible working mode, its proven zeros marked.
+  3. ``workspace``: the path in the workspace with the singular points and the surface
+     ξ(X) = 0 near it (marching cubes, or a contour for a planar robot).
+  4. ``jointspace``: the path's image in joint space for every real working mode, with
+     the joint-limit box; the feasible mode(s) drawn bold.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from singcheck.certify.classification import TrajectoryReport
+
+FIGURES = ("mu", "detA", "workspace", "jointspace")
+
+
+def numpy_polynomial(poly):
+    """A vectorised float evaluator of an exact polynomial (for drawing only)."""
+    terms = [(float(c), [(i, int(e)) for i, e in enumerate(exps) if e])
+             for exps, c in poly.terms()]
+    nvars = poly.context().nvars()
+    top = [max((int(e[i]) for e, _ in poly.terms()), default=0) for i in range(nvars)]
+
+    def f(arrays):
+        arrays = [np.asarray(a, dtype=float) for a in arrays]
+        shape = np.broadcast(*arrays).shape if arrays else ()
+        powers = []
+        for a, m in zip(arrays, top, strict=True):
+            p = [None, a]
+            for _ in range(2, m + 1):
+                p.append(p[-1] * a)
+            powers.append(p)
+        total = np.zeros(shape)
+        for coeff, factors in terms:
+            term = np.full(shape, coeff)
+            for i, e in factors:
+                term = term * powers[i][e]
+            total = total + term
+        return total
+
+    return f
+
+
+@dataclass
+class FigureData:
+    t: np.ndarray
+    mu: np.ndarray  # normalised to max |μ| = 1 on the samples
+    candidates: list[dict]  # t, status, label, interval
+    pose: list[np.ndarray]
+    joints: dict[str, list[np.ndarray]]  # mode -> per-joint values (NaN where not real)
+    det_a: dict[str, np.ndarray]  # feasible mode -> det A samples
+    singular: dict[str, list[float]]  # feasible mode -> certified singular times
+    feasible: list[str]
+    limits: dict[str, tuple[float, float]]
+    names: dict[str, list[str]] = field(default_factory=dict)
+
+
+def figure_data(report: TrajectoryReport, samples: int = 2000) -> FigureData:
+    """Everything the figures draw, as arrays and certified marks."""
+    path = report.path
+    model = path.projection.model
+    lo, hi = float(path.trajectory.range.start), float(path.trajectory.range.end)
+    t = np.linspace(lo, hi, samples)
+    tsc = [t, np.sin(t), np.cos(t)]
+    pose = [numpy_polynomial(p)(tsc) for p in path.phi]
+    mu = numpy_polynomial(path.mu)(tsc)
+    mu = mu / (np.max(np.abs(mu)) or 1.0)
+    legs = []
+    for leg in path.legs:
+        values = [numpy_polynomial(c)(tsc) for c in leg.coefficients]
+        if len(values) == 2:
+            legs.append({"o": -values[1] / values[0]})
+        else:
+            a, b, c = values
+            with np.errstate(invalid="ignore"):
+                root = np.sqrt(b * b - 4 * a * c)
+            legs.append({"+": (-b + root) / (2 * a), "-": (-b - root) / (2 * a)})
+    joints = {m.label: [legs[i][ch] for i, ch in enumerate(m.label)] for m in report.modes}
+    det = numpy_polynomial(model.det_A)
+    feasible = [m.label for m in report.modes if m.feasible]
+    det_a = {label: det([*joints[label], *pose]) for label in feasible}
+    singular = {m.label: [float(c.t.mid()) for c in m.singular_times] for m in report.modes
+                if m.feasible}
+    candidates = []
+    for i, c in enumerate(report.candidates, 1):
+        candidates.append({"t": float(c.t.mid()), "status": c.status, "label": f"s{i}",
+                           "interval": (float(c.t.lower()), float(c.t.upper())),
+                           "pose": [float(b.mid()) for b in c.pose]})
+    limits = {j: (float(a), float(b)) for j, (a, b) in model.spec.joint_limits.items()}
+    return FigureData(t, mu, candidates, pose, joints, det_a, singular, feasible, limits,
+                      {"pose": list(model.pose), "joints": list(model.joints),
+                       "parameter": [path.trajectory.parameter]})
+
+
+_STATUS_STYLE = {"real": ("red", "o"), "spurious": ("green", "x"), "unknown": ("magenta", "s")}
+
+
+def _mu_figure(plt, d: FigureData, title: str):
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(d.t, d.mu, color="black", lw=1)
+    ax.axhline(0, color="grey", lw=0.5)
+    for i, c in enumerate(d.candidates):
+        color, marker = _STATUS_STYLE.get(c["status"], ("magenta", "s"))
+        ax.plot([c["t"]], [0], marker=marker, color=color, ms=8, ls="none")
+        ax.annotate(f"{c['label']} ({c['status']})\nt={c['t']:.6f}", (c["t"], 0),
+                    textcoords="offset points", xytext=(0, 14 if i % 2 else -30),
+                    ha="center", fontsize=7)
+    ax.set_xlabel(d.names["parameter"][0])
+    ax.set_ylabel("μ(t) / max|μ|")
+    ax.set_title(title)
+    return fig
+
+
+def _det_figure(plt, d: FigureData, title: str):
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for label in d.feasible:
+        ax.plot(d.t, d.det_a[label], lw=1, label=f"mode {label}")
+        ts = d.singular[label]
+        if ts:
+            ax.plot(ts, [0] * len(ts), "o", color="red", ms=7, label=f"proven zeros ({label})")
+    ax.axhline(0, color="grey", lw=0.5)
+    ax.set_xlabel(d.names["parameter"][0])
+    ax.set_ylabel("det A")
+    ax.set_title(title)
+    if d.feasible:
+        ax.legend(fontsize=7)
+    return fig
+
+
+def _workspace_figure(plt, d: FigureData, xi, title: str):
+    pose = d.names["pose"]
+    f = numpy_polynomial(xi)
+    if len(pose) == 2:
+        fig, ax = plt.subplots(figsize=(6, 5))
+        (x0, x1), (y0, y1) = _box(d.pose[0]), _box(d.pose[1])
+        gx, gy = np.meshgrid(np.linspace(x0, x1, 300), np.linspace(y0, y1, 300))
+        ax.contour(gx, gy, f([gx, gy]), levels=[0], colors="orange")
+        ax.plot(d.pose[0], d.pose[1], color="black", lw=1)
+        _mark_points(ax, d, 2)
+        ax.set_xlabel(pose[0])
+        ax.set_ylabel(pose[1])
+    else:
+        from skimage.measure import marching_cubes
+
+        fig = plt.figure(figsize=(6, 5))
+        ax = fig.add_subplot(projection="3d")
+        boxes = [_box(p) for p in d.pose[:3]]
+        n = 48
+        axes = [np.linspace(a, b, n) for a, b in boxes]
+        grid = list(np.meshgrid(*axes, indexing="ij"))
+        values = f(grid + [np.zeros_like(grid[0])] * (len(pose) - 3))
+        if values.min() < 0 < values.max():
+            verts, faces, _, _ = marching_cubes(values, 0.0)
+            verts = np.array([b[0] for b in boxes]) + verts * np.array(
+                [(b[1] - b[0]) / (n - 1) for b in boxes])
+            ax.plot_trisurf(verts[:, 0], verts[:, 1], faces, verts[:, 2], color="orange",
+                            alpha=0.35, lw=0)
+        ax.plot(d.pose[0], d.pose[1], d.pose[2], color="black", lw=1.2)
+        _mark_points(ax, d, 3)
+        ax.set_xlabel(pose[0])
+        ax.set_ylabel(pose[1])
+        ax.set_zlabel(pose[2])
+    ax.set_title(title)
+    return fig
+
+
+def _box(values: np.ndarray, margin: float = 0.25) -> tuple[float, float]:
+    lo, hi = float(np.min(values)), float(np.max(values))
+    pad = max(margin, 0.15 * (hi - lo))
+    return lo - pad, hi + pad
+
+
+def _mark_points(ax, d: FigureData, dims: int) -> None:
+    for c in d.candidates:
+        color, marker = _STATUS_STYLE.get(c["status"], ("magenta", "s"))
+        ax.plot(*[[v] for v in c["pose"][:dims]], marker=marker, color=color, ms=8, ls="none")
+
+
+def _joint_figure(plt, d: FigureData, title: str):
+    names = d.names["joints"]
+    three = len(names) >= 3
+    fig = plt.figure(figsize=(6, 5))
+    ax = fig.add_subplot(projection="3d") if three else fig.add_subplot()
+    for label, values in d.joints.items():
+        bold = label in d.feasible
+        coords = values[:3] if three else values[:2]
+        ax.plot(*coords, lw=2.5 if bold else 0.8, alpha=1 if bold else 0.5,
+                label=f"{label}{' (feasible)' if bold else ''}")
+    if all(j in d.limits for j in names[:3 if three else 2]):
+        _limit_box(ax, [d.limits[j] for j in names[:3 if three else 2]])
+    ax.set_xlabel(names[0])
+    ax.set_ylabel(names[1])
+    if three:
+        ax.set_zlabel(names[2])
+    ax.legend(fontsize=6, loc="upper left")
+    ax.set_title(title)
+    return fig
+
+
+def _limit_box(ax, limits) -> None:
+    from itertools import product
+
+    corners = list(product(*limits))
+    for a in corners:
+        for b in corners:
+            if sum(x != y for x, y in zip(a, b, strict=True)) == 1 and a < b:
+                ax.plot(*[[x, y] for x, y in zip(a, b, strict=True)], color="grey", lw=0.6)
+
+
+def write_figures(report: TrajectoryReport, out_dir: str | Path,
+                  formats: tuple[str, ...] = ("png", "svg"), dpi: int = 120) -> list[Path]:
+    """Write the four figures for one trajectory; returns the files written."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    d = figure_data(report)
+    robot = report.path.projection.model.name
+    name = report.name
+    makers = {
+        "mu": lambda: _mu_figure(plt, d, f"{robot} · {name}: μ(t) and its certified roots"),
+        "detA": lambda: _det_figure(plt, d, f"{robot} · {name}: det A along feasible modes"),
+        "workspace": lambda: _workspace_figure(
+            plt, d, report.path.projection.singularity_surface,
+            f"{robot} · {name}: path and ξ(X) = 0"),
+        "jointspace": lambda: _joint_figure(plt, d, f"{robot} · {name}: working modes"),
+    }
+    written = []
+    for key in FIGURES:
+        fig = makers[key]()
+        for fmt in formats:
+            target = out / f"{name}-{key}.{fmt}"
+            fig.savefig(target, dpi=dpi, bbox_inches="tight")
+            written.append(target)
+        plt.close(fig)
+    return written
+
+
+def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
+    """One self-contained interactive page (plotly, its JavaScript inlined once) with
+    the same four figures for every trajectory."""
+    import plotly.graph_objects as go
+
+    from singcheck.atomic import write_atomically
+
+    parts = []
+    first = True
+    for report in reports:
+        d = figure_data(report)
+        robot = report.path.projection.model.name
+        figs = []
+        mu = go.Figure(go.Scatter(x=d.t, y=d.mu, mode="lines", name="μ(t)/max|μ|"))
+        for c in d.candidates:
+            color = _STATUS_STYLE.get(c["status"], ("magenta", "s"))[0]
+            mu.add_trace(go.Scatter(x=[c["t"]], y=[0], mode="markers", name=f"{c['label']} "
+                                    f"{c['status']}", marker={"color": color, "size": 10},
+                                    hovertext=f"t ∈ [{c['interval'][0]:.12g}, "
+                                              f"{c['interval'][1]:.12g}]"))
+        mu.update_layout(title=f"{robot} · {report.name}: μ(t) and its certified roots")
+        figs.append(mu)
+        det = go.Figure()
+        for label in d.feasible:
+            det.add_trace(go.Scatter(x=d.t, y=d.det_a[label], mode="lines", name=label))
+            det.add_trace(go.Scatter(x=d.singular[label], y=[0] * len(d.singular[label]),
+                                     mode="markers", name=f"proven zeros ({label})",
+                                     marker={"color": "red", "size": 10}))
+        det.update_layout(title=f"{robot} · {report.name}: det A along feasible modes")
+        figs.append(det)
+        pose = d.names["pose"]
+        if len(pose) >= 3:
+            ws = go.Figure(go.Scatter3d(x=d.pose[0], y=d.pose[1], z=d.pose[2], mode="lines",
+                                        name="path"))
+            for c in d.candidates:
+                ws.add_trace(go.Scatter3d(x=[c["pose"][0]], y=[c["pose"][1]],
+                                          z=[c["pose"][2]], mode="markers",
+                                          name=f"{c['label']} {c['status']}",
+                                          marker={"color": _STATUS_STYLE.get(
+                                              c["status"], ("magenta",))[0]}))
+            ws.update_layout(scene={"xaxis_title": pose[0], "yaxis_title": pose[1],
+                                    "zaxis_title": pose[2]})
+        else:
+            ws = go.Figure(go.Scatter(x=d.pose[0], y=d.pose[1], mode="lines", name="path"))
+            for c in d.candidates:
+                ws.add_trace(go.Scatter(x=[c["pose"][0]], y=[c["pose"][1]], mode="markers",
+                                        name=f"{c['label']} {c['status']}",
+                                        marker={"color": _STATUS_STYLE.get(
+                                            c["status"], ("magenta",))[0]}))
+            ws.update_layout(xaxis_title=pose[0], yaxis_title=pose[1])
+        ws.update_layout(title=f"{robot} · {report.name}: path and singular points")
+        figs.append(ws)
+        js = go.Figure()
+        names = d.names["joints"]
+        for label, values in d.joints.items():
+            width = 6 if label in d.feasible else 2
+            if len(names) >= 3:
+                js.add_trace(go.Scatter3d(x=values[0], y=values[1], z=values[2],
+                                          mode="lines", name=label, line={"width": width}))
+            else:
+                js.add_trace(go.Scatter(x=values[0], y=values[1], mode="lines", name=label,
+                                        line={"width": width}))
+        js.update_layout(title=f"{robot} · {report.name}: working modes in joint space")
+        if len(names) >= 3:
+            js.update_layout(scene={"xaxis_title": names[0], "yaxis_title": names[1],
+                                    "zaxis_title": names[2]})
+        else:
+            js.update_layout(xaxis_title=names[0], yaxis_title=names[1])
+        figs.append(js)
+        for fig in figs:
+            parts.append(fig.to_html(full_html=False, include_plotlyjs=first))
+            first = False
+    page = ("<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>singcheck figures"
+            "</title></head><body>\n" + "\n".join(parts) + "\n</body></html>\n")
+    write_atomically(target, page)
+    return Path(target)

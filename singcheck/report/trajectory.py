@@ -1,0 +1,199 @@
+"""Rendering of certification reports: a rich table for people, JSON for programs.
+
+The JSON document is described in the README ("JSON output"); bump
+``SCHEMA_VERSION`` on any incompatible change.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from singcheck.algebra.intervals import endpoints
+from singcheck.certify.classification import TrajectoryReport
+from singcheck.elimination.projection import RobotProjection
+from singcheck.version import __version__
+
+SCHEMA_VERSION = 1
+
+_VERDICT_STYLE = {
+    "singularity-free": "bold green",
+    "singular": "bold red",
+    "infeasible": "bold yellow",
+    "unknown": "bold magenta",
+}
+
+
+def _num(x: float | None, digits: int = 6) -> str:
+    return "—" if x is None else f"{x:.{digits}g}"
+
+
+def _interval(ball) -> list[float]:
+    lo, hi = endpoints(ball)
+    return [lo, hi]
+
+
+def candidate_json(report: TrajectoryReport, c) -> dict[str, Any]:
+    pose_names = report.path.projection.model.pose
+    return {
+        "t": float(c.t.mid()),
+        "t_interval": _interval(c.t),
+        "pose": {v: float(b.mid()) for v, b in zip(pose_names, c.pose, strict=True)},
+        "joints": c.joints,
+        "singular_modes": c.singular_modes,
+        "status": c.status,
+        "modes": [{"mode": m.mode, "status": m.status, "proof": m.proof} for m in c.modes],
+    }
+
+
+def _trajectory_head(spec) -> dict[str, Any]:
+    return {
+        "name": spec.name,
+        "path": spec.path,
+        "parameter": spec.parameter,
+        "range": [str(spec.range.start), str(spec.range.end)],
+    }
+
+
+def time_limited_json(spec, reason: str) -> dict[str, Any]:
+    """The trajectory object of a certification stopped by its time limit: unknown."""
+    return {**_trajectory_head(spec), "verdict": "unknown", "reason": reason,
+            "root_isolation": None, "candidates": [], "working_modes": [], "undecided": []}
+
+
+def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
+    return {
+        **_trajectory_head(report.path.trajectory),
+        "verdict": report.verdict,
+        "reason": report.reason,
+        "root_isolation": report.root_method,
+        "candidates": [candidate_json(report, c) for c in report.candidates],
+        "working_modes": [
+            {
+                "label": m.label,
+                "feasible": m.feasible,
+                "status": m.status,
+                "reason": m.reason,
+                "joints_at_start": m.joints_at_start,
+                "singular_times": [float(c.t.mid()) for c in m.singular_times],
+            }
+            for m in report.modes
+        ],
+        "undecided": [{"t_interval": _interval(t), "reason": r} for t, r in report.undecided],
+    }
+
+
+def workspace_json(w) -> dict[str, Any]:
+    """The path against the workspace's regions (:mod:`singcheck.path_regions`)."""
+    return {
+        "one_region": w.one_region,
+        "region": w.region,
+        "crossings": [{"t_interval": _interval(c.t), "surfaces": list(c.surfaces)}
+                      for c in w.crossings],
+        "ik_counts": [s.count for s in w.stretches],
+        "exit_time_interval": None if w.exit_time is None else _interval(w.exit_time),
+        "undecided": w.undecided,
+    }
+
+
+def workspace_line(w: dict[str, Any]) -> str:
+    """One sentence for the table report."""
+    counts = w["ik_counts"]
+    if w["one_region"] is None:
+        return "workspace: crossings not all decided: " + "; ".join(w["undecided"])
+    if w["one_region"]:
+        where = f"region {w['region']}" if w["region"] else "one region of the workspace"
+        return (f"workspace: the whole path lies in {where} "
+                f"({counts[0]} IK solution(s) inside the joint limits all along)")
+    text = (f"workspace: the path crosses the discriminant variety {len(w['crossings'])} "
+            f"time(s); IK solutions inside the limits along it: "
+            + " → ".join("?" if c is None else str(c) for c in counts))
+    if w["exit_time_interval"]:
+        lo, hi = w["exit_time_interval"]
+        text += f"; it leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"
+    return text
+
+
+def robot_json(projection: RobotProjection) -> dict[str, Any]:
+    model = projection.model
+    return {"name": model.name, "path": model.spec.path, "joints": list(model.joints),
+            "pose": list(model.pose)}
+
+
+def document(projection: RobotProjection, trajectories: list[dict[str, Any]],
+             tolerance: float, exit_code: int) -> dict[str, Any]:
+    return {
+        "schema_version": SCHEMA_VERSION,
+        "singcheck_version": __version__,
+        "robot": robot_json(projection),
+        "backend": projection.backend,
+        "elimination_method": projection.method,
+        "singularity_surface_degree": int(projection.singularity_surface.total_degree()),
+        "tolerance": tolerance,
+        "trajectories": trajectories,
+        "exit_code": exit_code,
+    }
+
+
+def to_json(doc: dict[str, Any]) -> str:
+    return json.dumps(doc, indent=2, ensure_ascii=False) + "\n"
+
+
+def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, Any]],
+                  verbose: bool = False) -> None:
+    """Print one candidates table and one working-modes table per trajectory.
+
+    Works from the JSON-shaped dicts of :func:`trajectory_json`, so reports computed in
+    worker processes render the same way.
+    """
+    from rich.table import Table
+
+    joints, pose = robot["joints"], robot["pose"]
+    for t in trajectories:
+        title = (f"{robot['name']} · {t['name']}  ({t['parameter']} ∈ [{t['range'][0]}, "
+                 f"{t['range'][1]}], roots by {t['root_isolation']})")
+        feasible = [m["label"] for m in t["working_modes"] if m["feasible"]]
+        if t["candidates"]:
+            table = Table(title=title, title_justify="left")
+            for col in ("#", t["parameter"], *pose,
+                        *[j + (f" [{feasible[0]}]" if feasible else "") for j in joints]):
+                table.add_column(col, justify="right")
+            table.add_column("singular modes")
+            table.add_column("status")
+            for i, c in enumerate(t["candidates"], 1):
+                shown = c["joints"].get(feasible[0], {}) if feasible else {}
+                style = {"real": "red", "spurious": "green"}.get(c["status"], "magenta")
+                table.add_row(str(i), _num(c["t"], 9), *[_num(c["pose"][v], 4) for v in pose],
+                              *[_num(shown.get(j), 4) for j in joints],
+                              ", ".join(c["singular_modes"]) or "none",
+                              f"[{style}]{c['status']}[/{style}]")
+            console.print(table)
+        else:
+            console.print(f"[bold]{title}[/bold]\n  no candidate: μ(t) = ξ(φ(t)) has no real "
+                          "root on the range")
+        modes = Table(title="working modes", title_justify="left")
+        for col in ("mode", "status", *[f"{j} at start" for j in joints], "singular at",
+                    "why"):
+            modes.add_column(col)
+        for m in t["working_modes"]:
+            if not verbose and m["status"] == "infeasible" and len(t["working_modes"]) > 8:
+                continue
+            modes.add_row(m["label"], m["status"],
+                          *[_num(m["joints_at_start"].get(j), 4) for j in joints],
+                          ", ".join(_num(x, 6) for x in m["singular_times"]) or "—",
+                          m["reason"] or "")
+        console.print(modes)
+        if verbose:
+            for i, c in enumerate(t["candidates"], 1):
+                lo, hi = c["t_interval"]
+                console.print(f"  candidate {i}: {t['parameter']} ∈ [{lo:.17g}, {hi:.17g}]")
+                for m in c["modes"]:
+                    console.print(f"    {m['mode']}: {m['status']} ({m['proof']})")
+        for u in t["undecided"]:
+            lo, hi = u["t_interval"]
+            console.print(f"  undecided for {t['parameter']} in [{lo:.9g}, {hi:.9g}]: "
+                          f"{u['reason']}")
+        if t.get("workspace"):
+            console.print(workspace_line(t["workspace"]))
+        style = _VERDICT_STYLE.get(t["verdict"], "bold")
+        console.print(f"verdict [{style}]{t['verdict']}[/{style}]: {t['reason']}\n")

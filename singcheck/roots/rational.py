@@ -1,0 +1,228 @@
+"""Exact isolation of the real roots of a univariate polynomial over Q.
+
+Squarefree factorisation, then Descartes' rule of signs with Vincent–Collins–Akritas
+bisection in exact integer arithmetic: each root gets a rational interval holding
+exactly one root, with a sign change at its ends (or a point, for a root met exactly),
+refined by bisection on exact signs (a 128-bit ball decides most signs, exact rational
+arithmetic the rest).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from fractions import Fraction
+
+from flint import arb, arb_poly, fmpq, fmpq_poly, fmpz_poly
+
+from singcheck.algebra.intervals import working_precision
+from singcheck.budget import checkpoint
+
+
+def bits_for(tolerance: float) -> int:
+    return max(53, int(-math.log2(tolerance)) + 30)
+
+
+def exact_tolerance(x: float) -> fmpq:
+    """An exact rational for a positive float tolerance (tiny ones clamped to 2^-1000)."""
+    if x < 1e-300:
+        return fmpq(1, 2**1000)
+    num, den = x.as_integer_ratio()
+    return fmpq(num, den)
+
+
+def to_fraction(q: fmpq) -> Fraction:
+    """An exact FLINT rational as a Python Fraction."""
+    return Fraction(int(q.p), int(q.q))
+
+
+def to_fmpq(x: Fraction | int) -> fmpq:
+    """An exact Python rational (Fraction or int) as a FLINT rational."""
+    x = Fraction(x)
+    return fmpq(x.numerator, x.denominator)
+
+
+def rational_ball(lo: fmpq, hi: fmpq) -> arb:
+    """A ball containing the rational interval [lo, hi], at a precision fine enough
+    that rounding does not widen it noticeably."""
+    width = hi - lo
+    bits = 60 + (int(-math.log2(float(width))) if width > 0 and float(width) > 0 else 200)
+    with working_precision(bits):
+        return arb(lo).union(arb(hi))
+
+
+def arb_to_fmpq(x: arb) -> fmpq:
+    man, exp = x.man_exp()
+    return fmpq(int(man) * 2**int(exp)) if exp >= 0 else fmpq(int(man), 2 ** (-int(exp)))
+
+
+# ---------------------------------------------------------------------------------
+# exact univariate isolation
+
+
+@dataclass
+class RationalRoot:
+    """A root of a squarefree integer polynomial in [lo, hi] with a sign change (or lo == hi)."""
+
+    poly: fmpq_poly
+    lo: fmpq
+    hi: fmpq
+    _balls: arb_poly | None = None
+
+    def width(self) -> fmpq:
+        return self.hi - self.lo
+
+    def sign_at(self, q: fmpq) -> int:
+        """The exact sign of the polynomial at q: a ball evaluation when it decides,
+        exact rational arithmetic otherwise."""
+        if self._balls is None:
+            with working_precision(128):
+                self._balls = arb_poly([arb(c) for c in self.poly.coeffs()])
+        with working_precision(128):
+            value = self._balls(arb(q))
+        if value > 0:
+            return 1
+        if value < 0:
+            return -1
+        return _qsign(self.poly(q))
+
+    def bisect_to(self, width: fmpq) -> None:
+        f = self.poly
+        slo = _qsign(f(self.lo))
+        if slo == 0:
+            self.hi = self.lo
+            return
+        if _qsign(f(self.hi)) == 0:
+            self.lo = self.hi
+            return
+        while self.hi - self.lo > width:
+            mid = (self.lo + self.hi) / 2
+            sm = self.sign_at(mid)
+            if sm == 0:
+                self.lo = self.hi = mid
+                return
+            if sm == slo:
+                self.lo = mid
+            else:
+                self.hi = mid
+
+    def ball(self) -> arb:
+        return rational_ball(self.lo, self.hi)
+
+    def compare(self, q: fmpq) -> int:
+        """-1, 0, 1 as the root is below, at, above the rational q (exact: the interval
+        is bisected until it lies on one side of q, or q is found to be the root)."""
+        while True:
+            if self.hi < q:
+                return -1
+            if self.lo > q:
+                return 1
+            if self.lo == self.hi or self.poly(q) == 0:
+                return 0
+            self.bisect_to((self.hi - self.lo) / 4)
+
+    def pin(self, q: fmpq) -> bool:
+        """Collapse to ``q`` when it lies inside the isolating interval and is a root.
+
+        The end points of an isolating interval are never its root (they may be
+        another root), so only a point strictly inside, or the point itself, counts.
+        """
+        if (self.lo < q < self.hi or self.lo == q == self.hi) and self.poly(q) == 0:
+            self.lo = self.hi = q
+            return True
+        return False
+
+
+def _qsign(q: fmpq) -> int:
+    return (q > 0) - (q < 0)
+
+
+def _sign_variations(coeffs) -> int:
+    signs = [c > 0 for c in coeffs if c != 0]
+    return sum(1 for x, y in zip(signs, signs[1:], strict=False) if x != y)
+
+
+_X_PLUS_1 = fmpz_poly([1, 1])
+_TWO_X = fmpz_poly([0, 2])
+
+
+def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
+    """Isolating intervals of the positive real roots of a squarefree ``f`` with f(0) ≠ 0.
+
+    Vincent–Collins–Akritas bisection: roots are first scaled into (0, 1) by a power
+    of two above the Cauchy bound; on a dyadic interval, the number of sign variations
+    of the coefficients of (x+1)^n g(1/(x+1)) bounds the number of roots and has the
+    same parity (Descartes); 0 proves none, 1 proves exactly one (Vincent's theorem
+    makes the bisection terminate for squarefree input).  A root found exactly at a
+    bisection point is returned as a point interval; an interval whose end is such a
+    root is bisected further, so every other interval has a sign change at its ends.
+    """
+    cs = [int(c) for c in f.coeffs()]
+    n = len(cs) - 1
+    # Fujiwara: every root has |z| <= 2 max |a_i / a_n|^(1/(n-i)); bounded with bit
+    # lengths (|a| < 2^bitlen), plus one more bit so that every root is < 2^b strictly.
+    top = abs(cs[-1]).bit_length() - 1  # 2^top <= |a_n|
+    b = 2 + max((-(-(abs(c).bit_length() - top) // (n - i)) for i, c in enumerate(cs[:-1])
+                 if c), default=0)
+    b = max(b, 1)
+    g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)])  # g(x) = f(2^b x)
+    out: list[tuple[int, int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
+    stack = [(g, 0, 0)]
+    while stack:
+        g, a, k = stack.pop()
+        checkpoint()
+        coeffs = g.coeffs()
+        m = len(coeffs) - 1
+        reversed_g = fmpz_poly(coeffs[::-1])
+        v = _sign_variations(reversed_g(_X_PLUS_1).coeffs())
+        ends_are_roots = coeffs[0] == 0 or g(1) == 0
+        if v == 0:
+            continue
+        if v == 1 and not ends_are_roots:
+            out.append((a, k, False))
+            continue
+        # 2^m g(x/2): reverse, substitute 2x, reverse back (all in FLINT)
+        scaled = reversed_g(_TWO_X).coeffs()
+        scaled += [0] * (m + 1 - len(scaled))
+        half = fmpz_poly(scaled[::-1])
+        if half(1) == 0:
+            out.append((2 * a + 1, k + 1, True))
+        stack.append((half(_X_PLUS_1), 2 * a + 1, k + 1))
+        stack.append((half, 2 * a, k + 1))
+    scale = fmpq(2**b)
+    intervals = []
+    for a, k, exact in out:
+        lo = scale * fmpq(a, 2**k)
+        intervals.append((lo, lo) if exact else (lo, scale * fmpq(a + 1, 2**k)))
+    return intervals
+
+
+def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
+                     ) -> list[tuple[RationalRoot, int]]:
+    """Isolating rational intervals of the real roots of ``p``, with multiplicities
+    (only the roots ≥ 0 when ``nonnegative_only``)."""
+    if p.degree() < 1:
+        return []
+    num = fmpz_poly([int(c * p.denom()) for c in p.coeffs()])
+    _, factors = num.factor_squarefree()
+    out = []
+    for factor, mult in factors:
+        f = fmpq_poly(factor)
+        cs = [int(c) for c in factor.coeffs()]
+        shift = next(i for i, c in enumerate(cs) if c != 0)
+        if shift:  # a root at 0 (squarefree: simple)
+            out.append((RationalRoot(f, fmpq(0), fmpq(0)), mult))
+            factor = fmpz_poly(cs[shift:])
+            f = fmpq_poly(factor)  # the other roots: f no longer vanishes at 0
+        if factor.degree() < 1:
+            continue
+        for lo, hi in _positive_root_intervals(factor):
+            out.append((RationalRoot(f, lo, hi), mult))
+        if nonnegative_only:
+            continue
+        mirrored = fmpz_poly([c if i % 2 == 0 else -c
+                              for i, c in enumerate(int(c) for c in factor.coeffs())])
+        for lo, hi in _positive_root_intervals(mirrored):
+            out.append((RationalRoot(f, -hi, -lo), mult))
+    out.sort(key=lambda item: item[0].lo)
+    return out

@@ -1,0 +1,261 @@
+"""Workspace and joint-space analysis: where the kinematics has how many real solutions.
+
+The paper's second half, exactly:
+
+1. **Discriminant variety** of the space studied, as a list of named surfaces:
+   in the workspace, the serial singularities (each quadratic leg's discriminant: two
+   IK branches meet), the parallel singularity surface ξ(X) and the joint limits
+   projected (the leg polynomial with its joint at a limit); in the joint space, the
+   serial singularities projected (the pose eliminated from {F, ∂f_i/∂ρ_i}), ε(ρ) and
+   the limit planes ρ_i = bound.  The number of inverse-kinematic solutions inside the
+   limits (workspace) changes only across the serial and limit surfaces; the number of
+   direct-kinematic solutions (joint space) only across ε and the limits (the legs'
+   leading coefficients are constant, so no solution escapes to infinity).
+2. **Generic CAD** of its complement (:mod:`singcheck.cad`), in all the space's axes or
+   in a slice where some axes are fixed to exact rationals: open cells with rational
+   sample points.
+3. **Counts**, exactly, at each sample point (:mod:`singcheck.solution_counts`): since a
+   count is constant on a connected set avoiding the variety, it holds on the whole cell.
+4. **Regions** (plane decompositions): cells joined by exact free segments
+   (:mod:`singcheck.regions`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
+
+from singcheck.algebra.polynomials import restrict, squarefree_part
+from singcheck.elimination.projection import RobotProjection, joint_space_singularities
+from singcheck.elimination.requests import EliminationRequest
+from singcheck.errors import SingcheckError
+from singcheck.model.robot import RobotModel
+from singcheck.spaces.cad import Cell, OpenCAD, open_cad
+from singcheck.spaces.regions import Region, Regions, connect_regions, factor_signs
+from singcheck.spaces.solution_counts import direct_kinematics_count, ik_count, ik_root_placement
+
+WORKSPACE, JOINTSPACE = "workspace", "jointspace"
+SERIAL, PARALLEL, LIMIT = "serial singularity", "parallel singularity", "joint limit"
+
+
+class SliceError(SingcheckError):
+    """A slice that cannot be studied (unknown axis, or lying inside a surface)."""
+
+
+@dataclass(frozen=True)
+class VarietyComponent:
+    kind: str  # SERIAL | PARALLEL | LIMIT
+    label: str  # what it is, e.g. "leg rho1: its two branches meet", "rho1 = 0"
+    polynomial: fmpq_mpoly  # in the studied axes
+
+
+@dataclass(frozen=True)
+class CellCount:
+    cell: Cell
+    count: int | None  # real solutions (within the limits, for the workspace)
+    reason: str  # why count is None
+    within_limits: bool  # joint space: the sample is inside the joint-limit box
+    region: int | None = None
+
+
+@dataclass
+class SpaceAnalysis:
+    space: str  # WORKSPACE | JOINTSPACE
+    robot: str
+    axes: tuple[str, ...]  # the axes decomposed (free)
+    fixed: dict[str, Fraction]  # the slice: axes set to exact values
+    components: list[VarietyComponent]
+    cad: OpenCAD
+    cells: list[CellCount]
+    regions: Regions | None
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def counted(self) -> str:
+        return ("inverse-kinematic solutions within the joint limits" if self.space == WORKSPACE
+                else "direct-kinematic solutions")
+
+    def region_count(self, number: int) -> int | None:
+        counts = {c.count for c in self.cells if c.region == number}
+        return counts.pop() if len(counts) == 1 else None
+
+
+# ---------------------------------------------------------------------------------
+# the discriminant varieties
+
+
+def workspace_variety(projection: RobotProjection,
+                      parallel: bool = True) -> list[VarietyComponent]:
+    """Serial singularities, ξ (unless ``parallel`` is False) and joint limits in X."""
+    model = projection.model
+    out = []
+    for leg, disc in zip(model.legs, projection.workspace_boundary, strict=True):
+        if not disc.is_constant():
+            out.append(VarietyComponent(SERIAL, f"leg {leg.joint}: its two branches meet",
+                                        disc))
+    if parallel:
+        out.append(VarietyComponent(PARALLEL, "ξ(X): some working mode is singular",
+                                    projection.singularity_surface))
+    for s in projection.joint_limit_surfaces:
+        out.append(VarietyComponent(LIMIT, f"{s.joint} = {s.value} ({s.bound})", s.polynomial))
+    return out
+
+
+def serial_singularities_request(model: RobotModel, leg) -> EliminationRequest:
+    """Eliminate the pose from ``{F, ∂f_leg/∂ρ_leg}``: where that leg is serially singular."""
+    return EliminationRequest("joint_space_serial_singularities", model.context,
+                              (*model.constraints, leg.constraint.derivative(leg.joint)),
+                              model.pose)
+
+
+def jointspace_variety(model: RobotModel, backend,
+                       parallel: bool = True) -> list[VarietyComponent]:
+    """Serial singularities projected, ε (unless ``parallel`` is False), limit planes."""
+    ctx = fmpq_mpoly_ctx.get(model.joints, "lex")
+    out = []
+    for leg in model.legs:
+        if leg.degree < 2:
+            continue
+        result = backend.eliminate(serial_singularities_request(model, leg))
+        polys = [p for p in result.polynomials if not p.is_zero()]
+        g = polys[0] if polys else None
+        for p in polys[1:]:
+            g = g.gcd(p)
+        if g is not None and not g.is_constant():
+            out.append(VarietyComponent(SERIAL, f"leg {leg.joint}: two branches meet",
+                                        squarefree_part(g)))
+    if parallel:
+        eps = joint_space_singularities(model, backend)
+        out.append(VarietyComponent(PARALLEL, "ε(ρ): a parallel singularity", eps))
+    gens = dict(zip(model.joints, ctx.gens(), strict=True))
+    for joint, (lo, hi) in model.spec.joint_limits.items():
+        for bound, value in (("min", lo), ("max", hi)):
+            plane = gens[joint] - fmpq(value.numerator, value.denominator)
+            out.append(VarietyComponent(LIMIT, f"{joint} = {value} ({bound})", plane))
+    return out
+
+
+def fix_axes(components: list[VarietyComponent], axes: tuple[str, ...],
+             fixed: dict[str, Fraction]) -> tuple[tuple[str, ...], list[VarietyComponent]]:
+    """The components restricted to the slice where ``fixed`` axes take exact values.
+
+    A surface the slice misses (a non-zero constant) is dropped; a slice lying inside a
+    surface is refused, since no open cell of the slice would avoid it.
+    """
+    for name in fixed:
+        if name not in axes:
+            raise SliceError(f"--slice {name}=…: {name} is not one of the axes "
+                             f"({', '.join(axes)})")
+    free = tuple(a for a in axes if a not in fixed)
+    if not free:
+        raise SliceError("the slice fixes every axis; leave at least one free")
+    ctx = fmpq_mpoly_ctx.get(free, "lex")
+    values = {a: fmpq(v.numerator, v.denominator) for a, v in fixed.items()}
+    out = []
+    for c in components:
+        p = c.polynomial.subs(values) if values else c.polynomial
+        if p.is_zero():
+            raise SliceError(f"the slice {_slice_text(fixed)} lies inside the surface "
+                             f"{c.label}; choose another value")
+        if p.is_constant():
+            continue
+        out.append(VarietyComponent(c.kind, c.label, restrict(p, ctx)))
+    return free, out
+
+
+COUNT_CHANGING = {WORKSPACE: (SERIAL, LIMIT), JOINTSPACE: (PARALLEL, LIMIT)}
+
+
+def select_surfaces(components: list[VarietyComponent], space: str, surfaces: str,
+                    free_axes: int) -> tuple[list[VarietyComponent], list[str]]:
+    """The components to decompose by, and the labels of those left out.
+
+    ``all`` keeps the whole discriminant variety; ``counts`` only the surfaces across
+    which the count can change (workspace: serial singularities and limits; joint space:
+    ε and limits); ``auto`` is ``all`` in a plane or a line and ``counts`` in 3-D and up,
+    where the generic CAD with the parallel singularity surface has tens of thousands of
+    cells (the Orthoglide: 30108, and minutes to join them into regions).
+    """
+    if surfaces == "auto":
+        surfaces = "all" if free_axes <= 2 else "counts"
+    if surfaces == "all":
+        return list(components), []
+    keep = [c for c in components if c.kind in COUNT_CHANGING[space]]
+    return keep, [c.label for c in components if c.kind not in COUNT_CHANGING[space]]
+
+
+def _slice_text(fixed: dict[str, Fraction]) -> str:
+    return ", ".join(f"{a} = {v}" for a, v in fixed.items())
+
+
+# ---------------------------------------------------------------------------------
+# the analysis
+
+
+def _point(axes: tuple[str, ...], free: tuple[str, ...], sample, fixed) -> list[Fraction]:
+    values = dict(zip(free, sample, strict=True)) | dict(fixed)
+    return [values[a] for a in axes]
+
+
+def _within(model: RobotModel, joints) -> bool:
+    limits = model.spec.joint_limits
+    return all(lo < q < hi for j, q in zip(model.joints, joints, strict=True)
+               if j in limits for lo, hi in [limits[j]])
+
+
+def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
+            fixed: dict[str, Fraction] | None = None, use_limits: bool = True) -> SpaceAnalysis:
+    """Decompose the complement of the variety and count solutions in every cell.
+
+    With ``use_limits`` False the joint limits are ignored (and their surfaces must not
+    be among ``components``): every real solution counts.
+    """
+    fixed = dict(fixed or {})
+    axes = model.pose if space == WORKSPACE else model.joints
+    free, sliced = fix_axes(components, axes, fixed)
+    timings = {}
+    start = time.perf_counter()
+    cad = open_cad([c.polynomial for c in sliced]) if sliced else _trivial_cad(free)
+    timings["decomposition_s"] = time.perf_counter() - start
+    start = time.perf_counter()
+    cells = []
+    invariants = {}  # cell index -> what is constant on a component (for proofs)
+    for cell in cad.cells:
+        point = _point(axes, free, cell.sample, fixed)
+        if space == WORKSPACE:
+            placement = ik_root_placement(model, point, use_limits)
+            cells.append(CellCount(cell, ik_count(placement), "", True))
+            invariants[cell.index] = placement
+        else:
+            dk = direct_kinematics_count(model, point)
+            cells.append(CellCount(cell, dk.count, dk.reason,
+                                   not use_limits or _within(model, point)))
+            if dk.count is not None:
+                invariants[cell.index] = (dk.count, cells[-1].within_limits)
+    timings["counting_s"] = time.perf_counter() - start
+    start = time.perf_counter()
+    regions = _regions(cad, invariants)
+    timings["regions_s"] = time.perf_counter() - start
+    if regions is not None:
+        number = {c.index: r.number for r in regions.regions for c in r.cells}
+        cells = [CellCount(c.cell, c.count, c.reason, c.within_limits,
+                           number[c.cell.index]) for c in cells]
+    return SpaceAnalysis(space, model.name, free, fixed, sliced, cad, cells, regions, timings)
+
+
+def _regions(cad: OpenCAD, counts: dict) -> Regions:
+    """Connected regions: every cell of a line, else cells joined by free segments
+    (``counts``, constant on each component, help prove regions distinct)."""
+    if len(cad.variables) == 1 or not cad.factors:
+        return Regions(tuple(Region(i + 1, (c,), factor_signs(cad, c.sample))
+                             for i, c in enumerate(cad.cells)), True, "")
+    return connect_regions(cad, counts)
+
+
+def _trivial_cad(free: tuple[str, ...]) -> OpenCAD:
+    """No surface meets the slice: one cell, the whole slice."""
+    return OpenCAD(free, (), tuple(() for _ in free),
+                   (Cell(tuple(0 for _ in free), tuple(Fraction(0) for _ in free)),))

@@ -1,0 +1,304 @@
+"""A trajectory against the workspace's regions: crossings, counts, exit time, region.
+
+What is proven, and how:
+
+* **Crossings.**  The path meets a surface of the workspace's discriminant variety
+  (a leg's serial singularity D = 0, a joint limit projected, ξ = 0) exactly at the
+  real roots of that surface's polynomial composed with φ(t); they are isolated in
+  certified balls (:func:`singcheck.roots.isolate_real_roots`).
+* **Counts between crossings.**  Between two consecutive crossings the path stays in
+  one connected component of the complement, where the number of inverse-kinematic
+  solutions inside the joint limits is constant; it is counted at one exact point of
+  the stretch with ball arithmetic (each branch's reality from D's sign, its place
+  against the limits), which is decided because no surface passes through the point.
+* **Exit time.**  The first crossing after which the count is 0 is when the path
+  leaves the workspace; its ball is the certified exit time.
+* **Region.**  A path with no crossing lies in one region.  The decomposition of the
+  smallest subspace holding it (pose coordinates that are rational constants fixed: a
+  line, a plane, or the whole workspace) is computed (:mod:`singcheck.space_analysis`),
+  a rational point of the path is located in a cell exactly, and the cell's region
+  names it.  In 3-D, ξ is left out of the decomposition (``--surfaces auto``), and the
+  name says so: the region is then one of the count-changing surfaces' complement.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+from flint import acb, arb
+
+from singcheck.algebra.intervals import fraction_ball, working_precision
+from singcheck.algebra.polynomials import constant_value
+from singcheck.algebra.trig import uses_t, uses_trig
+from singcheck.certify.path import PathModel
+from singcheck.certify.working_modes import gap_points
+from singcheck.roots.enclosures import IdenticallyZeroError
+from singcheck.roots.isolation import isolate_real_roots
+from singcheck.roots.rational import to_fmpq, to_fraction
+
+_PRECISIONS = (53, 128, 384)
+
+
+@dataclass(frozen=True)
+class Crossing:
+    t: arb
+    surfaces: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Stretch:
+    point: arb  # the exact point where the count was taken
+    count: int | None
+
+
+@dataclass
+class PathInWorkspace:
+    crossings: list[Crossing]
+    stretches: list[Stretch]  # one per gap between crossings, in time order
+    undecided: list[str] = field(default_factory=list)
+    exit_time: arb | None = None
+    region: str | None = None  # e.g. "R21 of the workspace plane z = 1"
+
+    @property
+    def one_region(self) -> bool | None:
+        """True/False when proven; None when some crossing could not be decided."""
+        return None if self.undecided else not self.crossings
+
+
+def path_surfaces(path: PathModel) -> list[tuple[str, object]]:
+    """(label, trig polynomial along the path) for every surface of the variety."""
+    out = []
+    limits = path.projection.model.spec.joint_limits
+    for leg in path.legs:
+        joint = leg.leg.joint
+        if leg.discriminant is not None:
+            out.append((f"serial singularity of leg {joint}", leg.discriminant))
+        for bound, value in zip(("min", "max"), limits.get(joint, ()), strict=False):
+            out.append((f"{joint} = {value} ({bound})", leg.limit_polynomial(value)))
+    out.append((XI, path.mu))
+    return out
+
+
+def _inside(v: arb, lo: arb, hi: arb) -> bool | None:
+    if v >= lo and v <= hi:
+        return True
+    if v < lo or v > hi:
+        return False
+    return None
+
+
+def _leg_count(leg, t: arb, bounds) -> int | None:
+    """Real branches of one leg inside its limits at t (None if not decided)."""
+    n = 0
+    for value in leg.branches(t).values():
+        if value is None:
+            return None
+        if isinstance(value, acb):
+            continue  # a complex branch
+        inside = True if bounds is None else _inside(
+            value, fraction_ball(bounds[0]), fraction_ball(bounds[1]))
+        if inside is None:
+            return None
+        n += inside
+    return n
+
+
+def ik_count_at(path: PathModel, t: arb) -> int | None:
+    """IK solutions inside the limits at the exact time t (None if not decided)."""
+    limits = path.projection.model.spec.joint_limits
+    for prec in _PRECISIONS:
+        with working_precision(prec):
+            counts = [_leg_count(leg, t, limits.get(leg.leg.joint)) for leg in path.legs]
+        if None not in counts:
+            return math.prod(counts)
+    return None
+
+
+XI = "parallel singularity ξ"
+
+
+def _crossings(path: PathModel, tolerance: float,
+               mu_roots: list[arb] | None) -> tuple[list[Crossing], list[str]]:
+    interval = path.trajectory.range
+    events: list[tuple[arb, str]] = []
+    undecided = []
+    for label, poly in path_surfaces(path):
+        if label == XI and mu_roots is not None:
+            events += [(t, label) for t in mu_roots]
+            continue
+        try:
+            iso = isolate_real_roots(poly, interval, tolerance)
+        except IdenticallyZeroError:
+            undecided.append(f"the path lies on the surface {label}")
+            continue
+        events += [(r.t, label) for r in iso.roots]
+        undecided += [f"{label}: {u.reason}" for u in iso.undecided]
+    events.sort(key=lambda e: float(e[0].mid()))
+    merged: list[Crossing] = []
+    for t, label in events:
+        if merged and merged[-1].t.overlaps(t):
+            last = merged[-1]
+            merged[-1] = Crossing(last.t.union(t), (*last.surfaces, label))
+        else:
+            merged.append(Crossing(t, (label,)))
+    return merged, undecided
+
+
+def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: bool = True,
+                      mu_roots: list[arb] | None = None, region_cache=None,
+                      notify=None) -> PathInWorkspace:
+    """Where the path crosses the discriminant variety, and its IK count in between.
+
+    ``mu_roots``: the certified roots of μ already isolated by the certification (every
+    one of them, none undecided), so that they are not isolated twice.  ``region_cache``:
+    where region maps are kept between runs (None: computed in this process only);
+    ``notify(message)`` is told before a decomposition is computed (it takes seconds).
+    """
+    crossings, undecided = _crossings(path, tolerance, mu_roots)
+    points = gap_points(path.trajectory.range, [c.t for c in crossings])
+    stretches = [Stretch(p, ik_count_at(path, p)) for p in points]
+    result = PathInWorkspace(crossings, stretches, undecided)
+    if not undecided and len(stretches) == len(crossings) + 1:
+        for before, crossing, after in zip(stretches, crossings, stretches[1:], strict=False):
+            if before.count and after.count == 0:
+                result.exit_time = crossing.t
+                break
+    if name_region and result.one_region:
+        result.region = locate_region(path, region_cache, notify)
+    return result
+
+
+# ---------------------------------------------------------------------------------
+# naming the region of a path that stays in one
+
+
+def _rational_time_points(path: PathModel):
+    """Exact times with a rational pose: t = 2·atan(u) for rational u (sin/cos only),
+    or rational t (polynomial paths); yields (t ball, {s, c, t} rationals)."""
+    polys = path.phi
+    trig = any(uses_trig(p) for p in polys)
+    if trig and any(uses_t(p) for p in polys):
+        return
+    candidates = [Fraction(n, d) for d in (2, 3, 5, 7) for n in range(-3 * d, 3 * d + 1)
+                  if n % d or d == 2]
+    rng = path.trajectory.range
+    lo, hi = rng.start.ball(), rng.end.ball()
+    for u in candidates:
+        if trig:
+            s, c = 2 * u / (1 + u * u), (1 - u * u) / (1 + u * u)
+            with working_precision(128):
+                t = 2 * fraction_ball(u).atan()
+            values = {"s": s, "c": c}
+        else:
+            t, values = fraction_ball(u), {"t": u}
+        if t > lo and t < hi:
+            yield values
+
+
+def _subspace(pose: tuple[str, ...], phi) -> tuple[dict[str, Fraction], tuple[int, ...]]:
+    """The fixed pose coordinates (rational constants of φ) and the free axes' indices."""
+    fixed, free = {}, []
+    for i, (name, p) in enumerate(zip(pose, phi, strict=True)):
+        if p.is_constant():
+            fixed[name] = to_fraction(constant_value(p))
+        else:
+            free.append(i)
+    return fixed, tuple(free)
+
+
+def prepare_region_maps(projection, specs, cache=None, notify=None) -> None:
+    """Compute, in this process, the region map of every subspace that several of the
+    trajectories lie in (forked workers then inherit it instead of each computing it)."""
+    from collections import Counter
+
+    pose = projection.model.pose
+    shared = Counter()
+    for spec in specs:
+        fixed, free = _subspace(pose, [spec.pose[v] for v in pose])
+        shared[tuple(fixed.items()), len(free)] += 1
+    for (fixed, free), n in shared.items():
+        if n > 1 and free:
+            _region_map(projection, dict(fixed), free, cache, notify)
+
+
+def locate_region(path: PathModel, cache=None, notify=None) -> str | None:
+    """The name of the region holding the path, in the smallest space that holds it
+    (a line, a plane or the whole workspace: φ's constant coordinates are fixed); None
+    when no rational point of the path could be located in an open cell.  ``cache``: a
+    :class:`~singcheck.region_map.RegionMapCache`, or None to compute without storing."""
+    fixed, free = _subspace(path.projection.model.pose, path.phi)
+    if not free:
+        return None
+    regions, left_out = _region_map(path.projection, fixed, len(free), cache, notify)
+    where = "" if not fixed else " " + ", ".join(f"{k} = {v}" for k, v in fixed.items())
+    kind = {1: "line", 2: "plane"}.get(len(free), "")
+    space = f"the workspace {kind}{where}".replace("  ", " ").rstrip()
+    if left_out:
+        space += " cut by its serial-singularity and joint-limit surfaces only"
+    points = (point for values in _rational_time_points(path)
+              for point in [[_exact(path.phi[i], values) for i in free]])
+    for point in (*points, *_rational_points_near(path, free, regions.factors)):
+        number = regions.region_at(point)
+        if number is not None:
+            return f"R{number} of {space}"
+    return None
+
+
+def _rational_points_near(path: PathModel, free: tuple[int, ...], factors):
+    """Rational points in the same component as a point of the path, for paths whose
+    rational times give irrational poses (t mixed with sin t, cos t).
+
+    At a rational time t₀ the pose is enclosed in a box of balls; when every factor of
+    the decomposition excludes 0 on the whole box (ball arithmetic), the box is a
+    connected set avoiding the variety, so its rational centre lies in the path's
+    component.
+    """
+    from singcheck.algebra.intervals import evaluate
+    from singcheck.roots.rational import arb_to_fmpq
+
+    rng = path.trajectory.range
+    lo, hi = rng.start.ball(), rng.end.ball()
+    for k in range(1, 8):
+        t = lo + (hi - lo) * k / 8
+        with working_precision(128):
+            t0 = t.mid()
+            pose = path.pose_at(t0)
+            box = [pose[i] for i in free]
+            if all(evaluate(f, box).contains(0) is False for f in factors):
+                yield [to_fraction(arb_to_fmpq(b.mid())) for b in box]
+
+
+_SUBSPACES: dict = {}
+
+
+def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
+                notify=None):
+    """The region map of the subspace where ``fixed`` holds and the surfaces left out
+    (``--surfaces auto``): from this process's memo, else the disk cache, else computed
+    (then stored).  A batch of paths in one plane shares it."""
+    from singcheck.spaces.analysis import WORKSPACE, analyse, select_surfaces, workspace_variety
+    from singcheck.spaces.region_map import RegionMap
+
+    memo_key = (id(projection), tuple(sorted(fixed.items())))
+    if memo_key not in _SUBSPACES:
+        components, left_out = select_surfaces(workspace_variety(projection), WORKSPACE,
+                                               "auto", free_axes)
+        key = cache.key([c.polynomial for c in components], fixed) if cache else None
+        regions = cache.load(key) if cache else None
+        if regions is None:
+            if notify:
+                where = ", ".join(f"{k} = {v}" for k, v in fixed.items()) or "in 3-D"
+                notify(f"decomposing the workspace ({where}) into regions, once"
+                       + (" (then kept in the cache)" if cache else ""))
+            regions = RegionMap.of(analyse(WORKSPACE, projection.model, components, fixed))
+            if cache:
+                cache.store(key, regions)
+        _SUBSPACES[memo_key] = (projection, regions, left_out)
+    return _SUBSPACES[memo_key][1:]
+
+
+def _exact(p, values: dict[str, Fraction]) -> Fraction:
+    q = p.subs({k: to_fmpq(v) for k, v in values.items()})
+    return to_fraction(constant_value(q))

@@ -1,0 +1,102 @@
+"""Which region holds a rational point: a decomposition's levels and region numbers.
+
+A :class:`RegionMap` keeps what locating a point needs from a
+:class:`~singcheck.space_analysis.SpaceAnalysis` — the projection levels of its open CAD
+and the region number of every cell — and nothing else, so that it can be stored.  A
+rational point is located exactly: at each level its coordinate is compared with the
+real roots of the level's factors over the coordinates before it (exact isolation);
+a point on a root lies on no open cell and is not located.
+
+The map is cached on disk beside the elimination cache (a 3-D decomposition with its
+regions takes seconds; reading it back, milliseconds).  An entry is keyed by the SHA-256
+of the variety's polynomials, the slice and :data:`REGIONS_VERSION`, and carries the
+SHA-256 of its payload: a damaged entry is ignored and recomputed, never trusted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+from pathlib import Path
+
+from flint import fmpq_mpoly, fmpq_mpoly_ctx
+
+from singcheck.elimination.cas.polytext import (
+    PolynomialSyntaxError,
+    format_polynomial,
+    parse_polynomial,
+)
+from singcheck.spaces.cad import cell_index_of, fiber
+
+#: Bump when the decomposition or the joining of regions changes what a number means.
+REGIONS_VERSION = "2"
+FORMAT = "singcheck-region-map/1"
+
+
+@dataclass(frozen=True)
+class RegionMap:
+    variables: tuple[str, ...]
+    levels: tuple[tuple[fmpq_mpoly, ...], ...]
+    factors: tuple[fmpq_mpoly, ...]  # the variety's factors (for ball proofs near a point)
+    numbers: dict[tuple[int, ...], int]  # cell index -> region number
+
+    @classmethod
+    def of(cls, analysis) -> RegionMap:
+        cad = analysis.cad
+        numbers = {c.index: r.number for r in analysis.regions.regions for c in r.cells}
+        return cls(cad.variables, cad.levels, cad.factors, numbers)
+
+    def region_at(self, point: list[Fraction]) -> int | None:
+        """The region of the open cell holding a rational point (None on a root)."""
+        index = cell_index_of(lambda p: fiber(self.levels, self.variables, p), tuple(point))
+        return None if index is None else self.numbers.get(index)
+
+    # -- storage ------------------------------------------------------------------
+
+    def payload(self) -> dict:
+        return {"variables": list(self.variables),
+                "levels": [[format_polynomial(p) for p in level] for level in self.levels],
+                "factors": [format_polynomial(p) for p in self.factors],
+                "cells": [[list(index), n] for index, n in sorted(self.numbers.items())]}
+
+    @classmethod
+    def from_payload(cls, payload: dict) -> RegionMap:
+        variables = tuple(payload["variables"])
+        ctx = fmpq_mpoly_ctx.get(variables, "lex")
+        return cls(variables,
+                   tuple(tuple(parse_polynomial(t, ctx) for t in level)
+                         for level in payload["levels"]),
+                   tuple(parse_polynomial(t, ctx) for t in payload["factors"]),
+                   {tuple(int(i) for i in index): int(n) for index, n in payload["cells"]})
+
+
+class RegionMapCache:
+    """Region maps on disk, one JSON file per (variety, slice)."""
+
+    def __init__(self, directory: Path | None = None) -> None:
+        from singcheck.elimination.cache import cache_dir
+
+        self.directory = (directory or cache_dir()) / "regions"
+
+    @staticmethod
+    def key(polynomials, fixed: dict[str, Fraction]) -> str:
+        from singcheck.elimination.cache import _digest
+
+        return _digest(REGIONS_VERSION, *(f"{k}={v}" for k, v in sorted(fixed.items())),
+                       *sorted(format_polynomial(p) for p in polynomials))
+
+    def _path(self, key: str) -> Path:
+        return self.directory / f"{key}.json"
+
+    def load(self, key: str) -> RegionMap | None:
+        from singcheck.elimination.cache import read_entry
+
+        try:
+            return RegionMap.from_payload(read_entry(self._path(key), FORMAT, key))
+        except (OSError, ValueError, KeyError, TypeError, PolynomialSyntaxError):
+            return None
+
+    def store(self, key: str, region_map: RegionMap) -> None:
+        from singcheck.elimination.cache import write_entry
+
+        write_entry(self._path(key), FORMAT, key, region_map.payload())

@@ -1,0 +1,151 @@
+"""Exact numbers of real kinematic solutions at a rational point.
+
+* :func:`inverse_kinematics_count`: at a pose X, the number of joint vectors ρ with
+  F(ρ, X) = 0 inside the joint limits.  For a leg-decoupled robot this is the product
+  over legs of the number of real roots of the leg's polynomial in its joint that lie
+  in the joint's range; those roots are isolated exactly (Descartes/VCA) and compared
+  with the limits on exact signs.
+* :func:`direct_kinematics_count`: at a joint vector ρ, the number of real poses X with
+  F(ρ, X) = 0.  A reduced lex Gröbner basis over Q (SymPy) in *shape position*,
+  ``{x_1 - g_1(x_n), …, x_{n-1} - g_{n-1}(x_n), h(x_n)}`` with h squarefree, puts the
+  solutions in bijection with the roots of h, real ones with real ones (the g_i have
+  rational coefficients); the real roots of h are counted exactly.  When the basis is
+  not in that shape, a rational linear change of coordinates is tried (it keeps the
+  real solutions in bijection); if no shape is found the count is left undecided.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from flint import fmpq, fmpq_poly
+
+from singcheck.algebra.polynomials import constant_value
+from singcheck.model.robot import RobotModel, leg_coefficients
+from singcheck.roots.rational import to_fmpq
+from singcheck.spaces.cad import separated_roots
+
+_COORDINATE_CHANGES = ((), (1,), (1, -2), (3, 1, -1), (2, -3, 5, 1))
+
+
+def roots_within(p: fmpq_poly, limits: tuple | None) -> int:
+    """The number of distinct real roots of ``p`` in the closed range ``limits``
+    (all real roots when ``limits`` is None)."""
+    roots = separated_roots(p)
+    if limits is None:
+        return len(roots)
+    lo, hi = (to_fmpq(v) for v in limits)
+    return sum(1 for r in roots if r.compare(lo) >= 0 and r.compare(hi) <= 0)
+
+
+def leg_polynomial_at(model: RobotModel, leg, pose_point) -> fmpq_poly:
+    """The leg's polynomial in its joint at a rational pose (exact)."""
+    values = {v: to_fmpq(q) for v, q in zip(model.pose, pose_point, strict=True)}
+    coeffs = []
+    for c in leg_coefficients(leg):
+        value = c.subs(values) if values else c
+        coeffs.append(constant_value(value))
+    return fmpq_poly(coeffs[::-1])
+
+
+def inverse_kinematics_count(model: RobotModel, pose_point, use_limits: bool = True) -> int:
+    """Real IK solutions inside the joint limits (all of them when ``use_limits`` is
+    False) at a rational pose (exact): the product over legs of their roots inside."""
+    return ik_count(ik_root_placement(model, pose_point, use_limits))
+
+
+def ik_count(placement: tuple[tuple[int, int, int], ...]) -> int:
+    """The IK count from :func:`ik_root_placement`: the product of the legs' roots inside."""
+    return math.prod(inside for _, inside, _ in placement)
+
+
+def ik_root_placement(model: RobotModel, pose_point,
+                      use_limits: bool = True) -> tuple[tuple[int, int, int], ...]:
+    """Per leg, its distinct real joint roots below, inside and above the joint's range
+    at a rational pose (exact; all 'inside' for a joint without limits, or when
+    ``use_limits`` is False).
+
+    Off the serial-singularity and joint-limit surfaces this is constant on every
+    connected set: roots move continuously (the leading coefficient is constant), meet
+    only where the discriminant vanishes and pass a limit only where the leg polynomial
+    vanishes at it.  It refines the IK count (the product of the 'inside' entries).
+    """
+    limits = model.spec.joint_limits if use_limits else {}
+    out = []
+    for leg in model.legs:
+        roots = separated_roots(leg_polynomial_at(model, leg, pose_point))
+        if leg.joint not in limits:
+            out.append((0, len(roots), 0))
+            continue
+        lo, hi = (to_fmpq(v) for v in limits[leg.joint])
+        below = sum(1 for r in roots if r.compare(lo) < 0)
+        above = sum(1 for r in roots if r.compare(hi) > 0)
+        out.append((below, len(roots) - below - above, above))
+    return tuple(out)
+
+
+@dataclass(frozen=True)
+class DirectCount:
+    count: int | None
+    reason: str = ""  # why it is None
+
+
+def direct_kinematics_count(model: RobotModel, joint_point) -> DirectCount:
+    """Real DK solutions (poses) at a rational joint vector, from a shape-position basis."""
+    import sympy
+
+    pose = sympy.symbols(model.pose)
+    values = {j: to_fmpq(q) for j, q in zip(model.joints, joint_point, strict=True)}
+    system = [_to_sympy(f.subs(values), pose, model) for f in model.constraints]
+    last = pose[-1]
+    for change in _COORDINATE_CHANGES:
+        shift = sum((c * v for c, v in zip(change, pose[:-1], strict=False)), sympy.Integer(0))
+        changed = [sympy.expand(e.subs(last, last - shift)) for e in system]
+        basis = sympy.groebner(changed, *pose, order="lex", domain="QQ")
+        exprs = list(basis.exprs)
+        if exprs == [1]:
+            return DirectCount(0)
+        h = _shape_position(exprs, pose)
+        if h is not None:
+            return DirectCount(roots_within(h, None))
+    return DirectCount(None, "no coordinate change put the Gröbner basis in shape position "
+                             "(solutions at infinity, multiple or infinitely many)")
+
+
+def _to_sympy(poly, pose, model: RobotModel):
+    import sympy
+
+    names = poly.context().names()
+    index = [names.index(v) for v in model.pose]
+    expr = sympy.Integer(0)
+    for exps, c in poly.terms():
+        term = sympy.Rational(int(c.p), int(c.q))
+        for var, i in zip(pose, index, strict=True):
+            term *= var ** exps[i]
+        expr += term
+    return expr
+
+
+def _shape_position(exprs, pose) -> fmpq_poly | None:
+    """h when ``exprs`` is ``{x_i - g_i(x_n)}`` plus a squarefree h(x_n), else None."""
+    import sympy
+
+    if len(exprs) != len(pose):
+        return None
+    last = pose[-1]
+    *linear, h = exprs
+    for var, g in zip(pose[:-1], linear, strict=True):
+        p = sympy.Poly(g, *pose)
+        if p.degree(var) != 1 or p.coeff_monomial(var) == 0:
+            return None
+        if (g - p.coeff_monomial(var) * var).free_symbols - {last}:
+            return None
+    hp = sympy.Poly(h, *pose)
+    if hp.free_symbols - {last} or hp.degree(last) < 1:
+        return None
+    coeffs = [fmpq(int(c.p), int(c.q)) for c in sympy.Poly(h, last).all_coeffs()[::-1]]
+    h = fmpq_poly(coeffs)
+    if h.gcd(h.derivative()).degree() > 0:
+        return None
+    return h

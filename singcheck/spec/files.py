@@ -1,0 +1,331 @@
+"""Robot and trajectory spec files: YAML read through its node tree, exactly.
+
+The YAML is *composed* (``yaml.compose`` with the safe loader), never constructed, so
+every scalar is parsed from its source text by :mod:`singcheck.expr` (``0.1`` stays
+1/10; YAML never turns it into a float) and every error names its line.  Each failure
+is a one-line :class:`~singcheck.errors.SpecError`: ``FILE:LINE: KEY: problem``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+import yaml
+from flint import fmpq_mpoly, fmpq_mpoly_ctx
+
+from singcheck.algebra.trig import LinearInPi, TimeRange
+from singcheck.errors import SpecError
+from singcheck.spec.grammar import (
+    ExprError,
+    compile_constant,
+    compile_polynomial,
+    compile_trajectory_coordinate,
+    parse,
+)
+
+ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
+              "parameters": False, "constraints": True, "joint_limits": False}
+TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": True, "pose": True}
+RESERVED = {"pi", "sin", "cos"}
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
+MAX_BYTES = 1_000_000
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    path: str
+    name: str
+    description: str
+    joints: tuple[str, ...]
+    pose: tuple[str, ...]
+    parameters: dict[str, Fraction]
+    context: fmpq_mpoly_ctx  # joints then pose
+    constraints: tuple[fmpq_mpoly, ...]
+    constraint_lines: tuple[int, ...]
+    joint_limits: dict[str, tuple[Fraction, Fraction]]
+    lines: dict[str, int] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class TrajectorySpec:
+    path: str
+    name: str
+    parameter: str
+    range: TimeRange
+    pose: dict[str, fmpq_mpoly]  # pose variable -> TRIG polynomial, robot's pose order
+    lines: dict[str, int] = field(default_factory=dict)
+
+
+class _Doc:
+    """Helpers bound to one file, for located errors."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+
+    def error(self, node_or_line, key: str | None, message: str) -> SpecError:
+        line = node_or_line if isinstance(node_or_line, int) or node_or_line is None \
+            else node_or_line.start_mark.line + 1
+        return SpecError(message, path=self.path, line=line, key=key)
+
+    def mapping(self, node, key: str | None) -> dict[str, tuple[yaml.Node, yaml.Node]]:
+        if not isinstance(node, yaml.MappingNode):
+            raise self.error(node, key, f"expected a mapping (key: value), got {_kind(node)}")
+        out: dict[str, tuple[yaml.Node, yaml.Node]] = {}
+        for k, v in node.value:
+            if not isinstance(k, yaml.ScalarNode):
+                raise self.error(k, key, "keys must be plain names")
+            if k.value in out:
+                raise self.error(k, key, f"duplicate key {k.value!r}")
+            out[k.value] = (k, v)
+        return out
+
+    def keys(self, node, allowed: dict[str, bool], what: str):
+        m = self.mapping(node, None)
+        for name, (k, _) in m.items():
+            if name not in allowed:
+                raise self.error(k, name, f"unknown key in a {what} spec (allowed: "
+                                          f"{', '.join(allowed)})")
+        for name, required in allowed.items():
+            if required and name not in m:
+                raise self.error(node, name, f"missing required key in a {what} spec")
+        return m
+
+    def scalar(self, node, key: str) -> str:
+        if not isinstance(node, yaml.ScalarNode):
+            raise self.error(node, key, f"expected a single value, got {_kind(node)}")
+        return str(node.value)
+
+    def text(self, node, key: str) -> str:
+        value = self.scalar(node, key).strip()
+        if not value:
+            raise self.error(node, key, "is empty")
+        return value
+
+    def names(self, node, key: str) -> tuple[str, ...]:
+        if not isinstance(node, yaml.SequenceNode) or not node.value:
+            raise self.error(node, key, "expected a non-empty list of names, e.g. [x, y]")
+        out = []
+        for i, item in enumerate(node.value):
+            name = self.text(item, f"{key}[{i}]")
+            if not _IDENTIFIER.match(name):
+                raise self.error(item, f"{key}[{i}]", f"{name!r} is not a valid name")
+            if name in RESERVED:
+                raise self.error(item, f"{key}[{i}]", f"{name!r} is reserved")
+            if name in out:
+                raise self.error(item, f"{key}[{i}]", f"{name!r} is listed twice")
+            out.append(name)
+        return tuple(out)
+
+    def number(self, node, key: str) -> Fraction:
+        text = self.text(node, key)
+        try:
+            value = compile_constant(parse(text))
+        except ExprError as e:
+            raise self.error(node, key, f"{e} in {text!r}") from None
+        if value.pi_coefficient:
+            raise self.error(node, key, f"must be an exact rational number, not {text!r}")
+        return value.rational
+
+    def expression(self, node, key: str, compile_):
+        text = self.text(node, key)
+        try:
+            return compile_(parse(text))
+        except ExprError as e:
+            raise self.error(node, key, f"{e.message} in {text!r}" +
+                             (f" at column {e.column}" if e.column else "")) from None
+
+
+def _kind(node) -> str:
+    return {yaml.MappingNode: "a mapping", yaml.SequenceNode: "a list",
+            yaml.ScalarNode: "a single value"}.get(type(node), "nothing")
+
+
+def _compose(text: str, path: str):
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.MarkedYAMLError as e:
+        mark = e.problem_mark or e.context_mark
+        line = mark.line + 1 if mark else None
+        problem = (e.problem or e.context or "invalid YAML").strip()
+        raise SpecError(f"not valid YAML: {problem}", path=path, line=line) from None
+    except yaml.YAMLError as e:
+        raise SpecError(f"not valid YAML: {str(e).splitlines()[0]}", path=path) from None
+    if node is None:
+        raise SpecError("the file is empty", path=path, line=1)
+    _refuse_tags(node, _Doc(path), set())
+    return node
+
+
+_PLAIN_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "null", "bool",
+                                                  "map", "seq")}
+
+
+def _refuse_tags(node, doc: _Doc, seen: set[int]) -> None:
+    """Refuse YAML tags, and aliases (``*name``): a node reached twice is an alias, and
+    nested aliases are how a small file expands into an enormous one."""
+    if id(node) in seen:
+        raise doc.error(node, None, "YAML aliases (*name) are not allowed in specs")
+    seen.add(id(node))
+    if node.tag not in _PLAIN_TAGS:
+        raise doc.error(node, None, f"YAML tags like {node.tag} are not allowed")
+    children = []
+    if isinstance(node, yaml.MappingNode):
+        for k, v in node.value:
+            children += [k, v]
+    elif isinstance(node, yaml.SequenceNode):
+        children = node.value
+    for child in children:
+        _refuse_tags(child, doc, seen)
+
+
+def _read(path: str | os.PathLike) -> str:
+    p = os.fspath(path)
+    try:
+        with open(p, "rb") as f:
+            data = f.read(MAX_BYTES + 1)
+    except OSError as e:
+        raise SpecError(f"cannot read the file: {e.strerror or e}", path=p) from None
+    if len(data) > MAX_BYTES:
+        raise SpecError(f"the file is larger than {MAX_BYTES} bytes", path=p)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = data[: e.start].count(b"\n") + 1
+        raise SpecError("the file is not UTF-8 text", path=p, line=line) from None
+
+
+def _line(node) -> int:
+    return node.start_mark.line + 1
+
+
+# ---------------------------------------------------------------------------------
+# robots
+
+
+def parse_robot(text: str, path: str) -> RobotSpec:
+    doc = _Doc(path)
+    top = doc.keys(_compose(text, path), ROBOT_KEYS, "robot")
+    lines = {k: _line(knode) for k, (knode, _) in top.items()}
+    name = doc.text(top["name"][1], "name")
+    description = doc.scalar(top["description"][1], "description").strip() \
+        if "description" in top else ""
+    joints = doc.names(top["joints"][1], "joints")
+    pose = doc.names(top["pose"][1], "pose")
+    for j in joints:
+        if j in pose:
+            raise doc.error(top["pose"][1], "pose", f"{j!r} is both a joint and a pose variable")
+    parameters: dict[str, Fraction] = {}
+    if "parameters" in top:
+        for pname, (knode, vnode) in doc.mapping(top["parameters"][1], "parameters").items():
+            key = f"parameters.{pname}"
+            if not _IDENTIFIER.match(pname) or pname in RESERVED:
+                raise doc.error(knode, key, f"{pname!r} is not a valid parameter name")
+            if pname in joints or pname in pose:
+                raise doc.error(knode, key, f"{pname!r} is already a joint or pose variable")
+            parameters[pname] = doc.number(vnode, key)
+    ctx = fmpq_mpoly_ctx.get(joints + pose, "lex")
+    variables = dict(zip(joints + pose, ctx.gens(), strict=True))
+    cnode = top["constraints"][1]
+    if not isinstance(cnode, yaml.SequenceNode) or not cnode.value:
+        raise doc.error(cnode, "constraints", "expected a non-empty list of polynomials")
+    constraints, constraint_lines = [], []
+    for i, item in enumerate(cnode.value):
+        key = f"constraints[{i}]"
+        poly = doc.expression(item, key,
+                              lambda n: compile_polynomial(n, ctx, variables, parameters))
+        if poly.is_zero():
+            raise doc.error(item, key, "is identically zero")
+        constraints.append(poly)
+        constraint_lines.append(_line(item))
+    if not len(constraints) == len(joints) == len(pose):
+        raise doc.error(top["constraints"][0], "constraints",
+                        f"{len(constraints)} constraints for {len(joints)} joints and "
+                        f"{len(pose)} pose variables: the system must be square")
+    limits: dict[str, tuple[Fraction, Fraction]] = {}
+    if "joint_limits" in top:
+        for jname, (knode, vnode) in doc.mapping(top["joint_limits"][1],
+                                                 "joint_limits").items():
+            key = f"joint_limits.{jname}"
+            if jname not in joints:
+                raise doc.error(knode, key, f"{jname!r} is not a joint (joints: "
+                                            f"{', '.join(joints)})")
+            if not isinstance(vnode, yaml.SequenceNode) or len(vnode.value) != 2:
+                raise doc.error(vnode, key, "expected [min, max]")
+            lo, hi = (doc.number(v, key) for v in vnode.value)
+            if not lo < hi:
+                raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
+            limits[jname] = (lo, hi)
+    return RobotSpec(path, name, description, joints, pose, parameters, ctx,
+                     tuple(constraints), tuple(constraint_lines), limits, lines)
+
+
+def load_robot(path: str | os.PathLike) -> RobotSpec:
+    return parse_robot(_read(path), os.fspath(path))
+
+
+# ---------------------------------------------------------------------------------
+# trajectories
+
+
+def _less(a: LinearInPi, b: LinearInPi) -> bool:
+    """Exactly a < b (π is irrational, so unequal values separate at some precision)."""
+    from singcheck.algebra.intervals import working_precision
+
+    if a == b:
+        return False
+    for bits in (64, 256, 1024, 4096):
+        with working_precision(bits):
+            d = b.ball() - a.ball()
+            if d > 0:
+                return True
+            if d < 0:
+                return False
+    raise AssertionError("unreachable: distinct a + bπ values separate")  # pragma: no cover
+
+
+def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
+    doc = _Doc(path)
+    top = doc.keys(_compose(text, path), TRAJECTORY_KEYS, "trajectory")
+    lines = {k: _line(knode) for k, (knode, _) in top.items()}
+    name = doc.text(top["name"][1], "name")
+    pnode = top["parameter"][1]
+    parameter = doc.text(pnode, "parameter")
+    if not _IDENTIFIER.match(parameter) or parameter in RESERVED:
+        raise doc.error(pnode, "parameter", f"{parameter!r} is not a valid name")
+    if parameter in robot.pose or parameter in robot.joints or parameter in robot.parameters:
+        raise doc.error(pnode, "parameter",
+                        f"{parameter!r} is already a name of robot {robot.name}")
+    rnode = top["range"][1]
+    if not isinstance(rnode, yaml.SequenceNode) or len(rnode.value) != 2:
+        raise doc.error(rnode, "range", "expected [start, end], e.g. [-pi, pi]")
+    ends = []
+    for i, item in enumerate(rnode.value):
+        ends.append(doc.expression(item, f"range[{i}]", compile_constant))
+    start, end = ends
+    if not _less(start, end):
+        raise doc.error(rnode, "range", f"empty range: start {start} must be smaller than "
+                                        f"end {end}")
+    pose_map = doc.mapping(top["pose"][1], "pose")
+    missing = [v for v in robot.pose if v not in pose_map]
+    extra = [v for v in pose_map if v not in robot.pose]
+    if extra:
+        knode = pose_map[extra[0]][0]
+        raise doc.error(knode, f"pose.{extra[0]}",
+                        f"{extra[0]!r} is not a pose variable of robot {robot.name} "
+                        f"(pose: {', '.join(robot.pose)})")
+    if missing:
+        raise doc.error(top["pose"][0], "pose",
+                        f"missing coordinate(s) {', '.join(missing)} of robot {robot.name}")
+    coords = {}
+    for v in robot.pose:
+        coords[v] = doc.expression(
+            pose_map[v][1], f"pose.{v}",
+            lambda n: compile_trajectory_coordinate(n, parameter, robot.parameters))
+    return TrajectorySpec(path, name, parameter, TimeRange(start, end), coords, lines)
+
+
+def load_trajectory(path: str | os.PathLike, robot: RobotSpec) -> TrajectorySpec:
+    return parse_trajectory(_read(path), os.fspath(path), robot)

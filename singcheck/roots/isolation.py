@@ -20,7 +20,10 @@ from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
 from singcheck.algebra.trig import LinearInPi, TimeRange, reduce_trig, uses_t, uses_trig
 from singcheck.roots.branch_bound import branch_and_bound
 from singcheck.roots.enclosures import (
+    BRANCH_AND_BOUND,
     EXACT,
+    IN_T,
+    ExactTime,
     IdenticallyZeroError,
     RealRoot,
     RootIsolation,
@@ -35,7 +38,7 @@ from singcheck.roots.rational import (
 )
 
 
-def _as_univariate_t(p: fmpq_mpoly) -> fmpq_poly:
+def as_univariate_t(p: fmpq_mpoly) -> fmpq_poly:
     coeffs: dict[int, fmpq] = {}
     for (i, _j, _k), c in p.terms():
         coeffs[i] = coeffs.get(i, fmpq(0)) + c
@@ -46,7 +49,7 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
     roots, undecided = [], []
     ends = [fmpq(e.rational.numerator, e.rational.denominator)
             for e in (interval.start, interval.end) if not e.pi_coefficient]
-    for rr, mult in real_roots_exact(_as_univariate_t(p)):
+    for rr, mult in real_roots_exact(as_univariate_t(p)):
         for q in ends:
             rr.pin(q)
 
@@ -59,10 +62,55 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
         if where is None:
             undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
         elif where:
-            roots.append(RealRoot(make(tolerance), mult, make))
+            roots.append(RealRoot(make(tolerance), mult, make,
+                                  ExactTime(IN_T, lambda rr=rr: rr)))
     return RootIsolation(tuple(roots), tuple(undecided), EXACT)
 
 
+
+
+def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
+    """t mixed with sin t, cos t: each irreducible factor of p in Q[t, s, c] by its own
+    method (a factor free of t or of s, c exactly; the rest by branch-and-bound), so that
+    a repeated factor costs one isolation and pure factors keep their exact roots.
+
+    Roots of different factors are merged: balls that overlap are refined apart; a root
+    two factors share (proven only for the same exact point) is kept once; two balls
+    that stay overlapping otherwise become an undecided stretch."""
+    _, factors = p.factor()
+    if len(factors) == 1 and factors[0][1] == 1:
+        return branch_and_bound(p, interval, tolerance)
+    roots: list[tuple[RealRoot, int]] = []
+    undecided: list[Undecided] = []
+    for f, mult in factors:
+        if f.is_constant():
+            continue
+        iso = isolate_real_roots(f, interval, tolerance)
+        roots += [(r, int(mult)) for r in iso.roots]
+        undecided += list(iso.undecided)
+    roots.sort(key=lambda item: float(item[0].t.mid()))
+    merged: list[RealRoot] = []
+    for r, mult in roots:
+        r = RealRoot(r.t, None if r.multiplicity is None else r.multiplicity * mult,
+                     r._refine, r.exact)
+        if merged and merged[-1].t.overlaps(r.t):
+            prev, tol = merged[-1], tolerance
+            for _ in range(6):
+                if not prev.t.overlaps(r.t):
+                    break
+                tol /= 1e4
+                prev, r = prev.refined(tol), r.refined(tol)
+            if prev.t.overlaps(r.t):
+                if prev.t.is_exact() and r.t.is_exact() and prev.t == r.t:
+                    merged[-1] = RealRoot(prev.t, None, prev._refine, prev.exact or r.exact)
+                    continue
+                merged.pop()
+                undecided.append(Undecided(prev.t.union(r.t), "two factors of the function "
+                                           "have roots that could not be separated"))
+                continue
+            merged[-1] = prev
+        merged.append(r)
+    return RootIsolation(tuple(merged), tuple(undecided), BRANCH_AND_BOUND)
 
 
 def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
@@ -72,7 +120,7 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
     if p.is_zero():
         raise IdenticallyZeroError("the function is identically zero along the path")
     if uses_t(p) and uses_trig(p):
-        return branch_and_bound(p, interval, tolerance)
+        return _mixed(p, interval, tolerance)
     if uses_trig(p):
         return _half_angle(p, interval, tolerance)
     return _exact_univariate(p, interval, tolerance)

@@ -16,19 +16,28 @@ from fractions import Fraction
 import yaml
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
-from singcheck.algebra.trig import LinearInPi, TimeRange
 from singcheck.errors import SpecError
 from singcheck.spec.grammar import (
     ExprError,
     compile_constant,
     compile_polynomial,
-    compile_trajectory_coordinate,
     parse,
 )
+from singcheck.spec.paths import multi_piece, parse_csv
+from singcheck.spec.trajectory import (
+    TrajectorySpec,
+    pose_nodes,
+    time_range,
+    trajectory_piece,
+)
+
+__all__ = ["RobotSpec", "TrajectorySpec", "load_robot", "load_trajectory", "parse_robot",
+           "parse_trajectory"]
 
 ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
               "parameters": False, "constraints": True, "joint_limits": False}
-TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": True, "pose": True}
+TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": False, "pose": False,
+                   "segments": False, "waypoints": False, "interpolation": False}
 RESERVED = {"pi", "sin", "cos"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
@@ -46,16 +55,6 @@ class RobotSpec:
     constraints: tuple[fmpq_mpoly, ...]
     constraint_lines: tuple[int, ...]
     joint_limits: dict[str, tuple[Fraction, Fraction]]
-    lines: dict[str, int] = field(default_factory=dict)
-
-
-@dataclass(frozen=True)
-class TrajectorySpec:
-    path: str
-    name: str
-    parameter: str
-    range: TimeRange
-    pose: dict[str, fmpq_mpoly]  # pose variable -> TRIG polynomial, robot's pose order
     lines: dict[str, int] = field(default_factory=dict)
 
 
@@ -270,27 +269,7 @@ def load_robot(path: str | os.PathLike) -> RobotSpec:
 # trajectories
 
 
-def _less(a: LinearInPi, b: LinearInPi) -> bool:
-    """Exactly a < b (π is irrational, so unequal values separate at some precision)."""
-    from singcheck.algebra.intervals import working_precision
-
-    if a == b:
-        return False
-    for bits in (64, 256, 1024, 4096):
-        with working_precision(bits):
-            d = b.ball() - a.ball()
-            if d > 0:
-                return True
-            if d < 0:
-                return False
-    raise AssertionError("unreachable: distinct a + bπ values separate")  # pragma: no cover
-
-
-def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
-    doc = _Doc(path)
-    top = doc.keys(_compose(text, path), TRAJECTORY_KEYS, "trajectory")
-    lines = {k: _line(knode) for k, (knode, _) in top.items()}
-    name = doc.text(top["name"][1], "name")
+def trajectory_parameter(doc: _Doc, top, robot: RobotSpec) -> str:
     pnode = top["parameter"][1]
     parameter = doc.text(pnode, "parameter")
     if not _IDENTIFIER.match(parameter) or parameter in RESERVED:
@@ -298,34 +277,35 @@ def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
     if parameter in robot.pose or parameter in robot.joints or parameter in robot.parameters:
         raise doc.error(pnode, "parameter",
                         f"{parameter!r} is already a name of robot {robot.name}")
+    return parameter
+
+
+def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
+    doc = _Doc(path)
+    root = _compose(text, path)
+    top = doc.keys(root, TRAJECTORY_KEYS, "trajectory")
+    lines = {k: _line(knode) for k, (knode, _) in top.items()}
+    name = doc.text(top["name"][1], "name")
+    parameter = trajectory_parameter(doc, top, robot)
+    forms = [k for k in ("segments", "waypoints") if k in top]
+    if forms or "interpolation" in top:
+        return multi_piece(doc, root, top, name, parameter, robot, lines)
+    for k in ("range", "pose"):
+        if k not in top:
+            raise doc.error(root, k, "missing required key in a trajectory spec (or give "
+                                     "segments or waypoints)")
     rnode = top["range"][1]
-    if not isinstance(rnode, yaml.SequenceNode) or len(rnode.value) != 2:
-        raise doc.error(rnode, "range", "expected [start, end], e.g. [-pi, pi]")
-    ends = []
-    for i, item in enumerate(rnode.value):
-        ends.append(doc.expression(item, f"range[{i}]", compile_constant))
-    start, end = ends
-    if not _less(start, end):
-        raise doc.error(rnode, "range", f"empty range: start {start} must be smaller than "
-                                        f"end {end}")
-    pose_map = doc.mapping(top["pose"][1], "pose")
-    missing = [v for v in robot.pose if v not in pose_map]
-    extra = [v for v in pose_map if v not in robot.pose]
-    if extra:
-        knode = pose_map[extra[0]][0]
-        raise doc.error(knode, f"pose.{extra[0]}",
-                        f"{extra[0]!r} is not a pose variable of robot {robot.name} "
-                        f"(pose: {', '.join(robot.pose)})")
-    if missing:
-        raise doc.error(top["pose"][0], "pose",
-                        f"missing coordinate(s) {', '.join(missing)} of robot {robot.name}")
-    coords = {}
-    for v in robot.pose:
-        coords[v] = doc.expression(
-            pose_map[v][1], f"pose.{v}",
-            lambda n: compile_trajectory_coordinate(n, parameter, robot.parameters))
-    return TrajectorySpec(path, name, parameter, TimeRange(start, end), coords, lines)
+    rng = time_range(doc, rnode, "range")
+    nodes = pose_nodes(doc, top["pose"][1], "pose", robot, top["pose"][0])
+    rng, coords, scale = trajectory_piece(doc, rng, rnode, nodes, "pose", parameter, robot)
+    return TrajectorySpec(path, name, parameter, rng, coords, lines, scale)
 
 
-def load_trajectory(path: str | os.PathLike, robot: RobotSpec) -> TrajectorySpec:
-    return parse_trajectory(_read(path), os.fspath(path), robot)
+def load_trajectory(path: str | os.PathLike, robot: RobotSpec,
+                    interpolation: str | None = None) -> TrajectorySpec:
+    """A trajectory spec: YAML, or a CSV table of poses (``*.csv``) interpolated
+    ``interpolation`` (linear or cubic; default cubic)."""
+    p = os.fspath(path)
+    if p.lower().endswith(".csv"):
+        return parse_csv(_read(path), p, robot, interpolation or "cubic")
+    return parse_trajectory(_read(path), p, robot)

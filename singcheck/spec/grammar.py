@@ -221,7 +221,7 @@ class _Compiler:
         if k == "num":
             return node.value
         if k == "name":
-            if node.value == "pi":
+            if node.value == "pi" and "pi" not in self.names:
                 raise ExprError(f"pi is not allowed in a {self.what} (coefficients must be "
                                 "rational)", node.column)
             if node.value not in self.names:
@@ -306,34 +306,90 @@ def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmp
     return compiler.lift(compiler.run(node))
 
 
-def _multiple_of(node: Node, parameter: str) -> int:
-    """k when ``node`` is k·parameter for an integer k (else ExprError)."""
+_ARGUMENT = fmpq_mpoly_ctx.get(("t", "p"), "lex")  # a sin/cos argument: t and π
+
+
+def _argument(node: Node, parameter: str) -> tuple[Fraction, bool] | None:
+    """(k, False) when ``node`` is k·parameter, (k, True) when it is k·π·parameter, for a
+    rational k ≠ 0; None otherwise."""
+    t, p = _ARGUMENT.gens()
     try:
-        p = _Compiler(TRIG, {parameter: T}, what="sin/cos argument").run(node)
+        value = _Compiler(_ARGUMENT, {parameter: t, "pi": p},
+                          what="sin/cos argument").run(node)
     except ExprError:
-        p = None
-    terms = dict(p.terms()) if p is not None and not isinstance(p, Fraction) else {}
-    if set(terms) == {(1, 0, 0)}:
-        coeff = fmpq(terms[(1, 0, 0)])
-        if coeff.q == 1:
-            return int(coeff.p)
+        return None
+    terms = dict(value.terms()) if not isinstance(value, Fraction) else {}
+    if len(terms) != 1:
+        return None
+    (exps, coeff), = terms.items()
+    if exps not in ((1, 0), (1, 1)):
+        return None
+    k = fmpq(coeff)
+    return Fraction(int(k.p), int(k.q)), exps == (1, 1)
+
+
+def pi_multiples(node: Node, parameter: str) -> list[Fraction]:
+    """Every k of an argument k·π·parameter of sin/cos in the tree (to pick the rescaling
+    τ = g·π·t under which they all become integer multiples of τ)."""
+    out = []
+    if node.kind == "call" and node.args:
+        arg = _argument(node.args[0], parameter)
+        if arg is not None and arg[1]:
+            out.append(arg[0])
+    for a in node.args:
+        out += pi_multiples(a, parameter)
+    return out
+
+
+def _multiple_of(node: Node, parameter: str, pi_scale: Fraction | None = None) -> int:
+    """The integer m of a sin/cos argument m·τ: k·parameter (integer k) on an unscaled
+    path, k·π·parameter = (k/g)·τ on a path rescaled by τ = g·π·parameter."""
+    arg = _argument(node, parameter)
+    if arg is not None:
+        k, with_pi = arg
+        if with_pi and pi_scale is not None and (k / pi_scale).denominator == 1:
+            return int(k / pi_scale)
+        if with_pi and pi_scale is None:
+            raise ExprError(f"pi*{parameter} arguments need their own segment: sin/cos of "
+                            f"k*pi*{parameter} cannot be mixed here", node.column)
+        if not with_pi and pi_scale is not None:
+            raise ExprError(f"sin/cos of k*{parameter} and of k*pi*{parameter} cannot be "
+                            "mixed in one segment", node.column)
+        if not with_pi and k.denominator == 1:
+            return int(k)
     raise ExprError(f"the argument of sin/cos must be an integer multiple of {parameter} "
-                    f"(e.g. 3*{parameter})", node.column)
+                    f"or a rational multiple of pi*{parameter} (e.g. 3*{parameter}, "
+                    f"2*pi*{parameter})", node.column)
 
 
 def compile_trajectory_coordinate(node: Node, parameter: str,
-                                  parameters: dict[str, Fraction]) -> fmpq_mpoly:
-    """The trig polynomial (in ``TRIG``, reduced) of a trajectory coordinate."""
+                                  parameters: dict[str, Fraction],
+                                  pi_scale: Fraction | None = None) -> fmpq_mpoly:
+    """The trig polynomial (in ``TRIG``, reduced) of a trajectory coordinate.
+
+    With ``pi_scale`` g the coordinate is written in τ = g·π·parameter: sin(k·π·t)
+    becomes sin((k/g)·τ) (k/g must be an integer), and a bare parameter is refused (it
+    would be τ/(gπ), not rational)."""
 
     def call(n: Node):
-        k = _multiple_of(n.args[0], parameter)
+        k = _multiple_of(n.args[0], parameter, pi_scale)
         if abs(k) > MAX_DEGREE:
             raise ExprError(f"the multiple {k} of {parameter} is larger than {MAX_DEGREE}",
                             n.column)
         return sin_multiple(k) if n.value == "sin" else cos_multiple(k)
 
-    compiler = _Compiler(TRIG, {**parameters, parameter: T}, call, what="trajectory")
-    return reduce_trig(compiler.lift(compiler.run(node)))
+    names: dict = {**parameters}
+    if pi_scale is None:
+        names[parameter] = T
+    compiler = _Compiler(TRIG, names, call, what="trajectory")
+    try:
+        return reduce_trig(compiler.lift(compiler.run(node)))
+    except ExprError as e:
+        if pi_scale is not None and e.message.startswith(f"undeclared name {parameter!r}"):
+            raise ExprError(f"{parameter} outside sin/cos cannot be mixed with sin/cos of "
+                            f"k*pi*{parameter} (it would need an irrational coefficient)",
+                            e.column) from None
+        raise
 
 
 def compile_constant(node: Node) -> LinearInPi:

@@ -183,6 +183,9 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
 
         spec = load_robot(robot)
         traj = load_trajectory(trajectory, spec) if trajectory else None
+        if traj is not None and traj.segments:
+            raise SpecError(f"project prints the formulas of a one-piece trajectory; this one "
+                            f"has {len(traj.segments)} segments", path=traj.path)
         engine = api.elimination_engine(backend, cache=False)
         machine = api.robot_from_spec(spec, cache=False, engine=engine)
         epsilon = None if no_epsilon else joint_space_singularities(machine.model, engine)

@@ -16,17 +16,24 @@ from fractions import Fraction
 import yaml
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
+from singcheck.algebra.polynomials import restrict
+from singcheck.algebra.radicals import angle_names, radical_name, radical_variables
 from singcheck.errors import SpecError
 from singcheck.spec.grammar import (
+    Constant,
     ExprError,
+    angles_in,
     compile_constant,
     compile_polynomial,
+    compile_value,
     parse,
 )
 from singcheck.spec.paths import multi_piece, parse_csv
 from singcheck.spec.trajectory import (
     TrajectorySpec,
+    exactly_less,
     pose_nodes,
+    radical_primes,
     time_range,
     trajectory_piece,
 )
@@ -39,7 +46,7 @@ ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
               "drawing": False}
 TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": False, "pose": False,
                    "segments": False, "waypoints": False, "interpolation": False}
-RESERVED = {"pi", "sin", "cos"}
+RESERVED = {"pi", "sin", "cos", "sqrt"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
 MAX_DRAWING_POINTS = 1000  # every point of a drawing is evaluated once per frame drawn
@@ -63,12 +70,32 @@ class RobotSpec:
     description: str
     joints: tuple[str, ...]
     pose: tuple[str, ...]
-    parameters: dict[str, Fraction]
-    context: fmpq_mpoly_ctx  # joints then pose
+    parameters: dict[str, Fraction | Constant]  # Fraction when rational
+    context: fmpq_mpoly_ctx  # joints then pose then radicals (see ``variables``)
     constraints: tuple[fmpq_mpoly, ...]
     constraint_lines: tuple[int, ...]
-    joint_limits: dict[str, tuple[Fraction, Fraction]]
+    joint_limits: dict[str, tuple]  # Fractions; LinearInPi (radians) for an angle joint
     lines: dict[str, int] = field(default_factory=dict)
+    angles: frozenset[str] = frozenset()  # joints and pose variables used inside sin/cos
+    radicals: tuple[int, ...] = ()  # primes p whose sqrt(p) is a variable of the context
+
+    def variables(self, name: str) -> tuple[str, ...]:
+        """The context's variables of a joint or pose variable: itself, or
+        ``(cos(v), sin(v))`` for an angle."""
+        return angle_names(name) if name in self.angles else (name,)
+
+    @property
+    def joint_variables(self) -> tuple[str, ...]:
+        return tuple(v for j in self.joints for v in self.variables(j))
+
+    @property
+    def pose_variables(self) -> tuple[str, ...]:
+        return tuple(v for x in self.pose for v in self.variables(x))
+
+    @property
+    def radical_variables(self) -> tuple[str, ...]:
+        return tuple(radical_name(p) for p in self.radicals)
+
     drawing: tuple[DrawingBody, ...] = ()  # the optional ``drawing`` key
 
     @property
@@ -149,6 +176,17 @@ class _Doc:
         if value.pi_coefficient:
             raise self.error(node, key, f"must be an exact rational number, not {text!r}")
         return value.rational
+
+    def value(self, node, key: str, parameters: dict) -> Fraction | Constant:
+        """A parameter's exact value: a Fraction when rational, else a Constant."""
+        text = self.text(node, key)
+        try:
+            value = compile_value(parse(text), parameters)
+        except (ExprError, ValueError, ZeroDivisionError) as e:
+            raise self.error(node, key, f"{e} in {text!r}") from None
+        if not value.pi_coefficient and value.surd.is_rational():
+            return value.surd.rational_value()
+        return value
 
     def expression(self, node, key: str, compile_):
         text = self.text(node, key)
@@ -246,21 +284,33 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                 raise doc.error(knode, key, f"{pname!r} is not a valid parameter name")
             if pname in joints or pname in pose:
                 raise doc.error(knode, key, f"{pname!r} is already a joint or pose variable")
-            parameters[pname] = doc.number(vnode, key)
-    ctx = fmpq_mpoly_ctx.get(joints + pose, "lex")
-    variables = dict(zip(joints + pose, ctx.gens(), strict=True))
+            parameters[pname] = doc.value(vnode, key, parameters)
     cnode = top["constraints"][1]
     if not isinstance(cnode, yaml.SequenceNode) or not cnode.value:
         raise doc.error(cnode, "constraints", "expected a non-empty list of polynomials")
-    constraints, constraint_lines = [], []
+    trees = [doc.expression(item, f"constraints[{i}]", lambda n: n)
+             for i, item in enumerate(cnode.value)]
+    angles = frozenset().union(*(angles_in(t, joints + pose) for t in trees))
+    algebraic = [v for name in joints + pose
+                 for v in (angle_names(name) if name in angles else (name,))]
+    primes = sorted(radical_primes(parameters, trees))
+    wide = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in primes)), "lex")
+    gens = dict(zip(wide.names(), wide.gens(), strict=True))
+    variables = {v: gens[v] for v in joints + pose if v not in angles}
+    pairs = {v: tuple(gens[n] for n in angle_names(v)) for v in angles}
+    compiled, constraint_lines = [], []
     for i, item in enumerate(cnode.value):
         key = f"constraints[{i}]"
-        poly = doc.expression(item, key,
-                              lambda n: compile_polynomial(n, ctx, variables, parameters))
+        poly = doc.expression(item, key, lambda n: compile_polynomial(n, wide, variables,
+                                                                      parameters, pairs))
         if poly.is_zero():
             raise doc.error(item, key, "is identically zero")
-        constraints.append(poly)
+        compiled.append(poly)
         constraint_lines.append(_line(item))
+    used = tuple(p for i, p in radical_variables(wide)
+                 if any(f.degrees()[i] > 0 for f in compiled))
+    ctx = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in used)), "lex")
+    constraints = [restrict(f, ctx) for f in compiled]
     if not len(constraints) == len(joints) == len(pose):
         raise doc.error(top["constraints"][0], "constraints",
                         f"{len(constraints)} constraints for {len(joints)} joints and "
@@ -275,17 +325,27 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                                             f"{', '.join(joints)})")
             if not isinstance(vnode, yaml.SequenceNode) or len(vnode.value) != 2:
                 raise doc.error(vnode, key, "expected [min, max]")
-            lo, hi = (doc.number(v, key) for v in vnode.value)
-            if not lo < hi:
-                raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
+            if jname in angles:
+                lo, hi = (doc.expression(v, key, compile_constant) for v in vnode.value)
+                if not exactly_less(lo, hi):
+                    raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
+            else:
+                lo, hi = (doc.number(v, key) for v in vnode.value)
+                if not lo < hi:
+                    raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
             limits[jname] = (lo, hi)
-    drawing = _drawing(doc, top["drawing"][1], ctx, variables, parameters) \
+    final = dict(zip(ctx.names(), ctx.gens(), strict=True))
+    drawing = _drawing(doc, top["drawing"][1], ctx,
+                       {v: final[v] for v in joints + pose if v not in angles}, parameters,
+                       {v: tuple(final[n] for n in angle_names(v)) for v in angles}) \
         if "drawing" in top else ()
     return RobotSpec(path, name, description, joints, pose, parameters, ctx,
-                     tuple(constraints), tuple(constraint_lines), limits, lines, drawing)
+                     tuple(constraints), tuple(constraint_lines), limits, lines,
+                     angles=angles, radicals=used, drawing=drawing)
 
 
-def _drawing(doc: _Doc, node, ctx, variables, parameters) -> tuple[DrawingBody, ...]:
+def _drawing(doc: _Doc, node, ctx, variables, parameters,
+             angles=None) -> tuple[DrawingBody, ...]:
     """The ``drawing`` key: ``body: [item, ...]`` where an item is a point ``[e, e(, e)]``
     or a chain of segments ``[[e, e(, e)], [e, e(, e)], ...]`` (two points: one segment),
     every ``e`` a polynomial in the joints, pose and parameters; one dimension, 2 or 3,
@@ -309,7 +369,8 @@ def _drawing(doc: _Doc, node, ctx, variables, parameters) -> tuple[DrawingBody, 
         if count > MAX_DRAWING_POINTS:
             raise doc.error(pnode, key, f"more than {MAX_DRAWING_POINTS} points")
         return tuple(doc.expression(
-            v, f"{key}[{i}]", lambda n: compile_polynomial(n, ctx, variables, parameters))
+            v, f"{key}[{i}]", lambda n: compile_polynomial(n, ctx, variables, parameters,
+                                                          angles))
             for i, v in enumerate(pnode.value))
 
     for bname, (knode, bnode) in doc.mapping(node, "drawing").items():
@@ -364,8 +425,7 @@ def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
     lines = {k: _line(knode) for k, (knode, _) in top.items()}
     name = doc.text(top["name"][1], "name")
     parameter = trajectory_parameter(doc, top, robot)
-    forms = [k for k in ("segments", "waypoints") if k in top]
-    if forms or "interpolation" in top:
+    if "segments" in top or "waypoints" in top or "interpolation" in top:
         return multi_piece(doc, root, top, name, parameter, robot, lines)
     for k in ("range", "pose"):
         if k not in top:
@@ -374,8 +434,9 @@ def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
     rnode = top["range"][1]
     rng = time_range(doc, rnode, "range")
     nodes = pose_nodes(doc, top["pose"][1], "pose", robot, top["pose"][0])
-    rng, coords, scale = trajectory_piece(doc, rng, rnode, nodes, "pose", parameter, robot)
-    return TrajectorySpec(path, name, parameter, rng, coords, lines, scale)
+    rng, coords, scale, offsets = trajectory_piece(doc, rng, rnode, nodes, "pose", parameter,
+                                                   robot)
+    return TrajectorySpec(path, name, parameter, rng, coords, lines, offsets, scale)
 
 
 def load_trajectory(path: str | os.PathLike, robot: RobotSpec,

@@ -77,7 +77,7 @@ def multi_piece(doc, root, top, name: str, parameter: str, robot,
 
 def _whole(path: str, name: str, parameter: str, pieces, lines) -> TrajectorySpec:
     rng = TimeRange(pieces[0].global_range.start, pieces[-1].global_range.end)
-    return TrajectorySpec(path, name, parameter, rng, {}, lines, None, tuple(pieces))
+    return TrajectorySpec(path, name, parameter, rng, {}, lines, segments=tuple(pieces))
 
 
 def _segments(doc, node, name: str, parameter: str, robot):
@@ -98,10 +98,11 @@ def _segments(doc, node, name: str, parameter: str, robot):
         rnode = m["range"][1]
         rng = time_range(doc, rnode, f"{key}.range")
         coords = pose_nodes(doc, m["pose"][1], f"{key}.pose", robot, m["pose"][0])
-        rng, poly, scale = trajectory_piece(doc, rng, rnode, coords, f"{key}.pose", parameter,
-                                            robot)
+        rng, poly, scale, offsets = trajectory_piece(doc, rng, rnode, coords, f"{key}.pose",
+                                                     parameter, robot)
         piece = TrajectorySpec(doc.path, f"{name}[{i + 1}]", parameter, rng, poly,
-                               {"segment": _line(item)}, scale)
+                               {"segment": _line(item)}, angle_offsets=offsets,
+                               time_scale=scale)
         if pieces and pieces[-1].global_range.end != piece.global_range.start:
             raise doc.error(rnode, f"{key}.range",
                             f"segment {i + 1} starts at {piece.global_range.start} but "
@@ -119,11 +120,18 @@ def check_joins(pieces, path: str, lines: list[int | None]) -> None:
         checkpoint()
         at = left.global_range.end
         for v in left.pose:
+            where = f"segments {i + 1} and {i + 2} at {left.parameter} = {at}"
+            if left.pose[v].context() is not TRIG or right.pose[v].context() is not TRIG:
+                raise SpecError(f"cannot check exactly that {where} meet: square roots in "
+                                "segments are not supported", path=path, line=lines[i + 1],
+                                key=v)
+            pi = LinearInPi(Fraction(0), Fraction(1))  # an angle's offset q·π is q·t at t = π
+            offset = left.angle_offsets.get(v, 0) - right.angle_offsets.get(v, 0)
             same = sum_is_zero([(left.pose[v], left.local_time(at)),
-                                (-right.pose[v], right.local_time(at))])
+                                (-right.pose[v], right.local_time(at)),
+                                (T * _q(Fraction(offset)), pi)])
             if same is True:
                 continue
-            where = f"segments {i + 1} and {i + 2} at {left.parameter} = {at}"
             if same is None:
                 raise SpecError(f"cannot check exactly that {where} meet (put joins at "
                                 "rational times or rational multiples of pi)", path=path,

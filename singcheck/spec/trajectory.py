@@ -13,14 +13,19 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 
 import yaml
-from flint import fmpq_mpoly
+from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
-from singcheck.algebra.trig import LinearInPi, TimeRange
+from singcheck.algebra.polynomials import restrict
+from singcheck.algebra.radicals import radical_name, radical_variables
+from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
 from singcheck.spec.grammar import (
+    Constant,
     ExprError,
+    Node,
+    compile_angle_coordinate,
     compile_constant,
     compile_trajectory_coordinate,
-    parse,
+    compile_value,
     pi_multiples,
 )
 
@@ -33,6 +38,8 @@ class TrajectorySpec:
     range: TimeRange
     pose: dict[str, fmpq_mpoly]  # pose variable -> TRIG polynomial, robot's pose order
     lines: dict[str, int] = field(default_factory=dict)
+    #: an angle's coordinate is pose[v] + angle_offsets[v]·π (only angles have an entry)
+    angle_offsets: dict[str, Fraction] = field(default_factory=dict)
     #: g when the pose is written in τ = g·π·t (sin/cos of k·π·t): ``pose`` and ``range``
     #: are then in τ, and :meth:`to_global` maps a time back to t.
     time_scale: Fraction | None = None
@@ -71,7 +78,7 @@ class TrajectorySpec:
         return t / (arb.pi() * arb(fmpq(g.numerator, g.denominator)))
 
 
-def _less(a: LinearInPi, b: LinearInPi) -> bool:
+def exactly_less(a: LinearInPi, b: LinearInPi) -> bool:
     """Exactly a < b (π is irrational, so unequal values separate at some precision)."""
     from singcheck.algebra.intervals import working_precision
 
@@ -93,7 +100,7 @@ def time_range(doc, rnode, key: str) -> TimeRange:
         raise doc.error(rnode, key, "expected [start, end], e.g. [-pi, pi]")
     start, end = (doc.expression(item, f"{key}[{i}]", compile_constant)
                   for i, item in enumerate(rnode.value))
-    if not _less(start, end):
+    if not exactly_less(start, end):
         raise doc.error(rnode, key, f"empty range: start {start} must be smaller than "
                                     f"end {end}")
     return TimeRange(start, end)
@@ -125,24 +132,58 @@ def _scale_of(multiples: list[Fraction]) -> Fraction | None:
     return Fraction(gcd(*(k.numerator for k in ks)), lcm(*(k.denominator for k in ks)))
 
 
-def trajectory_piece(doc, rng: TimeRange, rnode, nodes: dict, key: str,
-                     parameter: str, robot) -> tuple[TimeRange, dict, Fraction | None]:
-    """A piece's pose compiled exactly, with its range in its own time: sin/cos of k·π·t
-    (rational k) rescale the piece to τ = g·π·t (then the range must be rational, and
-    becomes [g·π·start, g·π·end])."""
-    multiples = []
+def radical_primes(parameters: dict, trees: list[Node]) -> set[int]:
+    """Every prime whose square root a compiled expression may need: those of the
+    parameters, of each ``sqrt(q)`` written inline, and 2 and 3 (the sines and
+    cosines of multiples of π/12)."""
+    primes = {2, 3}
+    for value in parameters.values():
+        if isinstance(value, Constant):
+            primes |= value.surd.primes()
+
+    def walk(node: Node) -> None:
+        if node.kind == "call" and node.value == "sqrt":
+            try:
+                primes.update(compile_value(node, parameters).surd.primes())
+            except ExprError:
+                pass  # the compiler reports it, with its column
+        for a in node.args:
+            walk(a)
+
+    for tree in trees:
+        walk(tree)
+    return primes
+
+
+def trajectory_piece(doc, rng: TimeRange, rnode, nodes: dict, key: str, parameter: str,
+                     robot) -> tuple[TimeRange, dict, Fraction | None, dict]:
+    """A piece's pose compiled exactly (with its angles' π offsets), its range in its own
+    time: sin/cos of k·π·t (rational k) rescale the piece to τ = g·π·t (then the range
+    must be rational, and becomes [g·π·start, g·π·end])."""
+    trees = {v: doc.expression(node, f"{key}.{v}", lambda n: n) for v, node in nodes.items()}
+    scale = _scale_of([k for tree in trees.values()
+                       for k in pi_multiples(tree, parameter, robot.parameters)])
+    primes = sorted(radical_primes(robot.parameters, list(trees.values())))
+    ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
+    coords, offsets = {}, {}
     for v, node in nodes.items():
-        try:
-            multiples += pi_multiples(parse(doc.text(node, f"{key}.{v}")), parameter)
-        except ExprError:
-            pass  # reported with its column when compiled below
-    scale = _scale_of(multiples)
-    coords = {v: doc.expression(node, f"{key}.{v}", lambda n: compile_trajectory_coordinate(
-        n, parameter, robot.parameters, scale)) for v, node in nodes.items()}
+        if v in robot.angles:
+            coords[v], offsets[v] = doc.expression(
+                node, f"{key}.{v}", lambda n: compile_angle_coordinate(
+                    n, parameter, robot.parameters, ring, scale))
+        else:
+            coords[v] = doc.expression(
+                node, f"{key}.{v}", lambda n: compile_trajectory_coordinate(
+                    n, parameter, robot.parameters, ring, scale))
+    used = [i for i, _ in radical_variables(ring)
+            if any(p.degrees()[i] > 0 for p in coords.values())]
+    names = ("t", "s", "c", *(ring.names()[i] for i in used))
+    small = TRIG if not used else fmpq_mpoly_ctx.get(names, "lex")
+    coords = {v: restrict(p, small) for v, p in coords.items()}
     if scale is not None:
         if rng.start.pi_coefficient or rng.end.pi_coefficient:
             raise doc.error(rnode, "range", f"with sin/cos of k*pi*{parameter} the range "
                                             "must be rational (no pi)")
         rng = TimeRange(LinearInPi(Fraction(0), scale * rng.start.rational),
                         LinearInPi(Fraction(0), scale * rng.end.rational))
-    return rng, coords, scale
+    return rng, coords, scale, offsets

@@ -124,6 +124,23 @@ BAD_ROBOTS = [
     ("!!python/object/apply:os.system ['echo hacked']\n", 1, None, "not allowed"),
     ("name: !!python/name:os.system x\n", 1, None, "not allowed"),
     ("- just\n- a list\n", 1, None, "expected a mapping"),
+    (ROBOT + "drawing: 3\n", 9, "drawing", "expected a mapping"),
+    (ROBOT + "drawing: {}\n", 9, "drawing", "names no body"),
+    (ROBOT + "drawing:\n  legs: []\n", 10, "drawing.legs", "non-empty list"),
+    (ROBOT + "drawing:\n  legs:\n    - [[p, 0], [x, w]]\n", 11, "drawing.legs[0][1][1]",
+     "undeclared name 'w'"),
+    (ROBOT + "drawing:\n  legs:\n    - [[p, 0], [x, y/x]]\n", 11, "drawing.legs[0][1][1]",
+     "division by a non-constant"),
+    (ROBOT + "drawing:\n  legs:\n    - [[p, 0], [x, y]]\n    - [[q, 0, 0], [x, y, 0]]\n",
+     12, "drawing.legs[1][0]", "3-D point in a 2-D drawing (line 11)"),
+    (ROBOT + "drawing:\n  dots: [[x]]\n", 10, "drawing.dots[0]", "2 or 3 coordinates"),
+    (ROBOT + "drawing:\n  dots: [[x, y, 0, 1]]\n", 10, "drawing.dots[0]",
+     "2 or 3 coordinates"),
+    (ROBOT + "drawing:\n  legs: [[[p, 0]]]\n", 10, "drawing.legs[0]", "two end points"),
+    (ROBOT + "drawing:\n  legs: [[[p, 0], x]]\n", 10, "drawing.legs[0][1]",
+     "expected a point"),
+    (ROBOT + "drawing:\n  legs: 3\n", 10, "drawing.legs", "non-empty list"),
+    (ROBOT + "drawing:\n  dots: [[pi, 0]]\n", 10, "drawing.dots[0][0]", "pi is not allowed"),
 ]
 
 
@@ -138,6 +155,40 @@ def test_bad_robot_specs_get_one_located_line(text, line, key, phrase):
     if key:
         assert f" {key}:" in message, message
     assert phrase in message, message
+
+
+def test_drawing_bodies_are_exact_polynomials_in_joints_pose_and_parameters():
+    spec = parse_robot(ROBOT + """\
+drawing:
+  rail: [[[-l, 0], [2*l, 0]]]
+  legs:
+    - [[p, 0], [x, y]]
+    - [[0, q], [x, y], [x + 1/10, y]]
+  platform: [[x, y], [x/2, 0.5*y]]
+""", "r.yaml")
+    assert [b.name for b in spec.drawing] == ["rail", "legs", "platform"]
+    assert [b.line for b in spec.drawing] == [10, 11, 14]
+    assert spec.drawing_dimension == 2
+    p, q, x, y = spec.context.gens()
+    rail, legs, platform = spec.drawing
+    assert rail.chains == (((-2, 0), (4, 0)),) and not rail.points
+    assert legs.chains[0] == ((p, 0 * x), (x, y))
+    assert legs.chains[1][2] == (x + fmpq(1, 10), y)  # 0.1 is exactly 1/10
+    assert platform.points == ((x, y), (x / 2, y / 2)) and not platform.chains
+    assert parse_robot(ROBOT, "r.yaml").drawing == ()
+    assert parse_robot(ROBOT, "r.yaml").drawing_dimension is None
+
+
+@pytest.mark.parametrize("path", sorted(ROBOTS.glob("*.yaml")), ids=lambda p: p.stem)
+def test_every_bundled_robot_has_a_drawing_of_its_dimension(path):
+    spec = load_robot(path)
+    assert spec.drawing, f"{path.name} has no drawing key"
+    assert spec.drawing_dimension == (3 if len(spec.pose) >= 3 else 2)
+    # the drawing moves with every joint and every pose coordinate
+    used = {v for body in spec.drawing for chain in body.chains for point in chain
+            for c in point for v, d in zip(spec.context.names(), c.degrees(), strict=True)
+            if d}
+    assert set(spec.joints) <= used and set(spec.pose) <= used
 
 
 BAD_TRAJECTORIES = [

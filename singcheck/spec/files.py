@@ -27,11 +27,24 @@ from singcheck.spec.grammar import (
 )
 
 ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
-              "parameters": False, "constraints": True, "joint_limits": False}
+              "parameters": False, "constraints": True, "joint_limits": False,
+              "drawing": False}
 TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": True, "pose": True}
 RESERVED = {"pi", "sin", "cos"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
+MAX_DRAWING_POINTS = 1000  # every point of a drawing is evaluated once per frame drawn
+
+
+@dataclass(frozen=True)
+class DrawingBody:
+    """One body of a robot's drawing: chains of segments and single points, each point a
+    tuple of 2 or 3 exact polynomials in the joints and pose (parameters substituted)."""
+
+    name: str
+    chains: tuple[tuple[tuple[fmpq_mpoly, ...], ...], ...]  # each: ≥ 2 points joined in turn
+    points: tuple[tuple[fmpq_mpoly, ...], ...]
+    line: int
 
 
 @dataclass(frozen=True)
@@ -47,6 +60,15 @@ class RobotSpec:
     constraint_lines: tuple[int, ...]
     joint_limits: dict[str, tuple[Fraction, Fraction]]
     lines: dict[str, int] = field(default_factory=dict)
+    drawing: tuple[DrawingBody, ...] = ()  # the optional ``drawing`` key
+
+    @property
+    def drawing_dimension(self) -> int | None:
+        """2 or 3 (every point of a drawing has as many coordinates), None without one."""
+        for body in self.drawing:
+            for point in (*body.points, *(p for chain in body.chains for p in chain)):
+                return len(point)
+        return None
 
 
 @dataclass(frozen=True)
@@ -258,8 +280,63 @@ def parse_robot(text: str, path: str) -> RobotSpec:
             if not lo < hi:
                 raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
             limits[jname] = (lo, hi)
+    drawing = _drawing(doc, top["drawing"][1], ctx, variables, parameters) \
+        if "drawing" in top else ()
     return RobotSpec(path, name, description, joints, pose, parameters, ctx,
-                     tuple(constraints), tuple(constraint_lines), limits, lines)
+                     tuple(constraints), tuple(constraint_lines), limits, lines, drawing)
+
+
+def _drawing(doc: _Doc, node, ctx, variables, parameters) -> tuple[DrawingBody, ...]:
+    """The ``drawing`` key: ``body: [item, ...]`` where an item is a point ``[e, e(, e)]``
+    or a chain of segments ``[[e, e(, e)], [e, e(, e)], ...]`` (two points: one segment),
+    every ``e`` a polynomial in the joints, pose and parameters; one dimension, 2 or 3,
+    for every point of the drawing."""
+    bodies = []
+    shape: dict[str, object] = {}  # the first point's dimension and where it is
+    count = 0
+
+    def point(pnode, key):
+        nonlocal count
+        if not isinstance(pnode, yaml.SequenceNode) or not 2 <= len(pnode.value) <= 3 or \
+                not all(isinstance(v, yaml.ScalarNode) for v in pnode.value):
+            raise doc.error(pnode, key, "expected a point: a list of 2 or 3 coordinates, "
+                                        "e.g. [x, y, z]")
+        if "dim" not in shape:
+            shape.update(dim=len(pnode.value), line=_line(pnode))
+        elif shape["dim"] != len(pnode.value):
+            raise doc.error(pnode, key, f"a {len(pnode.value)}-D point in a "
+                                        f"{shape['dim']}-D drawing (line {shape['line']})")
+        count += 1
+        if count > MAX_DRAWING_POINTS:
+            raise doc.error(pnode, key, f"more than {MAX_DRAWING_POINTS} points")
+        return tuple(doc.expression(
+            v, f"{key}[{i}]", lambda n: compile_polynomial(n, ctx, variables, parameters))
+            for i, v in enumerate(pnode.value))
+
+    for bname, (knode, bnode) in doc.mapping(node, "drawing").items():
+        key = f"drawing.{bname}"
+        if not _IDENTIFIER.match(bname):
+            raise doc.error(knode, key, f"{bname!r} is not a valid body name")
+        if not isinstance(bnode, yaml.SequenceNode) or not bnode.value:
+            raise doc.error(bnode, key, "expected a non-empty list of segments "
+                                        "[[x1, y1], [x2, y2]] or points [x, y]")
+        chains, points = [], []
+        for i, item in enumerate(bnode.value):
+            ikey = f"{key}[{i}]"
+            if not isinstance(item, yaml.SequenceNode) or not item.value:
+                raise doc.error(item, ikey, "expected a segment [[x1, y1], [x2, y2]] or a "
+                                            "point [x, y]")
+            if all(isinstance(v, yaml.ScalarNode) for v in item.value):
+                points.append(point(item, ikey))
+            elif len(item.value) < 2:
+                raise doc.error(item, ikey, "a segment needs two end points")
+            else:
+                chains.append(tuple(point(p, f"{ikey}[{j}]")
+                                    for j, p in enumerate(item.value)))
+        bodies.append(DrawingBody(bname, tuple(chains), tuple(points), _line(knode)))
+    if not bodies:
+        raise doc.error(node, "drawing", "names no body")
+    return tuple(bodies)
 
 
 def load_robot(path: str | os.PathLike) -> RobotSpec:

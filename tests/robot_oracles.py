@@ -174,7 +174,8 @@ PRR_LINK = 3
 
 
 def three_prr() -> Oracle:
-    """3-PRR: slider J_i = O_i + ρ_i d_i, link w_i = P + R b_i - J_i; det A ∝ det[w_i, J_i × w_i]."""
+    """3-PRR: slider J_i = O_i + ρ_i d_i, link w_i = P + R b_i - J_i;
+    det A ∝ det[w_i, J_i × w_i]."""
 
     def platform_point(i, X):
         rb = rotate2(X[2], RPR_PLATFORM[i])

@@ -72,7 +72,7 @@ def test_html_page_is_self_contained_and_holds_every_figure(tmp_path):
                     "html", "--backend", "flint")
     assert out.returncode == 0, out.stderr
     page = (tmp_path / "singcheck.html").read_text()
-    assert page.count('class="plotly-graph-div"') == 8
+    assert page.count('class="plotly-graph-div"') == 10  # four figures and the animation, each
     assert "<script src=" not in page.replace('<script src="data', "")  # JS inlined
     assert "s3 real" in page and "s1 spurious" in page
     assert (tmp_path / "singcheck.html").stat().st_mode & 0o044  # readable by others

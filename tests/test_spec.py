@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 
+import mpmath
 import pytest
 from flint import arb, fmpq
 
@@ -96,7 +97,15 @@ def test_heart1_range_is_exactly_minus_pi_to_pi(orthoglide):
 BAD_ROBOTS = [
     # (text, line, key, phrase)
     (ROBOT.replace("(x - p)^2", "(x - w)^2"), 6, "constraints[0]", "undeclared name 'w'"),
-    (ROBOT.replace("(x - p)^2", "sin(x - p)"), 6, "constraints[0]", "must be polynomial"),
+    (ROBOT.replace("(x - p)^2", "sin(x*p)"), 6, "constraints[0]", "integer combination"),
+    (ROBOT.replace("(x - p)^2", "sin(x + 1)"), 6, "constraints[0]", "integer combination"),
+    (ROBOT.replace("(x - p)^2", "cos(x + pi/5)"), 6, "constraints[0]", "multiples of pi/12"),
+    (ROBOT.replace("(x - p)^2", "cos(p) + p"), 6, "constraints[0]", "is an angle"),
+    (ROBOT.replace("(x - p)^2", "sqrt(x)"), 6, "constraints[0]", "sqrt takes a rational"),
+    (ROBOT.replace("(x - p)^2", "sqrt(-2)"), 6, "constraints[0]", "not real"),
+    (ROBOT.replace("{l: 2}", "{l: sqrt(-1)}"), 4, "parameters.l", "not real"),
+    (ROBOT.replace("{l: 2}", "{l: pi*sqrt(2)}"), 4, "parameters.l", "not supported"),
+    (ROBOT.replace("{l: 2}", "{l: pi}"), 6, "constraints[0]", "contains pi"),
     (ROBOT.replace("(x - p)^2", "(x - p)/y"), 6, "constraints[0]", "division by a non-constant"),
     (ROBOT.replace("(x - p)^2", "(x - p)^-2"), 6, "constraints[0]", "non-negative integers"),
     (ROBOT.replace("(x - p)^2", "(x - p)^(1/2)"), 6, "constraints[0]", "non-negative integers"),
@@ -264,3 +273,80 @@ def test_specs_cannot_blow_up_memory_or_time(text, phrase):
     with pytest.raises(SpecError, match=phrase):
         parse_robot(text, "bomb.yaml")
     assert time.monotonic() - start < 5
+
+
+# ---------------------------------------------------------------------------------
+# angles (sin/cos of variables), exact square roots, pi
+
+ANGLE_ROBOT = """\
+name: angles
+joints: [th, r]
+pose: [x, phi]
+parameters: {R: 3/2, s3: sqrt(3), h: s3/2*R, a: pi/6}
+constraints:
+  - x*cos(2*th) - h*sin(th + phi) + cos(phi - pi/6) + sqrt(12)
+  - r^2 - (x - cos(phi + a))^2 - sin(3*phi)^2
+joint_limits: {th: [-pi/2, pi], r: [0, 4]}
+"""
+
+
+def _mp_eval(text: str, values: dict) -> mpmath.mpf:
+    """The test's own evaluation of a spec expression (trusted text, 50 digits)."""
+    env = {"sin": mpmath.sin, "cos": mpmath.cos, "sqrt": mpmath.sqrt, "pi": mpmath.pi,
+           **values}
+    return eval(text.replace("^", "**"), {"__builtins__": {}}, env)  # noqa: S307
+
+
+def test_angles_and_square_roots_compile_exactly():
+    """Each constraint, compiled with angles as (cos, sin) and √3 as a variable, equals
+    the expression evaluated directly at 50 digits, at random points."""
+    import random
+
+    from singcheck.algebra.intervals import evaluate, working_precision
+
+    text = ANGLE_ROBOT
+    spec = parse_robot(text, "angles.yaml")
+    assert spec.angles == {"th", "phi"}
+    assert spec.radicals == (3,)
+    assert spec.context.names() == ("cos(th)", "sin(th)", "r", "x", "cos(phi)", "sin(phi)",
+                                    "sqrt(3)")
+    lo, hi = spec.joint_limits["th"]
+    assert (lo, hi) == (LinearInPi(Fraction(0), Fraction(-1, 2)),
+                        LinearInPi(Fraction(0), Fraction(1)))
+    sources = [line.strip()[2:] for line in text.splitlines() if line.startswith("  - ")]
+    rng = random.Random(7)
+    mpmath.mp.dps = 50
+    for _ in range(5):
+        th, r, x, phi = (mpmath.mpf(rng.uniform(-3, 3)) for _ in range(4))
+        values = {"th": th, "r": r, "x": x, "phi": phi, "s3": mpmath.sqrt(3),
+                  "h": mpmath.sqrt(3) / 2 * mpmath.mpf(3) / 2, "a": mpmath.pi / 6}
+        point = [mpmath.cos(th), mpmath.sin(th), r, x, mpmath.cos(phi), mpmath.sin(phi),
+                 mpmath.sqrt(3)]
+        for poly, source in zip(spec.constraints, sources, strict=True):
+            expected = _mp_eval(source, values)
+            with working_precision(200):
+                got = evaluate(poly, [arb(mpmath.nstr(v, 60)) for v in point])
+            assert abs(mpmath.mpf(got.mid().str(50, radius=False)) - expected) < 1e-40
+
+
+def test_an_angle_trajectory_keeps_its_pi_offset():
+    spec = parse_robot(ANGLE_ROBOT, "angles.yaml")
+    traj = parse_trajectory("name: a\nparameter: t\nrange: [0, 1]\npose:\n"
+                            "  x: cos(t + pi/6)\n  phi: 2*t - pi/6\n", "a.yaml", spec)
+    assert str(traj.pose["phi"]) == "2*t" and traj.angle_offsets == {"phi": Fraction(-1, 6)}
+    assert traj.pose["x"].context().names() == ("t", "s", "c", "sqrt(3)")
+    assert str(traj.pose["x"]) == "-1/2*s + 1/2*c*sqrt(3)"
+    with pytest.raises(SpecError, match="pi may only be added"):
+        parse_trajectory("name: a\nparameter: t\nrange: [0, 1]\npose:\n"
+                         "  x: 0\n  phi: pi*t\n", "a.yaml", spec)
+
+
+@pytest.mark.parametrize("text, value", [
+    ("sqrt(12)", "2*sqrt(3)"), ("sqrt(3/4)", "1/2*sqrt(3)"), ("1/(1 + sqrt(2))", "-1 + sqrt(2)"),
+    ("sqrt(2)*sqrt(3) - sqrt(6)", "0"), ("(sqrt(3)/2)^2", "3/4"), ("2*sin(pi/3)", "sqrt(3)"),
+    ("cos(pi/12)", "1/4*sqrt(2) + 1/4*sqrt(6)"), ("pi/6 + 1", "1 + 1/6*pi"),
+])
+def test_parameter_values_are_exact_algebraic_numbers(text, value):
+    from singcheck.spec.grammar import compile_value
+
+    assert str(compile_value(parse(text), {})) == value

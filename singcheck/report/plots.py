@@ -264,7 +264,8 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
 
 def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
     """One self-contained interactive page (plotly, its JavaScript inlined once) with
-    the same four figures for every trajectory."""
+    the same four figures for every trajectory, and the robot moving along it
+    (:mod:`singcheck.report.animation`) when its spec has a drawing."""
     import plotly.graph_objects as go
 
     from singcheck.atomic import write_atomically
@@ -331,8 +332,12 @@ def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
         else:
             js.update_layout(xaxis_title=names[0], yaxis_title=names[1])
         figs.append(js)
-        for fig in figs:
-            parts.append(fig.to_html(full_html=False, include_plotlyjs=first))
+        from singcheck.report.animation import animation_figure
+
+        moving = animation_figure(report, d, f"{robot} · {report.name}: the robot along "
+                                  "the path")
+        for fig in figs + ([moving] if moving is not None else []):
+            parts.append(fig.to_html(full_html=False, include_plotlyjs=first, auto_play=False))
             first = False
     page = ("<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>singcheck figures"
             "</title></head><body>\n" + "\n".join(parts) + "\n</body></html>\n")

@@ -67,7 +67,7 @@ def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:
             for body in spec.drawing]
 
 
-def _joints_at(report: TrajectoryReport, label: str, t: arb) -> list | None:
+def joints_at(report: TrajectoryReport, label: str, t: arb) -> list | None:
     path = report.path
     per_leg = [leg.branches(t) for leg in path.legs]
     joints = [per_leg[i][ch] for i, ch in enumerate(label)]
@@ -83,12 +83,12 @@ def postures(report: TrajectoryReport) -> list[Posture]:
     start = report.path.trajectory.range.start.ball()
     feasible = [m for m in report.modes if m.feasible]
     if not feasible:
-        feasible = [m for m in report.modes if _joints_at(report, m.label, start)][:1]
+        feasible = [m for m in report.modes if joints_at(report, m.label, start)][:1]
     out = []
     for mode in feasible:
         times = [("start", start)] + [("singular", c.t) for c in mode.singular_times]
         for kind, t in times:
-            joints = _joints_at(report, mode.label, t)
+            joints = joints_at(report, mode.label, t)
             if joints is None:  # the branch's reality is not proven on this ball
                 continue
             bodies = draw_bodies(spec, joints, report.path.pose_at(t))
@@ -119,9 +119,10 @@ def traced_points(report: TrajectoryReport, t: np.ndarray) -> list[np.ndarray]:
 _SINGULAR = "#d62728"
 
 
-def _limits(posts: list[Posture], traces: list[np.ndarray]) -> np.ndarray:
-    pts = [b.points for p in posts for b in p.bodies] + \
-        [c for p in posts for b in p.bodies for c in b.chains] + traces
+def drawing_box(drawings: list[list[DrawnBody]], traces: list[np.ndarray]) -> np.ndarray:
+    """One cube (dim × [lo, hi]) holding every drawn point and trace, a margin around."""
+    pts = [b.points for bodies in drawings for b in bodies] + \
+        [c for bodies in drawings for b in bodies for c in b.chains] + traces
     allp = np.concatenate([q for q in pts if len(q)])
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2, 0.5) * 1.08
@@ -138,7 +139,7 @@ def posture_figure(plt, report: TrajectoryReport, title: str, samples: int = 600
     axes = report.path.projection.model.pose  # named when they are the drawing's axes
     lo, hi = float(report.path.trajectory.range.start), float(report.path.trajectory.range.end)
     traces = traced_points(report, np.linspace(lo, hi, samples))
-    box = _limits(posts, traces)
+    box = drawing_box([p.bodies for p in posts], traces)
     n = len(posts)
     cols = min(n, 3)
     rows = -(-n // cols)

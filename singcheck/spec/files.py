@@ -16,13 +16,20 @@ from fractions import Fraction
 import yaml
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
-from singcheck.algebra.trig import LinearInPi, TimeRange
+from singcheck.algebra.polynomials import restrict
+from singcheck.algebra.radicals import angle_names, radical_name, radical_variables
+from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
 from singcheck.errors import SpecError
 from singcheck.spec.grammar import (
+    Constant,
     ExprError,
+    Node,
+    angles_in,
+    compile_angle_coordinate,
     compile_constant,
     compile_polynomial,
     compile_trajectory_coordinate,
+    compile_value,
     parse,
 )
 
@@ -30,7 +37,7 @@ ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
               "parameters": False, "constraints": True, "joint_limits": False,
               "drawing": False}
 TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": True, "pose": True}
-RESERVED = {"pi", "sin", "cos"}
+RESERVED = {"pi", "sin", "cos", "sqrt"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
 MAX_DRAWING_POINTS = 1000  # every point of a drawing is evaluated once per frame drawn
@@ -54,12 +61,32 @@ class RobotSpec:
     description: str
     joints: tuple[str, ...]
     pose: tuple[str, ...]
-    parameters: dict[str, Fraction]
-    context: fmpq_mpoly_ctx  # joints then pose
+    parameters: dict[str, Fraction | Constant]  # Fraction when rational
+    context: fmpq_mpoly_ctx  # joints then pose then radicals (see ``variables``)
     constraints: tuple[fmpq_mpoly, ...]
     constraint_lines: tuple[int, ...]
-    joint_limits: dict[str, tuple[Fraction, Fraction]]
+    joint_limits: dict[str, tuple]  # Fractions; LinearInPi (radians) for an angle joint
     lines: dict[str, int] = field(default_factory=dict)
+    angles: frozenset[str] = frozenset()  # joints and pose variables used inside sin/cos
+    radicals: tuple[int, ...] = ()  # primes p whose sqrt(p) is a variable of the context
+
+    def variables(self, name: str) -> tuple[str, ...]:
+        """The context's variables of a joint or pose variable: itself, or
+        ``(cos(v), sin(v))`` for an angle."""
+        return angle_names(name) if name in self.angles else (name,)
+
+    @property
+    def joint_variables(self) -> tuple[str, ...]:
+        return tuple(v for j in self.joints for v in self.variables(j))
+
+    @property
+    def pose_variables(self) -> tuple[str, ...]:
+        return tuple(v for x in self.pose for v in self.variables(x))
+
+    @property
+    def radical_variables(self) -> tuple[str, ...]:
+        return tuple(radical_name(p) for p in self.radicals)
+
     drawing: tuple[DrawingBody, ...] = ()  # the optional ``drawing`` key
 
     @property
@@ -79,6 +106,8 @@ class TrajectorySpec:
     range: TimeRange
     pose: dict[str, fmpq_mpoly]  # pose variable -> TRIG polynomial, robot's pose order
     lines: dict[str, int] = field(default_factory=dict)
+    #: an angle's coordinate is pose[v] + angle_offsets[v]·π (only angles have an entry)
+    angle_offsets: dict[str, Fraction] = field(default_factory=dict)
 
 
 class _Doc:
@@ -150,6 +179,17 @@ class _Doc:
         if value.pi_coefficient:
             raise self.error(node, key, f"must be an exact rational number, not {text!r}")
         return value.rational
+
+    def value(self, node, key: str, parameters: dict) -> Fraction | Constant:
+        """A parameter's exact value: a Fraction when rational, else a Constant."""
+        text = self.text(node, key)
+        try:
+            value = compile_value(parse(text), parameters)
+        except (ExprError, ValueError, ZeroDivisionError) as e:
+            raise self.error(node, key, f"{e} in {text!r}") from None
+        if not value.pi_coefficient and value.surd.is_rational():
+            return value.surd.rational_value()
+        return value
 
     def expression(self, node, key: str, compile_):
         text = self.text(node, key)
@@ -247,21 +287,33 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                 raise doc.error(knode, key, f"{pname!r} is not a valid parameter name")
             if pname in joints or pname in pose:
                 raise doc.error(knode, key, f"{pname!r} is already a joint or pose variable")
-            parameters[pname] = doc.number(vnode, key)
-    ctx = fmpq_mpoly_ctx.get(joints + pose, "lex")
-    variables = dict(zip(joints + pose, ctx.gens(), strict=True))
+            parameters[pname] = doc.value(vnode, key, parameters)
     cnode = top["constraints"][1]
     if not isinstance(cnode, yaml.SequenceNode) or not cnode.value:
         raise doc.error(cnode, "constraints", "expected a non-empty list of polynomials")
-    constraints, constraint_lines = [], []
+    trees = [doc.expression(item, f"constraints[{i}]", lambda n: n)
+             for i, item in enumerate(cnode.value)]
+    angles = frozenset().union(*(angles_in(t, joints + pose) for t in trees))
+    algebraic = [v for name in joints + pose
+                 for v in (angle_names(name) if name in angles else (name,))]
+    primes = sorted(_radical_primes(parameters, trees))
+    wide = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in primes)), "lex")
+    gens = dict(zip(wide.names(), wide.gens(), strict=True))
+    variables = {v: gens[v] for v in joints + pose if v not in angles}
+    pairs = {v: tuple(gens[n] for n in angle_names(v)) for v in angles}
+    compiled, constraint_lines = [], []
     for i, item in enumerate(cnode.value):
         key = f"constraints[{i}]"
-        poly = doc.expression(item, key,
-                              lambda n: compile_polynomial(n, ctx, variables, parameters))
+        poly = doc.expression(item, key, lambda n: compile_polynomial(n, wide, variables,
+                                                                      parameters, pairs))
         if poly.is_zero():
             raise doc.error(item, key, "is identically zero")
-        constraints.append(poly)
+        compiled.append(poly)
         constraint_lines.append(_line(item))
+    used = tuple(p for i, p in radical_variables(wide)
+                 if any(f.degrees()[i] > 0 for f in compiled))
+    ctx = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in used)), "lex")
+    constraints = [restrict(f, ctx) for f in compiled]
     if not len(constraints) == len(joints) == len(pose):
         raise doc.error(top["constraints"][0], "constraints",
                         f"{len(constraints)} constraints for {len(joints)} joints and "
@@ -276,17 +328,50 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                                             f"{', '.join(joints)})")
             if not isinstance(vnode, yaml.SequenceNode) or len(vnode.value) != 2:
                 raise doc.error(vnode, key, "expected [min, max]")
-            lo, hi = (doc.number(v, key) for v in vnode.value)
-            if not lo < hi:
-                raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
+            if jname in angles:
+                lo, hi = (doc.expression(v, key, compile_constant) for v in vnode.value)
+                if not _less(lo, hi):
+                    raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
+            else:
+                lo, hi = (doc.number(v, key) for v in vnode.value)
+                if not lo < hi:
+                    raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
             limits[jname] = (lo, hi)
-    drawing = _drawing(doc, top["drawing"][1], ctx, variables, parameters) \
+    final = dict(zip(ctx.names(), ctx.gens(), strict=True))
+    drawing = _drawing(doc, top["drawing"][1], ctx,
+                       {v: final[v] for v in joints + pose if v not in angles}, parameters,
+                       {v: tuple(final[n] for n in angle_names(v)) for v in angles}) \
         if "drawing" in top else ()
     return RobotSpec(path, name, description, joints, pose, parameters, ctx,
-                     tuple(constraints), tuple(constraint_lines), limits, lines, drawing)
+                     tuple(constraints), tuple(constraint_lines), limits, lines,
+                     angles=angles, radicals=used, drawing=drawing)
 
 
-def _drawing(doc: _Doc, node, ctx, variables, parameters) -> tuple[DrawingBody, ...]:
+def _radical_primes(parameters: dict, trees: list[Node]) -> set[int]:
+    """Every prime whose square root a compiled expression may need: those of the
+    parameters, of each ``sqrt(q)`` written inline, and 2 and 3 (the sines and
+    cosines of multiples of π/12)."""
+    primes = {2, 3}
+    for value in parameters.values():
+        if isinstance(value, Constant):
+            primes |= value.surd.primes()
+
+    def walk(node: Node) -> None:
+        if node.kind == "call" and node.value == "sqrt":
+            try:
+                primes.update(compile_value(node, parameters).surd.primes())
+            except ExprError:
+                pass  # the compiler reports it, with its column
+        for a in node.args:
+            walk(a)
+
+    for tree in trees:
+        walk(tree)
+    return primes
+
+
+def _drawing(doc: _Doc, node, ctx, variables, parameters,
+             angles=None) -> tuple[DrawingBody, ...]:
     """The ``drawing`` key: ``body: [item, ...]`` where an item is a point ``[e, e(, e)]``
     or a chain of segments ``[[e, e(, e)], [e, e(, e)], ...]`` (two points: one segment),
     every ``e`` a polynomial in the joints, pose and parameters; one dimension, 2 or 3,
@@ -310,7 +395,8 @@ def _drawing(doc: _Doc, node, ctx, variables, parameters) -> tuple[DrawingBody, 
         if count > MAX_DRAWING_POINTS:
             raise doc.error(pnode, key, f"more than {MAX_DRAWING_POINTS} points")
         return tuple(doc.expression(
-            v, f"{key}[{i}]", lambda n: compile_polynomial(n, ctx, variables, parameters))
+            v, f"{key}[{i}]", lambda n: compile_polynomial(n, ctx, variables, parameters,
+                                                          angles))
             for i, v in enumerate(pnode.value))
 
     for bname, (knode, bnode) in doc.mapping(node, "drawing").items():
@@ -396,12 +482,26 @@ def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
     if missing:
         raise doc.error(top["pose"][0], "pose",
                         f"missing coordinate(s) {', '.join(missing)} of robot {robot.name}")
-    coords = {}
+    trees = {v: doc.expression(pose_map[v][1], f"pose.{v}", lambda n: n) for v in robot.pose}
+    primes = sorted(_radical_primes(robot.parameters, list(trees.values())))
+    ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
+    coords, offsets = {}, {}
     for v in robot.pose:
-        coords[v] = doc.expression(
-            pose_map[v][1], f"pose.{v}",
-            lambda n: compile_trajectory_coordinate(n, parameter, robot.parameters))
-    return TrajectorySpec(path, name, parameter, TimeRange(start, end), coords, lines)
+        key = f"pose.{v}"
+        if v in robot.angles:
+            coords[v], offsets[v] = doc.expression(
+                pose_map[v][1], key,
+                lambda n: compile_angle_coordinate(n, parameter, robot.parameters, ring))
+        else:
+            coords[v] = doc.expression(
+                pose_map[v][1], key,
+                lambda n: compile_trajectory_coordinate(n, parameter, robot.parameters, ring))
+    used = [i for i, _ in radical_variables(ring)
+            if any(p.degrees()[i] > 0 for p in coords.values())]
+    names = ("t", "s", "c", *(ring.names()[i] for i in used))
+    small = TRIG if not used else fmpq_mpoly_ctx.get(names, "lex")
+    coords = {v: restrict(p, small) for v, p in coords.items()}
+    return TrajectorySpec(path, name, parameter, TimeRange(start, end), coords, lines, offsets)
 
 
 def load_trajectory(path: str | os.PathLike, robot: RobotSpec) -> TrajectorySpec:

@@ -286,10 +286,8 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
     }
     from singcheck.report.postures import posture_figure
 
-    if not report.pieces:  # postures are drawn for one-piece paths in their own time
-        makers["postures"] = lambda: posture_figure(
-            plt, report, f"{robot} · {name}: the robot at the start and its singular "
-                         "postures")
+    makers["postures"] = lambda: posture_figure(
+        plt, report, f"{robot} · {name}: the robot at the start and its singular postures")
     written = []
     for key in makers:
         fig = makers[key]()
@@ -375,8 +373,8 @@ def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
         figs.append(js)
         from singcheck.report.animation import animation_figure
 
-        moving = None if report.pieces else animation_figure(
-            report, d, f"{robot} · {report.name}: the robot along the path")
+        moving = animation_figure(report, d, f"{robot} · {report.name}: the robot along "
+                                  "the path")
         for fig in figs + ([moving] if moving is not None else []):
             parts.append(fig.to_html(full_html=False, include_plotlyjs=first, auto_play=False))
             first = False

@@ -3,7 +3,8 @@
 Composing with φ is exact (``fmpq_mpoly.compose`` into ``Q[t, s, c]`` then
 :func:`~singcheck.trig.reduce_trig`).  The results are:
 
-* ``mu`` = ξ(φ(t)), whose real roots are every candidate singular time,
+* ``mu`` = ξ(φ(t)), whose real roots are every candidate singular time (when ξ(X) was too
+  big to expand, μ is computed directly: :func:`eliminate_along_path`),
 * per leg, the coefficients of its constraint in its joint, its discriminant D(t) and
   its joint-limit polynomials, from which the IK branches ρ = (-b ± √D)/(2a) along the
   path (for a revolute leg, cos θ and sin θ of its two branches) and their limit
@@ -21,9 +22,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from flint import acb, arb, fmpq, fmpq_mpoly
+from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.intervals import evaluate, fraction_ball
+from singcheck.algebra.polynomials import restrict
 from singcheck.algebra.radicals import (
     cos_pi,
     evaluate_path,
@@ -41,9 +43,17 @@ from singcheck.elimination.projection import (
     angle_limit_values,
     degenerate_set,
     limit_constraint,
+    norm_legs,
 )
+from singcheck.elimination.requests import norm_chain
 from singcheck.errors import UnsupportedRobotError
-from singcheck.model.robot import REVOLUTE, Leg, leg_coefficients, leg_discriminant
+from singcheck.model.robot import (
+    REVOLUTE,
+    Leg,
+    RobotModel,
+    leg_coefficients,
+    leg_discriminant,
+)
 from singcheck.spec.files import TrajectorySpec
 
 
@@ -259,7 +269,42 @@ def _primes_of(*polys) -> set[int]:
     return out
 
 
+def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
+                         where: dict | None = None) -> fmpq_mpoly:
+    """μ(t) without ξ(X): substitute X = φ(t) first, then eliminate the joints.
+
+    det A and every leg constraint are composed with φ (the pose variables' coordinates:
+    cos φ, sin φ for an angle) into Q[ρ, √…, t, s, c], and the joints (and the robot's
+    square roots) are eliminated by the same norm as ξ
+    (:func:`~singcheck.elimination.requests.norm_chain`, a chain of resultants and
+    revolute norms, one factor of det A at a time).  Each leg's leading coefficient in
+    its joint is a non-zero constant (a revolute leg's norm is a polynomial identity), so
+    the elimination commutes with the substitution: the result is ξ(φ(t)) up to a
+    constant factor and multiplicities, and has exactly its zeros.  Only polynomials in
+    one parameter (and s, c) are formed, never ξ(X) in every pose variable.  A path with
+    square roots of its own is refused (they would be conjugated with the robot's).
+    """
+    if any(x.context() is not TRIG for x in coordinates):
+        raise UnsupportedRobotError(
+            "ξ(X) was not expanded and this path has square roots of its own (sqrt, or an "
+            "angle offset like pi/6): eliminating along it is not supported yet",
+            **(where or {}))
+    eliminated = model.eliminated
+    ring = fmpq_mpoly_ctx.get((*eliminated, "t", "s", "c"), "lex")
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    tsc = [gens["t"], gens["s"], gens["c"]]
+    pose = model.pose_variables
+    args = [gens[v] if v in gens else coordinates[pose.index(v)].compose(*tsc, ctx=ring)
+            for v in model.context.names()]
+    det_a = model.det_A.compose(*args, ctx=ring)
+    legs = [(v, f.compose(*args, ctx=ring)) for v, f in norm_legs(model)]
+    return reduce_trig(restrict(norm_chain(det_a, legs), TRIG))
+
+
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
+    """The model along one piece (a multi-piece path: one per ``trajectory.pieces``)."""
+    if trajectory.segments:
+        raise ValueError("build_path takes one piece: use trajectory.pieces")
     model = projection.model
     spec = model.spec
     where = dict(path=trajectory.path, line=trajectory.lines.get("pose"), key="pose")
@@ -289,7 +334,10 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
             coordinates.append(x)
     coordinates = tuple(coordinates)
     pose_vars = model.pose_variables
-    mu = compose_pose(projection.singularity_surface, coordinates, pose_vars)
+    if projection.expanded:
+        mu = compose_pose(projection.singularity_surface, coordinates, pose_vars)
+    else:
+        mu = eliminate_along_path(model, coordinates, where)
     legs = []
     for leg in model.legs:
         coeffs = tuple(compose_pose(c, coordinates, pose_vars) for c in leg_coefficients(leg))

@@ -23,6 +23,7 @@ from singcheck.elimination.cas import get_backend
 from singcheck.elimination.projection import project_robot
 from singcheck.model.robot import build_model
 from singcheck.spec.files import parse_robot, parse_trajectory
+from tests.test_certify import BIGLIDE
 
 ORTHOGLIDE = """\
 name: orthoglide
@@ -119,6 +120,19 @@ def test_biglide_path_through_a_rational_singular_pose_is_singular_in_two_modes(
         if 4 * (x - p) * (y - q) - 4 * x * y == 0:
             expected.add(("+" if sp > 0 else "-") + ("+" if sq > 0 else "-"))
     assert expected == {"++", "--"}
+    # and a tangency in both (50 digits): det A has one sign on either side of t = 1/2
+    mpmath.mp.dps = 50
+
+    def det_a(t, sp, sq):
+        x = mpmath.mpf(8) / 5 - mpmath.mpf(3) / 5 * (t - mpmath.mpf(1) / 2)
+        y = mpmath.mpf(6) / 5 + mpmath.mpf(4) / 5 * (t - mpmath.mpf(1) / 2)
+        p, q = x + sp * mpmath.sqrt(4 - y * y), y + sq * mpmath.sqrt(4 - x * x)
+        return 4 * (x - p) * (y - q) - 4 * x * y
+
+    for sp in (1, -1):
+        before, after = (det_a(mpmath.mpf(1) / 2 + e, sp, sp) for e in (-mpmath.mpf("1e-3"),
+                                                                         mpmath.mpf("1e-3")))
+        assert before * after > 0
     assert report.verdict == "singular"
     [candidate] = report.candidates
     assert candidate.t.contains(Fraction(1, 2).__float__()) and candidate.t.rad() < 1e-9
@@ -261,15 +275,6 @@ def test_mixed_path_touching_the_sphere_at_zero_from_outside_is_singular():
     assert at_zero[0].root.multiplicity % 2 == 0  # even: a tangency
     assert not report.undecided
 
-
-BIGLIDE = """\
-name: biglide
-joints: [p, q]
-pose: [x, y]
-constraints:
-  - (x - p)^2 + y^2 - 4
-  - (x - q)^2 + y^2 - 9/4
-"""
 
 
 def test_a_root_exactly_at_an_irrational_range_end_is_kept():

@@ -11,12 +11,25 @@ What is proven, and how:
   det A(ρ_mode(T), φ(T)) over the candidate's ball T excludes 0.
 * **Singular, by elimination.**  For a leg-decoupled robot the working modes list every
   complex solution of the inverse kinematics, so μ(τ) = 0 means some mode's det A
-  vanishes at τ.  When every other mode is proven non-zero on T, it is this one.
+  vanishes at τ.  When every other mode is proven non-zero on T, it is this one.  With
+  square roots among the parameters, "every mode" includes the conjugate robots' modes
+  (√p ↦ -√p, evaluated but never feasible), since ξ is normed over them; with revolute
+  legs it needs W = a² + b² ≠ 0 on T for each (the joint integral over the pose there).
+* **Singular, det A free of the joints.**  When det A involves no joint, ξ is det A
+  (normed over the square roots): at a root of μ where every conjugate det A is proven
+  non-zero, det A vanishes, in every mode at once.
 * **Singular, exactly.**  At a root known exactly (a point ball, e.g. t = 0) where every
   enclosure is exact, det A evaluating to an exact 0 is a proof.
 * **Singular, by sign change.**  When det A along a real mode has proven opposite signs
   at the two ends of T, it vanishes inside T (intermediate values); that zero is a
   root of μ in T, hence τ itself (T isolates one root).
+* **Singular or regular, exactly (algebraic).**  Where none of the above decides (a
+  tangency, several modes vanishing at once), a root whose time is algebraic (every
+  root of a polynomial or sin/cos path, and t = kπ of a mixed one) is decided exactly
+  in Q(α)(√D₁, …) by :mod:`singcheck.certify.exact`.
+* **On the surface.**  When μ ≡ 0, each feasible mode is decided on its own: det A ≡ 0
+  along it, or the roots of a non-zero polynomial holding its zeros are its candidates
+  (classified for that mode alone, without the elimination proof).
 * Anything else, after refining T, is ``unknown`` for that mode, with the reason.
 """
 
@@ -27,13 +40,14 @@ from dataclasses import dataclass, field
 from flint import acb, arb
 
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
+from singcheck.algebra.radicals import evaluate_path
 from singcheck.certify.exact import (
     AlgebraicPoint,
     NotExact,
     det_a_vanishes_at,
     mode_zero_polynomial,
 )
-from singcheck.certify.path import PathModel
+from singcheck.certify.path import PathModel, joint_float
 from singcheck.certify.working_modes import (
     FEASIBLE,
     INFEASIBLE,
@@ -45,6 +59,7 @@ from singcheck.certify.working_modes import (
 from singcheck.roots.enclosures import IdenticallyZeroError, RealRoot
 from singcheck.roots.isolation import isolate_real_roots
 from singcheck.roots.rational import arb_to_fmpq
+from singcheck.spec.files import TrajectorySpec
 
 SINGULAR, REGULAR = "singular", "regular"
 BY_ELIMINATION = "elimination"
@@ -54,6 +69,7 @@ BY_EXACT_ZERO = "det A = 0 exactly"
 BY_ALGEBRAIC_ZERO = "det A = 0 exactly (algebraic)"
 BY_ALGEBRAIC_NONZERO = "det A ≠ 0 exactly (algebraic)"
 BY_IDENTICALLY_ZERO = "det A ≡ 0 along the path (exact)"
+BY_JOINT_FREE = "det A free of the joints (ξ = det A)"
 
 VERDICT_FREE = "singularity-free"
 VERDICT_SINGULAR = "singular"
@@ -75,6 +91,7 @@ class Candidate:
     joints: dict[str, dict[str, float | None]]  # feasible mode -> joint -> value
     modes: list[ModeAtCandidate]
     status: str = UNKNOWN  # real | spurious | unknown
+    segment: int = 1  # the piece of a multi-piece path it lies on (1 = the first)
 
     @property
     def t(self) -> arb:
@@ -95,22 +112,59 @@ class TrajectoryReport:
     root_method: str
     undecided: list = field(default_factory=list)  # (t ball, reason) left unproven
     mu_roots_complete: bool = False  # every root of μ isolated (the candidates are all)
+    spec: TrajectorySpec | None = None  # the whole path (None: path.trajectory)
+    pieces: list[TrajectoryReport] = field(default_factory=list)  # per segment, if several
+
+    @property
+    def trajectory(self) -> TrajectorySpec:
+        """The whole path's spec (all its segments)."""
+        return self.spec or self.path.trajectory
 
     @property
     def name(self) -> str:
-        return self.path.trajectory.name
+        return self.trajectory.name
 
 
 def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
     pose = path.pose_at(t)
+    variables = path.pose_variables_at(t)
     per_leg = [leg.branches(t) for leg in path.legs]
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}
     for mode in modes:
         js = [per_leg[i][b.label] for i, b in enumerate(mode.branches)]
         joints[mode.label] = js
-        values[mode.label] = None if any(j is None for j in js) else path.det_A(js, pose)
+        values[mode.label] = None if any(j is None for j in js) else \
+            path.det_A(js, variables)
     return pose, joints, values
+
+
+def _conjugate_values(path: PathModel, modes: list[WorkingMode], t: arb) -> list:
+    """det A of every mode of every conjugate robot (square roots' signs flipped)."""
+    from itertools import product
+
+    from singcheck.algebra.radicals import radical_variables
+
+    primes = [q for _, q in radical_variables(path.projection.model.context)]
+    if not primes:
+        return []
+    variables = path.pose_variables_at(t)
+    out = []
+    for signs in product((1, -1), repeat=len(primes)):
+        if -1 not in signs:
+            continue
+        sigma = dict(zip(primes, signs, strict=True))
+        per_leg = path.conjugate_branches(t, variables, sigma)
+        for mode in modes:
+            js = [per_leg[i][b.label] for i, b in enumerate(mode.branches)]
+            out.append(None if any(j is None for j in js) else
+                       path.det_A(js, variables, sigma))
+    return out
+
+
+def _integral(path: PathModel, t: arb) -> bool:
+    """W ≠ 0 on the ball for every revolute leg (its joint integral over the pose)."""
+    return all(excludes_zero(evaluate_path(w, t)) for w in path.degenerate)
 
 
 def _sign_at(path: PathModel, mode: WorkingMode, point: arb) -> int | None:
@@ -123,9 +177,7 @@ def _branches_continuous(path: PathModel, t: arb) -> bool:
     """True when every quadratic leg's discriminant is proven > 0 on the whole ball:
     then each branch is real and continuous there, as the intermediate value
     theorem needs."""
-    from singcheck.algebra.trig import evaluate_trig
-
-    return all(leg.discriminant is None or evaluate_trig(leg.discriminant, t) > 0
+    return all(leg.discriminant is None or evaluate_path(leg.discriminant, t) > 0
                for leg in path.legs)
 
 
@@ -134,6 +186,12 @@ def _decide(path, modes, root: RealRoot, by_elimination: bool = True):
     pose, joints, values = _mode_values(path, modes, root.t)
     decided: dict[str, ModeAtCandidate] = {}
     open_modes = []
+    conjugate = _conjugate_values(path, modes, root.t) if not path.projection.model.polynomial \
+        else []
+    conjugates_regular = all(v is not None and excludes_zero(v) for v in conjugate)
+    if path.projection.model.joint_free_det_A and conjugates_regular:
+        return pose, joints, {m.label: ModeAtCandidate(m.label, SINGULAR, BY_JOINT_FREE)
+                              for m in modes}
     for mode in modes:
         v = values[mode.label]
         if v is not None and excludes_zero(v):
@@ -143,7 +201,8 @@ def _decide(path, modes, root: RealRoot, by_elimination: bool = True):
             decided[mode.label] = ModeAtCandidate(mode.label, SINGULAR, BY_EXACT_ZERO)
         else:
             open_modes.append(mode)
-    if by_elimination and len(open_modes) == 1:
+    if by_elimination and len(open_modes) == 1 and conjugates_regular and \
+            _integral(path, root.t):
         m = open_modes[0]
         decided[m.label] = ModeAtCandidate(m.label, SINGULAR, BY_ELIMINATION)
         open_modes = []
@@ -200,14 +259,10 @@ def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot
     feasible = {m.label for m in modes if m.status == FEASIBLE}
     states = {pm.status for pm in per_mode if pm.mode in feasible}
     status = "real" if SINGULAR in states else "unknown" if UNKNOWN in states else "spurious"
-    shown = {m.label: {leg.leg.joint: _mid(v) for leg, v in zip(path.legs, joints[m.label],
-                                                                 strict=True)}
+    shown = {m.label: {leg.leg.joint: joint_float(v)
+                       for leg, v in zip(path.legs, joints[m.label], strict=True)}
              for m in modes if m.status == FEASIBLE}
     return Candidate(root, pose, shown, per_mode, status)
-
-
-def _mid(v) -> float | None:
-    return float(v.mid()) if isinstance(v, arb) else None
 
 
 def _clear_undecided(path, modes, box) -> bool:
@@ -228,7 +283,7 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
     undecided = [(b.t, b.reason) for b in isolation.undecided
                  if not _clear_undecided(path, modes, b)]
-    verdict, reason = _verdict(modes, candidates, undecided)
+    verdict, reason = verdict_of(modes, candidates, undecided)
     return TrajectoryReport(path, verdict, reason, candidates, modes, isolation.method,
                             undecided, not isolation.undecided)
 
@@ -264,7 +319,7 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
     candidates.sort(key=lambda c: float(c.t.mid()))
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
-    verdict, reason = _verdict(modes, candidates, undecided)
+    verdict, reason = verdict_of(modes, candidates, undecided)
     if verdict == VERDICT_FREE:
         reason += " (the path lies on ξ(X) = 0: each mode was decided on its own)"
     return TrajectoryReport(path, verdict, reason, candidates, modes, method, undecided,
@@ -275,14 +330,16 @@ def _on_surface_candidate(path, mode, status, proof) -> Candidate:
     """The whole path for one mode, shown at the range start."""
     t = path.trajectory.range.start.ball()
     pose, joints, _ = _mode_values(path, [mode], t)
-    shown = {mode.label: {leg.leg.joint: _mid(v) for leg, v in zip(path.legs, joints[mode.label],
-                                                                   strict=True)}}
+    shown = {mode.label: {leg.leg.joint: joint_float(v)
+                          for leg, v in zip(path.legs, joints[mode.label], strict=True)}}
     state = "real" if status == SINGULAR else UNKNOWN
     return Candidate(RealRoot(t, None), pose, shown, [ModeAtCandidate(mode.label, status, proof)],
                      state)
 
 
-def _verdict(modes, candidates, undecided) -> tuple[str, str]:
+def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
+    """The verdict and its one-sentence reason from the modes' feasibility, the
+    classified candidates and what root isolation left undecided."""
     feasible = [m for m in modes if m.status == FEASIBLE]
     unsure = [m for m in modes if m.status == UNKNOWN]
     singular = [(m.label, c) for c in candidates for m in feasible

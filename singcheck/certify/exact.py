@@ -75,6 +75,13 @@ class ModeExpression:
     """
 
     def __init__(self, path: PathModel) -> None:
+        model = path.projection.model
+        if any(leg.revolute for leg in path.legs):
+            raise NotExact("exact decisions are not implemented for revolute legs yet")
+        if path.mu.context() is not TRIG or any(x.context() is not TRIG
+                                                for x in path.coordinates):
+            raise NotExact("exact decisions are not implemented for square roots among "
+                           "the robot's or the path's numbers yet")
         quadratic = [i for i, leg in enumerate(path.legs) if leg.leg.degree == 2]
         names = ("t", "s", "c", *(f"r{q}" for q in range(len(quadratic))))
         ring = fmpq_mpoly_ctx.get(names, "lex")
@@ -92,8 +99,13 @@ class ModeExpression:
             else:
                 b, c = leg.coefficients
                 joints.append(-lift(c) / constant_value(b))
-        full = path.projection.model.det_A.compose(*joints, *(lift(x) for x in path.phi),
-                                                   ctx=ring)
+        images = dict(zip((leg.leg.joint for leg in path.legs), joints, strict=True))
+        images.update(zip(model.pose_variables, (lift(x) for x in path.coordinates),
+                          strict=True))
+        names = model.det_A.context().names()
+        if any(v not in images for v in names):
+            raise NotExact("det A involves variables other than the joints and the pose")
+        full = model.det_A.compose(*(images[v] for v in names), ctx=ring)
         self.D = [path.legs[i].discriminant for i in quadratic]
         self.legs = quadratic
         by_r: dict[tuple[int, ...], dict] = {}

@@ -29,10 +29,11 @@ from itertools import product
 
 from flint import arb
 
-from singcheck.algebra.intervals import fraction_ball, working_precision
-from singcheck.algebra.trig import TimeRange, evaluate_trig
+from singcheck.algebra.intervals import working_precision
+from singcheck.algebra.radicals import evaluate_path
+from singcheck.algebra.trig import TimeRange
 from singcheck.budget import checkpoint
-from singcheck.certify.path import LegAlongPath, PathModel
+from singcheck.certify.path import LegAlongPath, PathModel, joint_float
 from singcheck.roots.enclosures import IdenticallyZeroError, RootIsolation
 from singcheck.roots.isolation import isolate_real_roots
 
@@ -125,10 +126,11 @@ def _everywhere(predicate, interval: TimeRange) -> bool:
     return True
 
 
-def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float):
-    """Status of both branches of a quadratic leg with respect to step 1."""
+def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when):
+    """Status of both branches of a quadratic leg with respect to step 1 (``when``
+    writes a time ball in the user's parameter)."""
     joint = leg.leg.joint
-    if _everywhere(lambda t: evaluate_trig(leg.discriminant, t) > 0, interval):
+    if _everywhere(lambda t: evaluate_path(leg.discriminant, t) > 0, interval):
         return FEASIBLE, "", None
     iso = _isolate(leg.discriminant, interval, tolerance)
     if iso is None:
@@ -136,15 +138,15 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float):
             "(serial singularity)", None
     if iso.roots:
         t = iso.roots[0].t
-        return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {float(t.mid()):.6g} " \
+        return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {when(t)} " \
             "(serial singularity: the path reaches the workspace boundary)", t
     for box in iso.undecided:
-        if not evaluate_trig(leg.discriminant, box.t) > 0:
+        if not evaluate_path(leg.discriminant, box.t) > 0:
             return UNKNOWN, f"could not prove that the branches of {joint} stay apart: " \
                 f"{box.reason}", box.t
     for prec in _PRECISIONS:
         with working_precision(prec):
-            d = evaluate_trig(leg.discriminant, interval.start.ball())
+            d = evaluate_path(leg.discriminant, interval.start.ball())
         if d > 0:
             return FEASIBLE, "", None
         if d < 0:
@@ -153,29 +155,18 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float):
     return UNKNOWN, f"the sign of the discriminant of {joint} could not be decided", None
 
 
-def _inside(value, lo, hi) -> bool | None:
-    if value is None:
-        return None
-    if value > lo and value < hi:
-        return True
-    if value < lo or value > hi:
-        return False
-    return None
-
-
 def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
-                   tolerance: float, crossings: dict) -> BranchFeasibility:
+                   tolerance: float, crossings: dict, when) -> BranchFeasibility:
     """Whether this branch stays strictly inside the joint limits along the whole path.
 
     ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
     the leg equals it (one polynomial serves both branches)."""
     joint = leg.leg.joint
-    lo, hi = (fraction_ball(v) for v in limits)
     bounds = f"[{limits[0]}, {limits[1]}]"
-    if _inside(leg.branches(interval.start.ball())[label], lo, hi) is False:
+    if leg.inside(leg.branches(interval.start.ball())[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
                                  f"{joint} is outside {bounds} from the start")
-    if _everywhere(lambda t: _inside(leg.branches(t)[label], lo, hi) is True, interval):
+    if _everywhere(lambda t: leg.inside(leg.branches(t)[label], limits) is True, interval):
         return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
     undecided = []
@@ -185,6 +176,10 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
             crossings[value] = _isolate(leg.limit_polynomial(value), interval, tolerance)
         iso = crossings[value]
         if iso is None:
+            if leg.revolute:
+                return BranchFeasibility(joint, label, UNKNOWN,
+                                         f"a branch of {joint} sits on its limit {value} "
+                                         "all along")
             if leg.leg.degree == 1:  # the only branch is the limit all along: inside
                 return BranchFeasibility(joint, label, FEASIBLE)
             w = _switch_polynomial(leg, value)
@@ -196,7 +191,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
     for box in undecided:
-        if _inside(leg.branches(box.t)[label], lo, hi) is not True:
+        if leg.inside(leg.branches(box.t)[label], limits) is not True:
             return BranchFeasibility(joint, label, UNKNOWN,
                                      f"limit crossing of {joint} not decided: {box.reason}")
     events += [box.t for box in undecided]
@@ -204,7 +199,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         verdict = None
         for prec in _PRECISIONS:
             with working_precision(prec):
-                verdict = _inside(leg.branches(point)[label], lo, hi)
+                verdict = leg.inside(leg.branches(point)[label], limits)
                 if verdict is None and _sits_on_limit(leg, label, on_limit, point):
                     verdict = True  # exactly on a (closed) limit over this whole gap
             if verdict is not None:
@@ -212,12 +207,12 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         if verdict is None:
             return BranchFeasibility(joint, label, UNKNOWN,
                                      f"could not place {joint} against its limits at "
-                                     f"t = {float(point):.6g}")
+                                     f"t = {when(point)}")
         if verdict is False:
             crossing = max((e for e in events if e < point), key=lambda b: b.mid(),
                            default=None)
             reason = f"{joint} is outside {bounds} from the start" if crossing is None else \
-                f"{joint} leaves {bounds} at t ≈ {float(crossing.mid()):.6g}"
+                f"{joint} leaves {bounds} at t ≈ {when(crossing)}"
             return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing)
     return BranchFeasibility(joint, label, FEASIBLE)
 
@@ -239,28 +234,32 @@ def _sits_on_limit(leg: LegAlongPath, label: str, on_limit: dict, point: arb) ->
     (σ·w(point) > 0, proven; see :func:`_switch_polynomial`), hence over the whole gap
     between two roots of w that holds it."""
     sigma = 1 if label == "+" else -1
-    return any(sigma * evaluate_trig(w, point) > 0 for w in on_limit.values())
+    return any(sigma * evaluate_path(w, point) > 0 for w in on_limit.values())
 
 
 def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibility]]:
     """Feasibility of every branch of every leg (outer list in joint order)."""
     interval = path.trajectory.range
     limits_of = path.projection.model.spec.joint_limits
+
+    def when(t: arb) -> str:
+        return f"{float(path.trajectory.to_global(arb(t)).mid()):.6g}"
+
     out = []
     for leg in path.legs:
         joint = leg.leg.joint
-        if leg.leg.degree == 2:
-            status, reason, when = _leg_reality(leg, interval, tolerance)
+        if leg.discriminant is not None:
+            status, reason, event = _leg_reality(leg, interval, tolerance, when)
         else:
-            status, reason, when = FEASIBLE, "", None
+            status, reason, event = FEASIBLE, "", None
         branches = []
         crossings: dict = {}
         for label in leg.labels:
             if status != FEASIBLE:
-                branches.append(BranchFeasibility(joint, label, status, reason, when))
+                branches.append(BranchFeasibility(joint, label, status, reason, event))
             elif joint in limits_of:
                 branches.append(_branch_limits(leg, label, interval, limits_of[joint],
-                                               tolerance, crossings))
+                                               tolerance, crossings, when))
             else:
                 branches.append(BranchFeasibility(joint, label, FEASIBLE))
         out.append(branches)
@@ -272,8 +271,7 @@ def _start_values(path: PathModel) -> list[dict[str, float | None]]:
     out = []
     for leg in path.legs:
         values = leg.branches(start)
-        out.append({label: (float(v.mid()) if isinstance(v, arb) else None)
-                    for label, v in values.items()})
+        out.append({label: joint_float(v) for label, v in values.items()})
     return out
 
 

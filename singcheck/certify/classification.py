@@ -178,6 +178,30 @@ def _mid(v) -> float | None:
     return float(v.mid()) if isinstance(v, arb) else None
 
 
+def _classify_all(path: PathModel, modes: list[WorkingMode], roots, tolerance: float
+                  ) -> list[Candidate]:
+    """Every root classified.  On a path free of the bare t (X(t) depends on sin t and
+    cos t only) everything the classification looks at — the pose, each mode's joints
+    and det A — is 2π-periodic, so the root τ + 2kπ has exactly the classification of τ:
+    a root known to be a 2kπ shift of one already classified (``RealRoot.period``)
+    takes its verdicts per mode, with their proofs, and its pose and joints."""
+    from singcheck.algebra.trig import uses_t
+
+    periodic = not any(uses_t(x) for x in path.phi)
+    done: dict[int, Candidate] = {}
+    out = []
+    for r in roots:
+        base = done.get(r.period[0]) if periodic and r.period is not None else None
+        if base is None:
+            candidate = classify_candidate(path, modes, r, tolerance)
+            if periodic and r.period is not None:
+                done[r.period[0]] = candidate
+        else:
+            candidate = Candidate(r, base.pose, base.joints, base.modes, base.status)
+        out.append(candidate)
+    return out
+
+
 def _clear_undecided(path, modes, box) -> bool:
     """True when every feasible mode's det A provably stays away from 0 on the box."""
     _, _, values = _mode_values(path, [m for m in modes if m.status == FEASIBLE], box.t)
@@ -193,7 +217,7 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
         return TrajectoryReport(path, VERDICT_UNKNOWN,
                                 "the trajectory lies on the singularity surface ξ(X) = 0, so "
                                 "μ(t) ≡ 0 gives no candidates", [], modes, "none")
-    candidates = [classify_candidate(path, modes, r, tolerance) for r in isolation.roots]
+    candidates = _classify_all(path, modes, isolation.roots, tolerance)
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
     undecided = [(b.t, b.reason) for b in isolation.undecided

@@ -57,18 +57,19 @@ class LegAlongPath:
             out = out * q + c
         return out
 
-    def branches(self, t: arb) -> dict[str, arb | acb | None]:
+    def branches(self, t: arb, tight: bool = False) -> dict[str, arb | acb | None]:
         """Enclosures of each branch's joint value for every t in the ball ``t``.
 
         A quadratic leg's branches are real where D > 0 (proven) and complex
         conjugate where D < 0; where the sign of D is not proven both are None.
+        ``tight`` spends more on a wide ball (:func:`~singcheck.algebra.trig.evaluate_trig`).
         """
-        values = [evaluate_trig(c, t) for c in self.coefficients]
+        values = [evaluate_trig(c, t, tight) for c in self.coefficients]
         if self.leg.degree == 1:
             b, c = values
             return {"o": -c / b}
         a, b, _ = values
-        d = evaluate_trig(self.discriminant, t)
+        d = evaluate_trig(self.discriminant, t, tight)
         if d > 0:
             root = d.sqrt()
             return {"+": (-b + root) / (2 * a), "-": (-b - root) / (2 * a)}

@@ -5,7 +5,6 @@ Silent with ``--quiet``; plain lines when stderr is not a terminal (CI logs).
 
 from __future__ import annotations
 
-
 import sys
 
 

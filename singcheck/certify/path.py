@@ -96,8 +96,18 @@ class PathModel:
 
 
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
+    """The model along one piece (a multi-piece path: one per ``trajectory.pieces``)."""
+    if trajectory.segments:
+        raise ValueError("build_path takes one piece: use trajectory.pieces")
     model = projection.model
     phi = tuple(trajectory.pose[v] for v in model.pose)
+    if any(p.context() is not TRIG for p in phi):
+        from singcheck.errors import UnsupportedRobotError
+
+        raise UnsupportedRobotError(
+            "the trajectory uses square roots (sqrt, or sin/cos of t plus a multiple of pi): "
+            "this version certifies trajectories with rational coefficients only",
+            path=trajectory.path, line=trajectory.lines.get("pose"), key="pose")
     mu = compose_pose(projection.singularity_surface, phi, model.pose)
     legs = []
     for leg in model.legs:

@@ -69,15 +69,17 @@ def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:
 
 def _on_piece(report: TrajectoryReport, index: int, t: arb):
     """The model of the path's piece ``index`` (0-based) and the ball ``t`` of the user's
-    time in that piece's own time (τ = g·π·t on a rescaled piece)."""
+    time in that piece's own time (the inverse of ``TrajectorySpec.to_global``: τ = g·π·t
+    on a rescaled piece, u = t − t₀ on an interpolated one)."""
     if not report.pieces:
         return report.path, t
     spec = report.trajectory.pieces[index]
     path = report.pieces[index].path
-    if spec.time_scale is None:
-        return path, t
-    g = spec.time_scale
-    return path, t * arb.pi() * arb(fmpq(g.numerator, g.denominator))
+    if spec.time_scale is not None:
+        g = spec.time_scale
+        return path, t * arb.pi() * arb(fmpq(g.numerator, g.denominator))
+    d = spec.time_offset
+    return path, t - arb(fmpq(d.numerator, d.denominator)) if d else t
 
 
 def piece_index(report: TrajectoryReport, t: float) -> int:

@@ -365,3 +365,33 @@ def test_quick_root_exclusion_on_a_rational_range():
                        (0, 1, False), (fmpq(1, 3), 1, False), (1, 3, False)]:
         assert no_root_between(p, fmpq(a), fmpq(b)) is free
         assert not (nonzero_on(p, fmpq(a), fmpq(b)) and not free)  # never a false "free"
+
+
+def test_run_reads_a_csv_with_the_interpolation_asked(tmp_path):
+    csv = tmp_path / "path.csv"
+    csv.write_text(CSV)
+    expected = {"linear": singular_times(_linear_pieces()),
+                "cubic": singular_times(_cubic_pieces())}
+    for kind, roots in expected.items():
+        out = singcheck("run", str(ROBOTS / "orthoglide.yaml"), str(csv), "--format", "json",
+                        "--backend", "sympy", "--interpolation", kind)
+        assert out.returncode == 1, out.stderr
+        found = [c["t_interval"] for c in json.loads(out.stdout)["trajectories"][0]
+                 ["candidates"] if c["status"] == "real"]
+        assert len(found) == len(roots)
+        for (lo, hi), root in zip(found, roots, strict=True):
+            assert lo - 1e-12 <= float(root) <= hi + 1e-12, kind
+
+
+def test_a_serial_singularity_at_a_join_breaks_every_mode():
+    from singcheck import api
+
+    robot = api.robot_from_spec(parse_robot(RAIL, "rail.yaml"), "sympy", cache=False)
+    text = ("name: touch\nparameter: t\ninterpolation: linear\nwaypoints:\n"
+            "  - {t: 0, x: 1, y: 1}\n  - {t: 1, x: 1, y: 2}\n  - {t: 2, x: 3/2, y: 1}\n")
+    # independently: leg p's discriminant 4 − y² vanishes exactly at the join (y = 2)
+    assert 4 - Fraction(2) ** 2 == 0
+    report = api.check(robot, parse_trajectory(text, "p.yaml", robot.spec), regions=False)
+    assert report.verdict == "infeasible"
+    assert not [m for m in report.working_modes if m.feasible]
+    assert all("meet at t ≈ 1" in m.reason for m in report.working_modes)

@@ -30,10 +30,11 @@ from itertools import product
 
 from flint import arb
 
-from singcheck.algebra.intervals import fraction_ball, working_precision
-from singcheck.algebra.trig import LinearInPi, TimeRange, evaluate_trig, uses_t
+from singcheck.algebra.intervals import working_precision
+from singcheck.algebra.radicals import evaluate_path
+from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
 from singcheck.budget import checkpoint
-from singcheck.certify.path import LegAlongPath, PathModel
+from singcheck.certify.path import LegAlongPath, PathModel, joint_float
 from singcheck.roots.enclosures import IdenticallyZeroError, RootIsolation
 from singcheck.roots.isolation import isolate_real_roots
 
@@ -113,7 +114,26 @@ _TIGHT_DEGREE = 10  # ... when the leg's polynomials have at least this degree i
 
 def _high_degree(leg: LegAlongPath) -> bool:
     """Whether Horner in cos t is likely to overestimate badly on wide pieces."""
-    return max(sum(p.degrees()[1:]) for p in _leg_polys(leg) if p is not None) >= _TIGHT_DEGREE
+    return max(p.degrees()[1] + p.degrees()[2] for p in _leg_polys(leg)
+               if p is not None) >= _TIGHT_DEGREE
+
+
+def _leg_polys(leg: LegAlongPath):
+    return (*leg.coefficients, leg.discriminant)
+
+
+def one_period(interval: TimeRange, polys) -> TimeRange:
+    """The part of the range a quick proof about ``polys`` needs to cover.
+
+    Trig polynomials free of the bare t are 2π-periodic, so over a range longer than 2π
+    they take no value that they do not take on its first 2π: proving a property of
+    their values on [start, start + 2π] proves it on the whole range.
+    """
+    start, end = interval.start, interval.end
+    if any(uses_t(p) for p in polys if p is not None) or \
+            float(end) - float(start) <= 2 * math.pi + 1e-9:
+        return interval
+    return TimeRange(start, LinearInPi(start.rational, start.pi_coefficient + 2))
 
 
 def _halves(piece: arb) -> tuple[arb, arb]:
@@ -125,9 +145,9 @@ def _halves(piece: arb) -> tuple[arb, arb]:
 def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True) -> bool:
     """True when ``predicate(ball, tight)`` is proven on balls covering the whole range:
     a quick proof by ball arithmetic that spares a root isolation (False means "not
-    proven").  A wide piece where it fails is tried again with ``tight`` enclosures;
-    a piece where it still fails is halved (ball enclosures tighten as pieces shrink)
-    until a budget of evaluations is spent."""
+    proven").  A wide piece where it fails is tried again with ``tight`` enclosures
+    (when ``retry_tight``); a piece where it still fails is halved (ball enclosures
+    tighten as pieces shrink) until a budget of evaluations is spent."""
     todo = _pieces(interval)
     budget = _budget(interval)
     spent = 0
@@ -147,29 +167,11 @@ def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True) -> boo
     return True
 
 
-def one_period(interval: TimeRange, polys) -> TimeRange:
-    """The part of the range a quick proof about ``polys`` needs to cover.
-
-    Trig polynomials free of the bare t are 2π-periodic, so over a range longer than 2π
-    they take no value that they do not take on its first 2π: proving a property of
-    their values on [start, start + 2π] proves it on the whole range.
-    """
-    start, end = interval.start, interval.end
-    if any(uses_t(p) for p in polys if p is not None) or \
-            float(end) - float(start) <= 2 * math.pi + 1e-9:
-        return interval
-    return TimeRange(start, LinearInPi(start.rational, start.pi_coefficient + 2))
-
-
-def _leg_polys(leg: LegAlongPath):
-    return (*leg.coefficients, leg.discriminant)
-
-
 def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when):
     """Status of both branches of a quadratic leg with respect to step 1 (``when``
     writes a time ball in the user's parameter)."""
     joint = leg.leg.joint
-    if _everywhere(lambda t, tight: evaluate_trig(leg.discriminant, t, tight) > 0,
+    if _everywhere(lambda t, tight: evaluate_path(leg.discriminant, t, tight=tight) > 0,
                    one_period(interval, _leg_polys(leg)), _high_degree(leg)):
         return FEASIBLE, "", None
     iso = _isolate(leg.discriminant, interval, tolerance)
@@ -181,28 +183,18 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when)
         return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {when(t)} " \
             "(serial singularity: the path reaches the workspace boundary)", t
     for box in iso.undecided:
-        if not evaluate_trig(leg.discriminant, box.t) > 0:
+        if not evaluate_path(leg.discriminant, box.t) > 0:
             return UNKNOWN, f"could not prove that the branches of {joint} stay apart: " \
                 f"{box.reason}", box.t
     for prec in _PRECISIONS:
         with working_precision(prec):
-            d = evaluate_trig(leg.discriminant, interval.start.ball())
+            d = evaluate_path(leg.discriminant, interval.start.ball())
         if d > 0:
             return FEASIBLE, "", None
         if d < 0:
             return INFEASIBLE, f"{joint} has no real solution along the path " \
                 "(outside the workspace)", None
     return UNKNOWN, f"the sign of the discriminant of {joint} could not be decided", None
-
-
-def _inside(value, lo, hi) -> bool | None:
-    if value is None:
-        return None
-    if value > lo and value < hi:
-        return True
-    if value < lo or value > hi:
-        return False
-    return None
 
 
 def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
@@ -212,12 +204,11 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
     ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
     the leg equals it (one polynomial serves both branches)."""
     joint = leg.leg.joint
-    lo, hi = (fraction_ball(v) for v in limits)
     bounds = f"[{limits[0]}, {limits[1]}]"
-    if _inside(leg.branches(interval.start.ball())[label], lo, hi) is False:
+    if leg.inside(leg.branches(interval.start.ball())[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
                                  f"{joint} is outside {bounds} from the start")
-    if _everywhere(lambda t, tight: _inside(leg.branches(t, tight)[label], lo, hi) is True,
+    if _everywhere(lambda t, tight: leg.inside(leg.branches(t, tight)[label], limits) is True,
                    one_period(interval, _leg_polys(leg)), _high_degree(leg)):
         return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
@@ -232,7 +223,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
     for box in undecided:
-        if _inside(leg.branches(box.t)[label], lo, hi) is not True:
+        if leg.inside(leg.branches(box.t)[label], limits) is not True:
             return BranchFeasibility(joint, label, UNKNOWN,
                                      f"limit crossing of {joint} not decided: {box.reason}")
     events += [box.t for box in undecided]
@@ -240,7 +231,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         verdict = None
         for prec in _PRECISIONS:
             with working_precision(prec):
-                verdict = _inside(leg.branches(point)[label], lo, hi)
+                verdict = leg.inside(leg.branches(point)[label], limits)
             if verdict is not None:
                 break
         if verdict is None:
@@ -267,7 +258,7 @@ def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibili
     out = []
     for leg in path.legs:
         joint = leg.leg.joint
-        if leg.leg.degree == 2:
+        if leg.discriminant is not None:
             status, reason, event = _leg_reality(leg, interval, tolerance, when)
         else:
             status, reason, event = FEASIBLE, "", None
@@ -290,8 +281,7 @@ def _start_values(path: PathModel) -> list[dict[str, float | None]]:
     out = []
     for leg in path.legs:
         values = leg.branches(start)
-        out.append({label: (float(v.mid()) if isinstance(v, arb) else None)
-                    for label, v in values.items()})
+        out.append({label: joint_float(v) for label, v in values.items()})
     return out
 
 

@@ -66,3 +66,220 @@ def test_linear_delta_path_at_constant_z_gets_its_region(tmp_path):
         roots = [-0.4 + sign * math.sqrt(9 - d2) for sign in (1, -1)]
         count *= sum(-3 < r < 3 for r in roots)
     assert t["workspace"]["ik_counts"] == [count] == [8]
+
+
+# -- input: standard input, several documents, unique names ---------------------------
+
+ORTHO = str(ROOT / "robots" / "orthoglide.yaml")
+PAPER = {"heart1": "singular", "heart2": "singularity-free", "helix": "singularity-free"}
+
+
+def _stream(*names: str) -> str:
+    return "".join("---\n" + (ROOT / "trajectories" / f"{n}.yaml").read_text()
+                   for n in names)
+
+
+def singcheck_in(stdin: str, *args: str, env: dict | None = None):
+    import os
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "singcheck", *args], input=stdin,
+                          capture_output=True, text=True, cwd=ROOT, timeout=300,
+                          env={**os.environ, **(env or {})})
+
+
+def test_a_multi_document_stream_on_stdin_in_jsonl(tmp_path):
+    """Three documents on stdin: three JSON lines, nothing else on stdout, each the
+    trajectory object plus the robot, with the paper's verdicts."""
+    out = singcheck_in(_stream("heart1", "heart2", "helix"), "run", ORTHO, "-", "--format",
+                       "jsonl", "--backend", "flint", "--no-regions",
+                       env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 1, out.stderr  # heart 1 is singular
+    lines = out.stdout.splitlines()
+    assert len(lines) == 3 and out.stdout.endswith("\n")
+    docs = [json.loads(line) for line in lines]
+    assert {d["name"]: d["verdict"] for d in docs} == PAPER
+    for d in docs:
+        assert d["robot"]["name"] == "orthoglide" and d["path"] == "<stdin>"
+        assert "workspace" not in d  # --no-regions
+        assert "time_s" not in d  # the schema's object, unchanged
+    heart1 = next(d for d in docs if d["name"] == "heart1")
+    assert [round(c["t"], 2) for c in heart1["candidates"]] == [-1.51, -0.98, 0.98, 1.51]
+
+
+def test_a_file_of_several_documents_and_a_file_of_one(tmp_path):
+    many = tmp_path / "many.yaml"
+    many.write_text(_stream("heart1", "heart2"))
+    out = singcheck("run", ORTHO, str(many), str(ROOT / "trajectories" / "helix.yaml"),
+                    "--format", "json", "--backend", "flint", "-q",
+                    env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 1, out.stderr
+    docs = json.loads(out.stdout)["trajectories"]
+    assert [(d["name"], d["verdict"]) for d in docs] == list(PAPER.items())  # input order
+
+
+def test_names_must_be_unique_in_a_run(tmp_path):
+    out = singcheck_in(_stream("heart1", "heart2"), "run", ORTHO, "-",
+                       str(ROOT / "trajectories" / "heart1.yaml"), "--backend", "flint")
+    assert out.returncode == 2
+    assert out.stdout == ""
+    err = out.stderr.strip()
+    assert err.count("\n") == 0 and "Traceback" not in err
+    assert "heart1.yaml:" in err and "'heart1' is already used by <stdin>:" in err
+
+
+def test_an_error_in_a_later_document_names_the_line_and_the_document():
+    text = _stream("heart1") + "---\nname: bad\nparameter: t\nrange: [0, 1]\npose:\n" \
+        "  x: t\n  y: 0\n  z: sin(t\n"
+    out = singcheck_in(text, "run", ORTHO, "-", "--backend", "flint")
+    assert out.returncode == 2
+    line = len(_stream("heart1").splitlines()) + 8
+    assert out.stderr.startswith(f"singcheck: error: <stdin>:{line}: pose.z:")
+    assert "(document 2)" in out.stderr
+
+
+# -- output: JUnit XML for CI ----------------------------------------------------------
+
+
+def test_junit_parsed_back_by_a_ci_parser(tmp_path):
+    """junitparser (what CI report tools use) reads the file: one suite for the robot,
+    a case per trajectory, a failure for the singular heart 1 with its singular times,
+    an error for a trajectory stopped by its time limit."""
+    from junitparser import Error, Failure, JUnitXml
+
+    report = tmp_path / "report.xml"
+    out = singcheck("run", ORTHO, *(str(ROOT / "trajectories" / f"{n}.yaml") for n in PAPER),
+                    str(DATA / "slow.yaml"), "--format", "junit", "-o", str(report),
+                    "--backend", "flint", "--time-limit", "2", "--no-regions", "-q",
+                    env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 1, out.stderr
+    assert out.stdout == ""
+    xml = JUnitXml.fromfile(str(report))
+    (suite,) = list(xml)
+    assert suite.name == "orthoglide"
+    assert (suite.tests, suite.failures, suite.errors) == (4, 1, 1)
+    cases = {case.name: case for case in suite}
+    assert set(cases) == {*PAPER, "slow"}
+    (failure,) = cases["heart1"].result
+    assert isinstance(failure, Failure)
+    # the paper's S3 and S4 (Table 1): t ≈ 0.98 and 1.51 on mode +++
+    times = [float(x) for x in failure.message.split("≈")[1].split(",")]
+    assert [round(x, 2) for x in times] == [0.98, 1.51]
+    (error,) = cases["slow"].result
+    assert isinstance(error, Error) and "time limit" in error.message
+    assert cases["heart2"].result == [] and cases["helix"].result == []
+    assert cases["slow"].time >= 2 and all(c.time < 2 for n, c in cases.items() if n != "slow")
+
+
+# -- one path never sinks a batch -----------------------------------------------------
+
+
+@pytest.mark.slow
+def test_one_path_past_the_time_limit_and_the_others_come_back_right(tmp_path):
+    import time
+
+    start = time.monotonic()
+    out = singcheck("run", ORTHO, str(ROOT / "trajectories" / "heart1.yaml"),
+                    str(DATA / "slow.yaml"), str(ROOT / "trajectories" / "heart2.yaml"),
+                    "--format", "jsonl", "--backend", "flint", "--time-limit", "2", "-q",
+                    "--jobs", "1", env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    elapsed = time.monotonic() - start
+    assert out.returncode == 1, out.stderr  # the worst outcome: heart 1 is singular
+    docs = {d["name"]: d for d in map(json.loads, out.stdout.splitlines())}
+    assert docs["slow"]["verdict"] == "unknown"
+    assert "time limit (2 s)" in docs["slow"]["reason"]
+    assert docs["heart1"]["verdict"] == "singular" and docs["heart2"]["verdict"] == \
+        "singularity-free"
+    assert elapsed < 60  # unbounded, the slow path runs for minutes
+
+
+def _fail_on(name: str, monkeypatch):
+    from singcheck import api
+
+    real = api.check
+
+    def check(robot, trajectory, **options):
+        if trajectory.name == name:
+            raise ZeroDivisionError("Fraction(1, 0)")
+        return real(robot, trajectory, **options)
+
+    monkeypatch.setattr(api, "check", check)
+
+
+@pytest.fixture(scope="module")
+def orthoglide_robot():
+    import singcheck as sc
+
+    return sc.load_robot(ORTHO, backend="flint", cache=False)
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_an_internal_error_is_that_paths_result(orthoglide_robot, tmp_path, monkeypatch, jobs):
+    """A bug on one path: that path is an error with the reason, the others are
+    certified (in one process, and in forked workers)."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "bench"))
+    from generate import write
+
+    from singcheck import api
+    from singcheck.spec.files import load_trajectories
+
+    paths = write(tmp_path, 6)
+    specs = load_trajectories(paths, orthoglide_robot.spec)
+    expected = [api.check(orthoglide_robot, s, regions=False).verdict for s in specs]
+    _fail_on(specs[2].name, monkeypatch)
+    docs = list(api.check_batch(orthoglide_robot, specs, regions=False, jobs=jobs))
+    assert [d["name"] for d in docs] == [s.name for s in specs]
+    assert docs[2]["verdict"] == "error"
+    assert docs[2]["error"] == {"kind": "internal", "message": "ZeroDivisionError: Fraction(1, 0)"}
+    assert [d["verdict"] for i, d in enumerate(docs) if i != 2] == \
+        [v for i, v in enumerate(expected) if i != 2]
+
+
+def test_the_batch_exits_with_its_worst_outcome(monkeypatch, capsys):
+    """An error on one path: the others are printed, and the exit status is 70."""
+    import sys
+
+    from singcheck.cli import commands as cli
+
+    _fail_on("heart2", monkeypatch)
+    monkeypatch.setattr(sys, "argv", ["singcheck", "run", ORTHO,
+                                      str(ROOT / "trajectories" / "heart1.yaml"),
+                                      str(ROOT / "trajectories" / "heart2.yaml"),
+                                      "--format", "jsonl", "--backend", "flint", "-q",
+                                      "--no-cache", "--no-regions"])
+    with pytest.raises(SystemExit) as exit_:
+        cli.main()
+    assert exit_.value.code == 70
+    docs = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [(d["name"], d["verdict"]) for d in docs] == [("heart1", "singular"),
+                                                         ("heart2", "error")]
+    assert [cli._worst(c) for c in ([0, 3], [3, 1], [1, 4], [4, 70], [])] == [3, 1, 4, 70, 0]
+
+
+def test_the_hard_time_limit_stops_a_loop_without_checkpoints():
+    import time
+
+    from singcheck.api import hard_time_limit
+    from singcheck.budget import TimeLimitExceeded
+
+    start = time.monotonic()
+    with pytest.raises(TimeLimitExceeded), hard_time_limit(0.1):
+        while True:
+            pass
+    assert time.monotonic() - start < 5
+
+
+def test_robots_and_trajectories_pickle_exactly(orthoglide_robot):
+    """What a Dask cluster ships: the unpickled robot and path give the same report."""
+    import pickle
+
+    import singcheck as sc
+    from singcheck.algebra import pickling  # noqa: F401  (installs the reducers)
+
+    heart1 = sc.load_trajectory(str(ROOT / "trajectories" / "heart1.yaml"), orthoglide_robot)
+    robot2, heart2 = pickle.loads(pickle.dumps((orthoglide_robot, heart1)))
+    assert robot2.singularity_surface == orthoglide_robot.singularity_surface
+    assert sc.check(robot2, heart2).to_dict() == sc.check(orthoglide_robot, heart1).to_dict()

@@ -283,3 +283,115 @@ def test_robots_and_trajectories_pickle_exactly(orthoglide_robot):
     robot2, heart2 = pickle.loads(pickle.dumps((orthoglide_robot, heart1)))
     assert robot2.singularity_surface == orthoglide_robot.singularity_surface
     assert sc.check(robot2, heart2).to_dict() == sc.check(orthoglide_robot, heart1).to_dict()
+
+
+# -- signals: what was streamed stays valid, -o writes nothing partial -----------------
+
+
+def _generated(tmp_path, count: int) -> list[str]:
+    import sys
+
+    sys.path.insert(0, str(ROOT / "bench"))
+    from generate import write
+
+    return [str(p) for p in write(tmp_path / "paths", count)]
+
+
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP"])
+def test_a_signal_mid_batch_leaves_valid_jsonl_lines(tmp_path, sig):
+    """Stopped mid-batch (forked workers busy), singcheck exits 130; every line it wrote
+    is a whole JSON object, and no worker printed a traceback."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    paths = _generated(tmp_path, 40)
+    proc = subprocess.Popen([sys.executable, "-m", "singcheck", "run", ORTHO, *paths,
+                             str(DATA / "slow.yaml"), "--format", "jsonl", "--jobs", "2",
+                             "--backend", "flint", "--no-regions"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT,
+                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)})
+    first = proc.stdout.readline()  # a result streamed: the batch is under way
+    time.sleep(0.5)
+    proc.send_signal(getattr(signal, sig))
+    rest = proc.stdout.read()  # (communicate() would skip what readline buffered)
+    err = proc.stderr.read()
+    proc.wait(timeout=60)
+    assert proc.returncode == 130, err
+    lines = (first + rest).decode().splitlines()
+    assert 1 <= len(lines) < 41  # the slow path never finished
+    for line in lines:
+        assert line.startswith("{") and line.endswith("}"), (line[:200], line[-200:])
+        assert json.loads(line)["verdict"] in ("singular", "singularity-free", "infeasible")
+    text = err.decode()
+    assert "interrupted" in text
+    assert "Traceback" not in text and "ForkPoolWorker" not in text
+
+
+def test_a_signal_leaves_no_output_file(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "results.jsonl"
+    proc = subprocess.Popen([sys.executable, "-m", "singcheck", "run", ORTHO,
+                             str(ROOT / "trajectories" / "heart1.yaml"), str(DATA / "slow.yaml"),
+                             "--format", "jsonl", "-o", str(out), "--jobs", "1",
+                             "--backend", "flint", "--no-regions"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT,
+                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)})
+    err = b""
+    for line in proc.stderr:  # progress notes: heart 1 is done, the slow path running
+        err += line
+        if b"heart1" in line:
+            break
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGTERM)
+    _, rest = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err + rest
+    assert not out.exists() and list(tmp_path.glob(".results.jsonl*")) == []
+
+
+# -- Dask ------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def local_cluster():
+    """A dask.distributed cluster of two worker processes, on loopback only."""
+    distributed = pytest.importorskip("distributed")
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       host="127.0.0.1", dashboard_address=None)
+    yield cluster
+    cluster.close()
+
+
+@pytest.mark.slow
+def test_the_dask_run_gives_the_local_verdicts(local_cluster, tmp_path, orthoglide_robot):
+    """Generated heart-like paths on the cluster (SINGCHECK_SCHEDULER): the verdicts of
+    a local run of the API, each path once; jsonl in completion order, json in input
+    order."""
+    from singcheck import api
+    from singcheck.spec.files import load_trajectories
+
+    paths = _generated(tmp_path, 30)
+    local = {d["name"]: d for d in api.check_batch(
+        orthoglide_robot, load_trajectories(paths, orthoglide_robot.spec), regions=False)}
+    env = {"SINGCHECK_CACHE_DIR": str(tmp_path),
+           "SINGCHECK_SCHEDULER": local_cluster.scheduler_address}
+    lines = singcheck("run", ORTHO, *paths, "--format", "jsonl", "--backend", "flint",
+                      "--no-regions", "-q", env=env)
+    assert lines.returncode == 1, lines.stderr
+    streamed = [json.loads(line) for line in lines.stdout.splitlines()]
+    assert sorted(d["name"] for d in streamed) == sorted(local)
+    for d in streamed:
+        del d["robot"]
+        assert d == {k: v for k, v in local[d["name"]].items() if k != "time_s"}
+    doc = singcheck("run", ORTHO, *paths, "--format", "json", "--backend", "flint", "-q",
+                    env=env)
+    assert [t["name"] for t in json.loads(doc.stdout)["trajectories"]] == list(local)
+    assert {t["name"]: t["verdict"] for t in json.loads(doc.stdout)["trajectories"]} == \
+        {n: d["verdict"] for n, d in local.items()}

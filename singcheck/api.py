@@ -24,10 +24,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from singcheck.budget import TimeLimitExceeded, deadline
-from singcheck.certify.classification import Candidate, TrajectoryReport, certify_path
-from singcheck.certify.path import PathModel, build_path
+from singcheck.certify.classification import Candidate, TrajectoryReport
+from singcheck.certify.path import PathModel
+from singcheck.certify.pieces import certify_trajectory
 from singcheck.certify.working_modes import WorkingMode
-from singcheck.elimination.projection import RobotProjection, project_robot
+from singcheck.elimination.projection import MAX_SURFACE_TERMS, RobotProjection, project_robot
 from singcheck.model.robot import RobotModel, build_model
 from singcheck.spec.files import RobotSpec, TrajectorySpec
 from singcheck.spec.files import load_robot as read_robot_spec
@@ -75,17 +76,20 @@ class Robot:
 
     @property
     def singularity_surface(self):
-        """ξ(X), squarefree, exact (an ``fmpq_mpoly`` in the pose variables)."""
+        """ξ(X), squarefree, exact (an ``fmpq_mpoly`` in the pose variables); None when it
+        was too big to expand (``projection.not_expanded`` says why)."""
         return self.projection.singularity_surface
 
 
 def robot_from_spec(spec: RobotSpec, backend: str = "auto", *, timeout: float = 600.0,
-                    cache: bool = True, notify: Notify = _quiet, engine=None) -> Robot:
+                    cache: bool = True, notify: Notify = _quiet, engine=None,
+                    max_surface_terms: int = MAX_SURFACE_TERMS) -> Robot:
     """A :class:`Robot` from an already-read spec (``engine``: a ready backend, else one is
-    built from ``backend``, ``timeout`` and ``cache``)."""
+    built from ``backend``, ``timeout`` and ``cache``).  ξ(X) is not expanded when its
+    bound exceeds ``max_surface_terms`` (0: never; each path then eliminates along itself)."""
     model = build_model(spec)
     engine = engine or elimination_engine(backend, timeout, cache, notify)
-    projection = project_robot(model, engine)
+    projection = project_robot(model, engine, max_surface_terms)
     region_cache = None
     if cache:
         from singcheck.spaces.region_map import RegionMapCache
@@ -95,17 +99,20 @@ def robot_from_spec(spec: RobotSpec, backend: str = "auto", *, timeout: float = 
 
 
 def load_robot(path: str, backend: str = "auto", *, timeout: float = 600.0,
-               cache: bool = True, notify: Notify = _quiet) -> Robot:
+               cache: bool = True, notify: Notify = _quiet,
+               max_surface_terms: int = MAX_SURFACE_TERMS) -> Robot:
     """Read a robot spec (YAML) and project it: the elimination runs here, once (or comes
     from the cache); raises :class:`~singcheck.errors.SpecError` for a bad file and
     :class:`~singcheck.errors.BackendError` when the backend is missing or fails."""
     return robot_from_spec(read_robot_spec(path), backend, timeout=timeout, cache=cache,
-                           notify=notify)
+                           notify=notify, max_surface_terms=max_surface_terms)
 
 
-def load_trajectory(path: str, robot: Robot) -> TrajectorySpec:
-    """Read a trajectory spec (YAML) for ``robot``: its pose variables are checked."""
-    return read_trajectory_spec(path, robot.spec)
+def load_trajectory(path: str, robot: Robot, interpolation: str | None = None) -> TrajectorySpec:
+    """Read a trajectory spec (YAML, or a CSV table of poses interpolated
+    ``interpolation``: linear or cubic, the default) for ``robot``: its pose variables
+    are checked."""
+    return read_trajectory_spec(path, robot.spec, interpolation)
 
 
 @dataclass
@@ -180,12 +187,12 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
     """
     with deadline(time_limit):
         try:
-            path = build_path(robot.projection, trajectory)
-            certificate = certify_path(path, tolerance)
+            certificate = certify_trajectory(robot.projection, trajectory, tolerance)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions:
+        if not regions or not _one_piece(trajectory):
             return Report(trajectory, certificate)
+        path = certificate.path
         from singcheck.spaces.path_regions import path_in_workspace
 
         mu_roots = ([c.t for c in certificate.candidates]
@@ -196,6 +203,12 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
         except TimeLimitExceeded as e:
             return Report(trajectory, certificate, time_limited=str(e))
         return Report(trajectory, certificate, where)
+
+
+def _one_piece(trajectory: TrajectorySpec) -> bool:
+    """Whether the workspace statement applies: one piece in the user's own time (the
+    regions of a multi-piece or rescaled path are not placed yet)."""
+    return not trajectory.segments and trajectory.time_scale is None
 
 
 #: the default per-trajectory time limit of a batch (seconds): generous, but finite
@@ -282,7 +295,8 @@ def prepare_regions(robot: Robot, trajectories: list[TrajectorySpec], time_limit
 
     try:
         with deadline(time_limit), hard_time_limit(time_limit):
-            prepare_region_maps(robot.projection, trajectories, robot.region_cache, notify)
+            prepare_region_maps(robot.projection, [t for t in trajectories if _one_piece(t)],
+                                robot.region_cache, notify)
     except TimeLimitExceeded:
         notify(f"the workspace regions shared by the paths took more than {time_limit:g} s "
                "(--time-limit): the batch runs without the region statement")

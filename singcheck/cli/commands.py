@@ -97,12 +97,18 @@ def cli() -> None:
                    "pip install 'singcheck[dask]'.")
 @click.option("--plot", "plot_dir", type=click.Path(file_okay=False),
               help="Also write the figures (see `singcheck plot`) to this directory.")
+@click.option("--interpolation", type=click.Choice(["linear", "cubic"]), default="cubic",
+              show_default=True,
+              help="How a CSV table of poses (TRAJECTORY ending in .csv) is joined: straight "
+                   "lines, or the natural cubic spline through its rows.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
 def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs,
-        time_limit, no_regions, scheduler, plot_dir, quiet, verbose) -> None:
-    """Certify each TRAJECTORY of ROBOT (YAML spec files).
+        time_limit, no_regions, scheduler, plot_dir, interpolation, quiet, verbose) -> None:
+    """Certify each TRAJECTORY of ROBOT (YAML spec files; - reads standard input; a
+    trajectory may also be a CSV table of poses).  A YAML file may hold several
+    trajectories as documents separated by ---; their names must be unique in a run.
 
     For every trajectory it prints the candidate singular times (certified
     enclosures of the roots of μ(t)), the pose and joints there, which working
@@ -124,7 +130,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     progress = Progress(quiet)
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
-                    verbose, progress, jobs, plot_dir, time_limit=time_limit,
+                    verbose, progress, jobs, plot_dir, interpolation, time_limit=time_limit,
                     regions=not no_regions, scheduler=scheduler)
     sys.exit(int(code))
 
@@ -151,20 +157,24 @@ def _worst(codes) -> ExitCode:
 
 
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
-         progress, jobs, plot_dir=None, *, time_limit=300.0, regions=True, scheduler=None):
+         progress, jobs, plot_dir=None, interpolation="cubic", *, time_limit=300.0,
+         regions=True, scheduler=None):
     from contextlib import closing
 
     from singcheck import api
     from singcheck.spec.files import load_robot, load_trajectories
 
     spec = load_robot(robot)
-    specs = load_trajectories(trajectories, spec)
+    specs = load_trajectories(trajectories, spec, interpolation)
     engine = api.elimination_engine(backend_name, timeout, not no_cache, progress.note)
     with progress.status(f"projecting {spec.name} onto its workspace ({engine.name})"):
         machine = api.robot_from_spec(spec, cache=not no_cache, engine=engine)
     projection = machine.projection
-    degree = projection.singularity_surface.total_degree()
-    progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
+    if projection.expanded:
+        degree = projection.singularity_surface.total_degree()
+        progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
+    else:
+        progress.note(f"singularity surface: not expanded: {projection.not_expanded}")
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
                    ordered=fmt != "jsonl", notify=progress.note)
     if scheduler:
@@ -261,12 +271,9 @@ def _render(projection, results, tolerance, fmt, verbose, code, to_file: bool) -
     if fmt == "junit":
         from singcheck.report.junit import junit_xml
 
-        return junit_xml(rep.robot_json(projection), results,
-                         {"backend": projection.backend,
-                          "elimination_method": projection.method,
-                          "singularity_surface_degree":
-                              projection.singularity_surface.total_degree(),
-                          "tolerance": tolerance, "exit_code": int(code)})
+        doc = rep.document(projection, [], tolerance, int(code))
+        return junit_xml(doc.pop("robot"), results,
+                         {k: v for k, v in doc.items() if k != "trajectories"})
     from singcheck.report.console import captured
 
     robot = rep.robot_json(projection)
@@ -301,9 +308,13 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
 
         spec = load_robot(robot)
         traj = load_trajectory(trajectory, spec) if trajectory else None
+        if traj is not None and traj.segments:
+            raise SpecError(f"project prints the formulas of a one-piece trajectory; this one "
+                            f"has {len(traj.segments)} segments", path=traj.path)
         engine = api.elimination_engine(backend, cache=False)
         machine = api.robot_from_spec(spec, cache=False, engine=engine)
-        epsilon = None if no_epsilon else joint_space_singularities(machine.model, engine)
+        epsilon = None if no_epsilon or not machine.projection.expanded else \
+            joint_space_singularities(machine.model, engine)
         path = build_path(machine.projection, traj) if traj else None
         click.echo(render(machine.projection, epsilon, path, "json" if fmt == "json" else
                           "latex" if as_latex else "text"), nl=False)

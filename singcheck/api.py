@@ -190,7 +190,9 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
             certificate = certify_trajectory(robot.projection, trajectory, tolerance)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions or not _one_piece(trajectory):
+        if not regions or not _one_piece(trajectory) or not robot.model.polynomial:
+            # the workspace decomposition (CAD) needs rational polynomials in the pose:
+            # robots with angles or square roots get the certificate without it
             return Report(trajectory, certificate)
         path = certificate.path
         from singcheck.spaces.path_regions import path_in_workspace
@@ -319,7 +321,8 @@ def check_batch(robot: Robot, trajectories: list[TrajectorySpec], *,
                    notify=notify)
     n = len(trajectories)
     if jobs > 1 and n > 4:
-        if regions and not prepare_regions(robot, trajectories, time_limit, notify):
+        if regions and robot.model.polynomial and not prepare_regions(
+                robot, trajectories, time_limit, notify):
             options["regions"] = False
         yield from _forked(robot, trajectories, options, jobs, ordered)
         return

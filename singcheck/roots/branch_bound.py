@@ -55,7 +55,7 @@ def _point(p: fmpq_mpoly, t: fmpq) -> arb:
 def _excluded(p, dp, lo: fmpq, hi: fmpq) -> tuple[bool, arb]:
     box = rational_ball(lo, hi)
     naive = evaluate_trig(p, box)
-    if excludes_zero(naive):
+    if excludes_zero(naive) or excludes_zero(evaluate_trig(p, box, tight=True)):
         return True, None
     mid = (lo + hi) / 2
     slope = evaluate_trig(dp, box)
@@ -140,7 +140,8 @@ def _exact_root(k: int, order: int) -> RealRoot:
             return k * arb.pi()
 
     time = point_time(Fraction(0) if k == 0 else None, 0, 1 if k % 2 == 0 else -1)
-    return RealRoot(arb(0) if k == 0 else make(1e-9), order, None if k == 0 else make, time)
+    return RealRoot(arb(0) if k == 0 else make(1e-9), order, None if k == 0 else make,
+                    exact=time)
 
 
 def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
@@ -209,8 +210,8 @@ def _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambigu
         t = arb(q)
         where = inside_range(t, None, interval, 53)
         if where:
-            roots.append(RealRoot(t, None, None, point_time(Fraction(0), 0, 1) if q == 0
-                                  else None))
+            roots.append(RealRoot(t, None, None, exact=point_time(Fraction(0), 0, 1)
+                                  if q == 0 else None))
     for lo, hi, reason in _merge(ambiguous):
         box = rational_ball(lo, hi)
         undecided.append(Undecided(box, f"{reason} near t ≈ {float(box.mid()):.6g}"))

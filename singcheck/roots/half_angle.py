@@ -177,7 +177,7 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
         bases.append((base_pi, LinearInPi(Fraction(0), Fraction(1)), None,
                       point_time(None, 0, -1)))
     roots, undecided = [], []
-    for base, exact, mult, time in bases:
+    for index, (base, exact, mult, time) in enumerate(bases):
         for k in _periods(base(tolerance), interval):
             def make(tol: float, base=base, k=k) -> arb:
                 with working_precision(bits_for(tol)):
@@ -192,7 +192,8 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
             if where is None:
                 undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
             elif where:
-                roots.append(RealRoot(make(tolerance), mult, make, time))
+                roots.append(RealRoot(make(tolerance), mult, make, period=(index, k),
+                                      exact=time))
     roots.sort(key=lambda r: float(r.t.mid()))
     return RootIsolation(tuple(roots), tuple(undecided), HALF_ANGLE)
 

@@ -72,7 +72,7 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
             undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
         elif where:
             roots.append(RealRoot(make(tolerance), mult, make,
-                                  ExactTime(IN_T, lambda rr=rr: rr)))
+                                  exact=ExactTime(IN_T, lambda rr=rr: rr)))
     return RootIsolation(tuple(roots), tuple(undecided), EXACT)
 
 
@@ -101,7 +101,7 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
     merged: list[RealRoot] = []
     for r, mult in roots:
         r = RealRoot(r.t, None if r.multiplicity is None else r.multiplicity * mult,
-                     r._refine, r.exact)
+                     r._refine, exact=r.exact)
         if merged and merged[-1].t.overlaps(r.t):
             prev, tol = merged[-1], tolerance
             for _ in range(6):
@@ -111,7 +111,8 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
                 prev, r = prev.refined(tol), r.refined(tol)
             if prev.t.overlaps(r.t):
                 if prev.t.is_exact() and r.t.is_exact() and prev.t == r.t:
-                    merged[-1] = RealRoot(prev.t, None, prev._refine, prev.exact or r.exact)
+                    merged[-1] = RealRoot(prev.t, None, prev._refine,
+                                          exact=prev.exact or r.exact)
                     continue
                 merged.pop()
                 undecided.append(Undecided(prev.t.union(r.t), "two factors of the function "

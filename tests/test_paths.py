@@ -395,3 +395,16 @@ def test_a_serial_singularity_at_a_join_breaks_every_mode():
     assert report.verdict == "infeasible"
     assert not [m for m in report.working_modes if m.feasible]
     assert all("meet at t ≈ 1" in m.reason for m in report.working_modes)
+
+
+def test_csv_with_a_byte_order_mark_and_huge_exponents(robot_spec, tmp_path):
+    bom = tmp_path / "bom.csv"
+    bom.write_bytes("\ufefft,x,y,z\n0,0.5,0.5,1\n1,0.6,0.5,1\n".encode())
+    assert len(load_trajectory(bom, robot_spec).pieces) == 1
+    huge = tmp_path / "huge.csv"
+    huge.write_text("t,x,y,z\n0,1e99999999,0.5,1\n1,0.6,0.5,1\n")
+    with pytest.raises(SpecError, match=r"huge.csv:2: x: .*exponent"):
+        load_trajectory(huge, robot_spec)
+    text = "name: a\nparameter: t\nrange: [0, 1]\npose: {x: 1e99999999*t, y: 0, z: 1}\n"
+    with pytest.raises(SpecError, match="too large"):  # refused before 10^e is built
+        parse_trajectory(text, "a.yaml", robot_spec)

@@ -189,25 +189,22 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
             certificate = certify_trajectory(robot.projection, trajectory, tolerance)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions or not _one_piece(trajectory):
+        if not regions:
             return Report(trajectory, certificate)
-        path = certificate.path
-        from singcheck.spaces.path_regions import path_in_workspace
+        from singcheck.spaces.path_regions import path_in_workspace, pieces_in_workspace
 
         mu_roots = ([c.t for c in certificate.candidates]
                     if certificate.mu_roots_complete else None)
         try:
-            where = path_in_workspace(path, tolerance, mu_roots=mu_roots,
-                                      region_cache=robot.region_cache, notify=notify)
+            if certificate.pieces:
+                where = pieces_in_workspace(certificate, tolerance, robot.region_cache,
+                                            notify)
+            else:
+                where = path_in_workspace(certificate.path, tolerance, mu_roots=mu_roots,
+                                          region_cache=robot.region_cache, notify=notify)
         except TimeLimitExceeded as e:
             return Report(trajectory, certificate, time_limited=str(e))
         return Report(trajectory, certificate, where)
-
-
-def _one_piece(trajectory: TrajectorySpec) -> bool:
-    """Whether the workspace statement applies: one piece in the user's own time (the
-    regions of a multi-piece or rescaled path are not placed yet)."""
-    return not trajectory.segments and trajectory.time_scale is None
 
 
 # state inherited by forked workers (set just before the pool starts)
@@ -237,7 +234,7 @@ def check_batch(robot: Robot, trajectories: list[TrajectorySpec], *,
                 from singcheck.spaces.path_regions import prepare_region_maps
 
                 prepare_region_maps(robot.projection,
-                                    [t for t in trajectories if _one_piece(t)],
+                                    [p for t in trajectories for p in t.pieces[:1]],
                                     robot.region_cache, notify)
             with multiprocessing.get_context("fork").Pool(jobs) as pool:
                 yield from pool.imap(_check_index, range(n),

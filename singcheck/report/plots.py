@@ -287,7 +287,10 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
     from singcheck.report.postures import posture_figure
 
     makers["postures"] = lambda: posture_figure(
-        plt, report, f"{robot} · {name}: the robot at the start and its singular postures")
+        plt, report, f"{robot} · {name}: the robot at the start" + (
+            " and at its singular times" if any(m.singular_times for m in report.modes
+                                                if m.feasible) else
+            " (no singular time on a feasible mode)"))
     written = []
     for key in makers:
         fig = makers[key]()

@@ -56,6 +56,16 @@ def arb_to_fmpq(x: arb) -> fmpq:
     return fmpq(int(man) * 2**int(exp)) if exp >= 0 else fmpq(int(man), 2 ** (-int(exp)))
 
 
+def ball_ends(x: arb) -> tuple[fmpq, fmpq]:
+    """The exact ends mid − rad and mid + rad of a ball, as rationals.
+
+    ``x.lower()`` and ``x.upper()`` round outward to the working precision: still an
+    enclosure, but two disjoint balls closer than that precision would get crossing
+    ends.  These are the ball's own ends, so disjoint balls keep disjoint intervals."""
+    mid, rad = arb_to_fmpq(x.mid()), arb_to_fmpq(x.rad())
+    return mid - rad, mid + rad
+
+
 # ---------------------------------------------------------------------------------
 # exact univariate isolation
 

@@ -288,3 +288,21 @@ def test_a_root_exactly_at_an_irrational_range_end_is_kept():
     assert abs(float(candidate.t.mid()) - float(mpmath.pi / 3)) < 1e-9
     assert all(m.status == "singular" for m in candidate.modes)
     assert not report.undecided
+
+
+def test_a_singular_pose_at_the_join_of_two_segments_is_decided_exactly(tmp_path):
+    from singcheck.certify.pieces import certify_trajectory
+    from singcheck.spec.files import load_trajectory
+
+    model = build_model(parse_robot(XY_BIGLIDE, "r.yaml"))
+    projection = project_robot(model, get_backend("flint"))
+    path = tmp_path / "seg.yaml"
+    pose = "{x: 8/5 - 3/5*(t - 1/2), y: 6/5 + 4/5*(t - 1/2)}"
+    path.write_text(f"name: seg\nparameter: t\nsegments:\n  - range: [0, 1/2]\n    pose: {pose}\n"
+                    f"  - range: [1/2, 1]\n    pose: {pose}\n")
+    report = certify_trajectory(projection, load_trajectory(path, model.spec))
+    # the same pose as the one-piece path: singular in ++ and -- at the join t = 1/2
+    assert report.verdict == "singular"
+    [candidate] = report.candidates
+    assert candidate.t.contains(0.5)
+    assert set(candidate.singular_modes) == {"++", "--"}

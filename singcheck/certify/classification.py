@@ -330,11 +330,12 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
     are not looked at).  Infeasible modes are not examined."""
     interval = path.trajectory.range
     feasible = [m for m in modes if m.status == FEASIBLE]
-    samples = gap_points(interval, [])
+    middle = gap_points(interval, [])
+    samples = [arb_to_fmpq(t) for t in middle + gap_points(interval, middle)]
     candidates, undecided, method, complete = [], [], "none", True
     for mode in feasible:
         try:
-            zeros = mode_zero_polynomial(path, mode.label, arb_to_fmpq(samples[0]))
+            zeros = _mode_zeros(path, mode, samples)
         except NotExact as why:
             candidates.append(_on_surface_candidate(path, mode, UNKNOWN, str(why)))
             continue
@@ -357,6 +358,21 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
         reason += " (the path lies on ξ(X) = 0: each mode was decided on its own)"
     return TrajectoryReport(path, verdict, reason, candidates, modes, method, undecided,
                             complete)
+
+
+def _mode_zeros(path: PathModel, mode: WorkingMode, samples: list):
+    """:func:`.exact.mode_zero_polynomial` at the first sample time where ball arithmetic
+    tells a mode from its conjugate (a sample may happen to be a zero of the non-vanishing
+    one)."""
+    why = None
+    for t0 in samples:
+        try:
+            return mode_zero_polynomial(path, mode.label, t0)
+        except NotExact as e:
+            why = e
+            if "conjugate" not in str(e):
+                break
+    raise why
 
 
 def _on_surface_candidate(path, mode, status, proof) -> Candidate:

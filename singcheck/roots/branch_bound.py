@@ -6,6 +6,10 @@ strictly monotone (the one-dimensional interval-Newton uniqueness condition), so
 proven sign change at its ends proves exactly one root there and equal signs prove
 none; a root met exactly at a box end is kept.  Boxes that stay ambiguous down to the
 minimum width become :class:`~singcheck.roots.Undecided`, with the reason.
+
+F may also be a path polynomial with angle functions cos g(t), sin g(t) (a pose angle
+that is not k·t + qπ): it is enclosed with the ball of g over the box, and F' comes from
+:func:`~singcheck.algebra.radicals.path_derivative` (the chain rule through g).
 """
 
 from __future__ import annotations
@@ -13,7 +17,9 @@ from __future__ import annotations
 from flint import arb, fmpq, fmpq_mpoly
 
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
-from singcheck.algebra.trig import TimeRange, derivative, evaluate_trig
+from singcheck.algebra.radicals import evaluate_path as evaluate_trig
+from singcheck.algebra.radicals import path_derivative as derivative
+from singcheck.algebra.trig import TimeRange
 from singcheck.budget import checkpoint
 from singcheck.roots.enclosures import (
     BRANCH_AND_BOUND,

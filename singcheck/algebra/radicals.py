@@ -426,16 +426,18 @@ def _extra_balls(ctx: fmpq_mpoly_ctx, t: arb, signs) -> list:
     return out
 
 
-def evaluate_path(p: fmpq_mpoly, t: arb, signs: dict[int, int] | None = None) -> arb:
+def evaluate_path(p: fmpq_mpoly, t: arb, signs: dict[int, int] | None = None,
+                  tight: bool = False) -> arb:
     """Rigorous enclosure of a path polynomial (in a :func:`path_ring`) for every t in
     the ball ``t``, each ``sqrt(q)`` at its value √q (or -√q where ``signs[q] = -1``) and
-    each angle function's cos/sin at the ball of its angle over ``t``."""
+    each angle function's cos/sin at the ball of its angle over ``t``; ``tight`` as for
+    :func:`~singcheck.algebra.trig.evaluate_trig`."""
     if p.context() is TRIG:
-        return evaluate_trig(p, t)
+        return evaluate_trig(p, t, tight)
     values = _extra_balls(p.context(), t, signs)
     total = arb(0)
     for exps, part in _parts(p):
-        term = evaluate_trig(part, t)
+        term = evaluate_trig(part, t, tight)
         for v, e in zip(values, exps, strict=True):
             if e:
                 term *= v ** e

@@ -200,3 +200,14 @@ def test_five_bar_singularity_surface_is_the_distal_links_aligned(robots):
     ours = sympy.Poly(sympy.sympify(str(xi).replace("^", "**")), x, y)
     ratio = sympy.cancel(ours.as_expr() / closed.as_expr())
     assert ratio.is_number and ratio != 0, ratio
+
+
+def test_the_gough_stewart_yaml_is_what_its_generator_writes():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "generate_gough_stewart", ROBOTS / "generate_gough_stewart.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert (ROBOTS / "gough-stewart.yaml").read_text(encoding="utf-8") == module.document()
+    assert module.BASE == oracles.GS_BASE and module.PLATFORM == oracles.GS_PLATFORM

@@ -24,15 +24,17 @@ Whatever cannot be proven makes the branch ``unknown``, with the reason.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from itertools import product
 
 from flint import arb
 
-from singcheck.algebra.intervals import fraction_ball, working_precision
-from singcheck.algebra.trig import TimeRange, evaluate_trig
+from singcheck.algebra.intervals import working_precision
+from singcheck.algebra.radicals import evaluate_path
+from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
 from singcheck.budget import checkpoint
-from singcheck.certify.path import LegAlongPath, PathModel
+from singcheck.certify.path import LegAlongPath, PathModel, joint_float
 from singcheck.roots.enclosures import IdenticallyZeroError, RootIsolation
 from singcheck.roots.isolation import isolate_real_roots
 
@@ -88,7 +90,13 @@ def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | Non
 
 
 _PIECES = 8
-_BUDGET = 64  # ball evaluations spent before falling back to a root isolation
+_BUDGET = 64  # ball evaluations per 2π of range spent before falling back to a root isolation
+
+
+def _budget(interval: TimeRange) -> int:
+    """The evaluation budget grows with the range: a longer path needs more pieces."""
+    periods = (float(interval.end) - float(interval.start)) / (2 * math.pi)
+    return max(_BUDGET, math.ceil(_BUDGET * periods))
 
 
 def _pieces(interval: TimeRange) -> list[arb]:
@@ -100,26 +108,60 @@ def _pieces(interval: TimeRange) -> list[arb]:
     return [a.union(b) for a, b in zip(edges, edges[1:], strict=False)]
 
 
+_TIGHT_ABOVE = 0.05  # radius above which a failed piece is retried with tight enclosures
+_TIGHT_DEGREE = 10  # ... when the leg's polynomials have at least this degree in (s, c)
+
+
+def _high_degree(leg: LegAlongPath) -> bool:
+    """Whether Horner in cos t is likely to overestimate badly on wide pieces."""
+    return max(p.degrees()[1] + p.degrees()[2] for p in _leg_polys(leg)
+               if p is not None) >= _TIGHT_DEGREE
+
+
+def _leg_polys(leg: LegAlongPath):
+    return (*leg.coefficients, leg.discriminant)
+
+
+def one_period(interval: TimeRange, polys) -> TimeRange:
+    """The part of the range a quick proof about ``polys`` needs to cover.
+
+    Trig polynomials free of the bare t are 2π-periodic, so over a range longer than 2π
+    they take no value that they do not take on its first 2π: proving a property of
+    their values on [start, start + 2π] proves it on the whole range.
+    """
+    start, end = interval.start, interval.end
+    if any(uses_t(p) for p in polys if p is not None) or \
+            float(end) - float(start) <= 2 * math.pi + 1e-9:
+        return interval
+    return TimeRange(start, LinearInPi(start.rational, start.pi_coefficient + 2))
+
+
 def _halves(piece: arb) -> tuple[arb, arb]:
     lo, hi = piece.lower(), piece.upper()
     mid = piece.mid()
     return lo.union(mid), mid.union(hi)
 
 
-def _everywhere(predicate, interval: TimeRange) -> bool:
-    """True when ``predicate(ball)`` is proven on balls covering the whole range: a
-    quick proof by ball arithmetic that spares a root isolation (False means "not
-    proven").  A piece where it fails is halved (ball enclosures tighten as pieces
-    shrink) until a budget of evaluations is spent."""
+def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True) -> bool:
+    """True when ``predicate(ball, tight)`` is proven on balls covering the whole range:
+    a quick proof by ball arithmetic that spares a root isolation (False means "not
+    proven").  A wide piece where it fails is tried again with ``tight`` enclosures
+    (when ``retry_tight``); a piece where it still fails is halved (ball enclosures
+    tighten as pieces shrink) until a budget of evaluations is spent."""
     todo = _pieces(interval)
+    budget = _budget(interval)
     spent = 0
     while todo:
         piece = todo.pop()
         checkpoint()
         spent += 1
-        if predicate(piece):
+        if predicate(piece, False):
             continue
-        if spent + len(todo) + 2 > _BUDGET:
+        if retry_tight and piece.rad() > _TIGHT_ABOVE:
+            spent += 1
+            if predicate(piece, True):
+                continue
+        if spent + len(todo) + 2 > budget:
             return False
         todo += _halves(piece)
     return True
@@ -129,7 +171,8 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when)
     """Status of both branches of a quadratic leg with respect to step 1 (``when``
     writes a time ball in the user's parameter)."""
     joint = leg.leg.joint
-    if _everywhere(lambda t: evaluate_trig(leg.discriminant, t) > 0, interval):
+    if _everywhere(lambda t, tight: evaluate_path(leg.discriminant, t, tight=tight) > 0,
+                   one_period(interval, _leg_polys(leg)), _high_degree(leg)):
         return FEASIBLE, "", None
     iso = _isolate(leg.discriminant, interval, tolerance)
     if iso is None:
@@ -140,28 +183,18 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when)
         return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {when(t)} " \
             "(serial singularity: the path reaches the workspace boundary)", t
     for box in iso.undecided:
-        if not evaluate_trig(leg.discriminant, box.t) > 0:
+        if not evaluate_path(leg.discriminant, box.t) > 0:
             return UNKNOWN, f"could not prove that the branches of {joint} stay apart: " \
                 f"{box.reason}", box.t
     for prec in _PRECISIONS:
         with working_precision(prec):
-            d = evaluate_trig(leg.discriminant, interval.start.ball())
+            d = evaluate_path(leg.discriminant, interval.start.ball())
         if d > 0:
             return FEASIBLE, "", None
         if d < 0:
             return INFEASIBLE, f"{joint} has no real solution along the path " \
                 "(outside the workspace)", None
     return UNKNOWN, f"the sign of the discriminant of {joint} could not be decided", None
-
-
-def _inside(value, lo, hi) -> bool | None:
-    if value is None:
-        return None
-    if value > lo and value < hi:
-        return True
-    if value < lo or value > hi:
-        return False
-    return None
 
 
 def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
@@ -171,12 +204,12 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
     ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
     the leg equals it (one polynomial serves both branches)."""
     joint = leg.leg.joint
-    lo, hi = (fraction_ball(v) for v in limits)
     bounds = f"[{limits[0]}, {limits[1]}]"
-    if _inside(leg.branches(interval.start.ball())[label], lo, hi) is False:
+    if leg.inside(leg.branches(interval.start.ball())[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
                                  f"{joint} is outside {bounds} from the start")
-    if _everywhere(lambda t: _inside(leg.branches(t)[label], lo, hi) is True, interval):
+    if _everywhere(lambda t, tight: leg.inside(leg.branches(t, tight)[label], limits) is True,
+                   one_period(interval, _leg_polys(leg)), _high_degree(leg)):
         return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
     undecided = []
@@ -190,7 +223,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
     for box in undecided:
-        if _inside(leg.branches(box.t)[label], lo, hi) is not True:
+        if leg.inside(leg.branches(box.t)[label], limits) is not True:
             return BranchFeasibility(joint, label, UNKNOWN,
                                      f"limit crossing of {joint} not decided: {box.reason}")
     events += [box.t for box in undecided]
@@ -198,7 +231,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         verdict = None
         for prec in _PRECISIONS:
             with working_precision(prec):
-                verdict = _inside(leg.branches(point)[label], lo, hi)
+                verdict = leg.inside(leg.branches(point)[label], limits)
             if verdict is not None:
                 break
         if verdict is None:
@@ -225,7 +258,7 @@ def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibili
     out = []
     for leg in path.legs:
         joint = leg.leg.joint
-        if leg.leg.degree == 2:
+        if leg.discriminant is not None:
             status, reason, event = _leg_reality(leg, interval, tolerance, when)
         else:
             status, reason, event = FEASIBLE, "", None
@@ -248,8 +281,7 @@ def _start_values(path: PathModel) -> list[dict[str, float | None]]:
     out = []
     for leg in path.legs:
         values = leg.branches(start)
-        out.append({label: (float(v.mid()) if isinstance(v, arb) else None)
-                    for label, v in values.items()})
+        out.append({label: joint_float(v) for label, v in values.items()})
     return out
 
 

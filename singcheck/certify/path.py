@@ -271,6 +271,12 @@ def _primes_of(*polys) -> set[int]:
     return out
 
 
+def _free_of_radicals(p: fmpq_mpoly) -> bool:
+    """``p`` (in a path ring) involves no ``sqrt(q)`` variable: it lives in Q[t, s, c]."""
+    names = p.context().names()
+    return all(p.degrees()[i] <= 0 for i, v in enumerate(names) if v not in ("t", "s", "c"))
+
+
 def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
                          where: dict | None = None) -> fmpq_mpoly:
     """μ(t) without ξ(X): substitute X = φ(t) first, then eliminate the joints.
@@ -286,7 +292,9 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
     one parameter (and s, c) are formed, never ξ(X) in every pose variable.  A path with
     square roots of its own is refused (they would be conjugated with the robot's).
     """
-    if any(x.context() is not TRIG for x in coordinates):
+    if all(_free_of_radicals(x) for x in coordinates):
+        coordinates = tuple(restrict(x, TRIG) for x in coordinates)
+    else:
         raise UnsupportedRobotError(
             "ξ(X) was not expanded and this path has square roots of its own (sqrt, or an "
             "angle offset like pi/6): eliminating along it is not supported yet",

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
+from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.intervals import evaluate, fraction_ball
 from singcheck.algebra.polynomials import restrict
@@ -164,6 +164,22 @@ def branch_values(leg: Leg, values: list, d) -> dict:
     return {"+": None, "-": None}
 
 
+_LIMIT_BALLS: dict = {}
+
+
+def _limit_balls(limits) -> tuple[arb, arb]:
+    """The balls of a prismatic joint's rational limits (exact when dyadic), once per
+    limits and working precision: feasibility proofs compare against them thousands of
+    times."""
+    key = (tuple(limits), ctx.prec)
+    hit = _LIMIT_BALLS.get(key)
+    if hit is None:
+        if len(_LIMIT_BALLS) > 256:
+            _LIMIT_BALLS.clear()
+        hit = _LIMIT_BALLS[key] = tuple(fraction_ball(v) for v in limits)
+    return hit
+
+
 def inside_limits(leg: Leg, value, limits) -> bool | None:
     """Strictly inside (True), outside (False) or undecided (None).  For an angle θ and
     limits [lo, hi] of width w < 2π with middle m: θ is inside (mod 2π) exactly when
@@ -180,7 +196,7 @@ def inside_limits(leg: Leg, value, limits) -> bool | None:
         mid = (lo + hi) / 2
         margin = value[0] * mid.cos() + value[1] * mid.sin() - (width / 2).cos()
         return True if margin > 0 else False if margin < 0 else None
-    lo, hi = (fraction_ball(v) for v in limits)
+    lo, hi = _limit_balls(limits)
     if value > lo and value < hi:
         return True
     if value < lo or value > hi:
@@ -303,6 +319,20 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
     return reduce_trig(restrict(norm_chain(det_a, legs), TRIG))
 
 
+_LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}
+
+
+def _leg_coefficients(leg: Leg) -> tuple[fmpq_mpoly, ...]:
+    """:func:`~singcheck.model.robot.leg_coefficients`, once per leg of a model (the same
+    legs serve every path of a batch); the entry keeps the leg, so its id is not reused."""
+    hit = _LEG_COEFFICIENTS.get(id(leg))
+    if hit is None or hit[0] is not leg:
+        if len(_LEG_COEFFICIENTS) > 256:
+            _LEG_COEFFICIENTS.clear()
+        hit = _LEG_COEFFICIENTS[id(leg)] = (leg, leg_coefficients(leg))
+    return hit[1]
+
+
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
     """The model along one piece (a multi-piece path: one per ``trajectory.pieces``)."""
     if trajectory.segments:
@@ -342,7 +372,8 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
         mu = eliminate_along_path(model, coordinates, where)
     legs = []
     for leg in model.legs:
-        coeffs = tuple(compose_pose(c, coordinates, pose_vars) for c in leg_coefficients(leg))
+        in_pose_coeffs = _leg_coefficients(leg)
+        coeffs = tuple(compose_pose(c, coordinates, pose_vars) for c in in_pose_coeffs)
         disc = leg_discriminant(leg, coeffs)
         limits = {}
         if leg.kind == REVOLUTE and leg.joint in spec.joint_limits:

@@ -79,6 +79,7 @@ class RationalRoot:
     hi: fmpq
     _balls: arb_poly | None = None
     _newton_polys: tuple | None = None  # (precision, f, f') as ball polynomials
+    _sign_lo: int | None = None  # the sign of f at lo (the same at every later lo < root)
 
     def width(self) -> fmpq:
         return self.hi - self.lo
@@ -107,20 +108,25 @@ class RationalRoot:
         too little) it is a bisection on exact signs.  Newton's quadratic convergence
         takes a root to 10⁻⁹ in a handful of steps instead of some thirty bisections.
         """
-        f = self.poly
-        slo = _qsign(f(self.lo))
-        if slo == 0:
-            self.hi = self.lo
+        if self.hi - self.lo <= width:
             return
-        if _qsign(f(self.hi)) == 0:
-            self.lo = self.hi
-            return
+        slo = self._sign_lo
+        if slo is None:  # first refinement: are the ends roots themselves?
+            slo = self.sign_at(self.lo)
+            if slo == 0:
+                self.hi = self.lo
+                return
+            if self.sign_at(self.hi) == 0:
+                self.lo = self.hi
+                return
+            self._sign_lo = slo
         retry_below = self.hi - self.lo  # after a failed Newton step, bisect 4 times first
         while self.hi - self.lo > width:
             if self.hi - self.lo <= retry_below:
                 if self._newton_step(width):
-                    slo = self.sign_at(self.lo)
-                    if slo == 0:
+                    # f is monotone on the old interval, which held the one root: the
+                    # new ends keep their signs unless one is the root itself
+                    if self.sign_at(self.lo) == 0:
                         self.hi = self.lo
                         return
                     if self.sign_at(self.hi) == 0:

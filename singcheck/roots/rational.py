@@ -255,12 +255,17 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     """
     cs = [int(c) for c in f.coeffs()]
     n = len(cs) - 1
-    # Fujiwara: every root has |z| <= 2 max |a_i / a_n|^(1/(n-i)); bounded with bit
-    # lengths (|a| < 2^bitlen), plus one more bit so that every root is < 2^b strictly.
-    top = abs(cs[-1]).bit_length() - 1  # 2^top <= |a_n|
-    b = 2 + max((-(-(abs(c).bit_length() - top) // (n - i)) for i, c in enumerate(cs[:-1])
-                 if c), default=0)
-    b = max(b, 1)
+    if cs[-1] < 0:
+        cs = [-c for c in cs]
+    # Cauchy's bound for the positive roots: with a_n > 0 and λ negative coefficients,
+    # every positive root x has x^(n-i) <= λ|a_i|/a_n for some a_i < 0 (otherwise a_n x^n
+    # outweighs every negative term).  Bounded with bit lengths (|a| < 2^bitlen,
+    # a_n >= 2^(bitlen-1)), so every positive root is < 2^b strictly.
+    negative = [(i, c) for i, c in enumerate(cs[:-1]) if c < 0]
+    if not negative:
+        return []  # no sign variation: no positive root (Descartes)
+    spare = len(negative).bit_length() + 1 - cs[-1].bit_length()
+    b = max(0, max(-(-(spare + (-c).bit_length()) // (n - i)) for i, c in negative))
     g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)])  # g(x) = f(2^b x)
     out: list[tuple[int, int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
     stack = [(g, 0, 0)]

@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from fractions import Fraction
 
-from flint import arb, arb_poly, fmpq, fmpq_poly, fmpz_poly
+from flint import arb, arb_poly, ctx, fmpq, fmpq_poly, fmpz_poly
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.budget import checkpoint
@@ -101,7 +101,13 @@ class RationalRoot:
     def bisect_to(self, width: fmpq) -> None:
         """Shrink [lo, hi] to ``width`` or less, keeping the root inside.
 
-        Each step is an interval Newton step when it halves the interval at least:
+        First a guess is verified: Newton's iteration from the midpoint, in plain
+        (unproven) ball midpoints, proposes the root; a short dyadic interval of the
+        width asked for around it is accepted only when the exact signs of f at its ends
+        differ and it lies inside [lo, hi] (which holds exactly one root): then the root
+        is in it.  Otherwise, step by step:
+
+        each step is an interval Newton step when it halves the interval at least:
         where the ball of f' over [lo, hi] excludes 0, f is monotone there and the root
         lies in m - f(m)/f'([lo, hi]) (mean value theorem; m the midpoint), intersected
         with [lo, hi] and rounded outward to rationals.  Otherwise (or when Newton gains
@@ -120,6 +126,8 @@ class RationalRoot:
                 self.lo = self.hi
                 return
             self._sign_lo = slo
+        if self._guess_and_verify(width, slo):
+            return
         retry_below = self.hi - self.lo  # after a failed Newton step, bisect 4 times first
         while self.hi - self.lo > width:
             if self.hi - self.lo <= retry_below:
@@ -144,6 +152,61 @@ class RationalRoot:
             else:
                 self.hi = mid
 
+    def _guess_and_verify(self, target: fmpq, slo: int) -> bool:
+        """Narrow [lo, hi] to about ``target`` around Newton's guess when exact signs
+        confirm it (see :meth:`bisect_to`); False, with nothing changed, otherwise."""
+        w = float(target)
+        if not w > 0 or not math.isfinite(w):
+            return False
+        bits = max(128, 2 * int(-math.log2(w)) + 64)
+        old = ctx.prec
+        ctx.prec = bits
+        try:
+            value, slope_poly = self._ball_polys(bits)
+            a, b = arb(self.lo), arb(self.hi)  # a bracket: f has sign slo at a, -slo at b
+            x = ((a + b) / 2).mid()
+            for _ in range(200):  # safeguarded Newton (unproven guesses, checked below)
+                fx = value(x).mid()
+                if (fx > 0) == (slo > 0):
+                    a = x
+                else:
+                    b = x
+                slope = slope_poly(x).mid()
+                guess = (x - fx / slope).mid() if slope != 0 else a
+                if not (guess > a and guess < b):
+                    guess = ((a + b) / 2).mid()
+                step = abs(guess - x)
+                x = guess
+                if step < w / 16 or b - a < w / 16:
+                    break
+            else:
+                return False
+            centre = arb_to_fmpq(x)
+        finally:
+            ctx.prec = old
+        a, b = _short_dyadic_hull(centre - target / 4, centre + target / 4, target)
+        if not (self.lo < a < b < self.hi):
+            return False
+        sa, sb = self.sign_at(a), self.sign_at(b)
+        if sa == 0:
+            self.lo = self.hi = a
+            return True
+        if sb == 0:
+            self.lo = self.hi = b
+            return True
+        if sa != slo or sb != -slo:
+            return False
+        self.lo, self.hi = a, b
+        return True
+
+    def _ball_polys(self, bits: int) -> tuple[arb_poly, arb_poly]:
+        """f and f' as ball polynomials at ``bits`` of precision (memoised)."""
+        if self._newton_polys is None or self._newton_polys[0] != bits:
+            coeffs = [arb(c) for c in self.poly.coeffs()]
+            value = arb_poly(coeffs)
+            self._newton_polys = (bits, value, value.derivative())
+        return self._newton_polys[1], self._newton_polys[2]
+
     def _newton_step(self, target: fmpq) -> bool:
         """One interval Newton step on [lo, hi]; False (nothing changed) when f' may
         vanish there or the step would not halve the interval.  The new ends are
@@ -156,11 +219,7 @@ class RationalRoot:
             return False
         bits = max(128, int(-math.log2(w)) * 2 + 64)
         with working_precision(bits):
-            if self._newton_polys is None or self._newton_polys[0] != bits:
-                coeffs = [arb(c) for c in self.poly.coeffs()]
-                value = arb_poly(coeffs)
-                self._newton_polys = (bits, value, value.derivative())
-            _, value, slope_poly = self._newton_polys
+            value, slope_poly = self._ball_polys(bits)
             box = arb(self.lo).union(arb(self.hi))
             slope = slope_poly(box)
             if slope.contains(0):

@@ -164,6 +164,27 @@ def branch_values(leg: Leg, values: list, d) -> dict:
     return {"+": None, "-": None}
 
 
+_DET_A_SPLITS: dict[int, tuple] = {}
+
+
+def _det_a_by_joints(model: RobotModel) -> list[tuple[tuple[tuple[int, int], ...], fmpq_mpoly]]:
+    """det A as [(α, q_α)]: α the exponents of the joint variables (sparse pairs), q_α
+    the polynomial in the other variables; once per model."""
+    hit = _DET_A_SPLITS.get(id(model))
+    if hit is None or hit[0] is not model:
+        n_joint = len(model.joint_variables)
+        groups: dict[tuple[int, ...], dict] = {}
+        for exps, coeff in model.det_A.terms():
+            rest = (0,) * n_joint + tuple(exps[n_joint:])
+            groups.setdefault(tuple(exps[:n_joint]), {})[rest] = coeff
+        split = [(tuple((v, e) for v, e in enumerate(alpha) if e),
+                  model.context.from_dict(terms)) for alpha, terms in groups.items()]
+        if len(_DET_A_SPLITS) > 64:
+            _DET_A_SPLITS.clear()
+        hit = _DET_A_SPLITS[id(model)] = (model, split)
+    return hit[1]
+
+
 _LIMIT_BALLS: dict = {}
 
 
@@ -239,6 +260,32 @@ class PathModel:
         point += list(pose)
         point += [b for _, b in sorted(radical_balls(model.context, signs).items())]
         return evaluate(model.det_A, point)
+
+    def det_A_modes(self, joints_by_mode: dict, pose: list[arb],
+                    signs: dict[int, int] | None = None) -> dict:
+        """:meth:`det_A` for several modes at the same pose in one pass: det A is written
+        once as Σ_α q_α(pose) ρ^α (ρ the joint variables), each q_α is enclosed once at
+        the pose, and each mode only sums its few joint monomials.  The same polynomial,
+        grouped differently: every enclosure is as rigorous as :meth:`det_A`'s."""
+        model = self.projection.model
+        split = _det_a_by_joints(model)
+        n_joint = len(model.joint_variables)
+        point = [arb(0)] * n_joint + list(pose)
+        point += [b for _, b in sorted(radical_balls(model.context, signs).items())]
+        factors = [evaluate(q, point) for _, q in split]
+        out = {}
+        for label, joints in joints_by_mode.items():
+            flat: list = []
+            for j in joints:
+                flat += list(j) if isinstance(j, tuple) else [j]
+            total = arb(0)
+            for (alpha, _), factor in zip(split, factors, strict=True):
+                term = factor
+                for v, e in alpha:
+                    term = term * (flat[v] if e == 1 else flat[v] ** e)
+                total = total + term
+            out[label] = total
+        return out
 
     def conjugate_branches(self, t: arb, pose: list[arb], signs: dict[int, int]):
         """Per leg, the branches of the conjugate robot (its square roots' signs flipped

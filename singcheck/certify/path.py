@@ -126,7 +126,12 @@ class LegAlongPath:
         conjugate where D < 0; where the sign of D is not proven both are None.  A
         revolute branch is the pair (cos θ, sin θ).  ``tight`` spends more on a wide
         ball (:func:`~singcheck.algebra.trig.evaluate_trig`)."""
-        values = [evaluate_path(c, t, tight=tight) for c in self.coefficients]
+        if self.leg.kind != REVOLUTE and self.leg.degree == 2:
+            # ρ = (-b ± √D)/(2a) needs a, b and D only: c is in D already
+            a, b = (evaluate_path(c, t, tight=tight) for c in self.coefficients[:2])
+            values = [a, b, None]
+        else:
+            values = [evaluate_path(c, t, tight=tight) for c in self.coefficients]
         d = evaluate_path(self.discriminant, t, tight=tight) \
             if self.discriminant is not None else None
         return branch_values(self.leg, values, d)

@@ -327,9 +327,7 @@ def _plot_all(machine, specs, tolerance: float, out_dir: str, progress) -> list:
         raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
                         "missing): pip install 'singcheck[plot]'") from None
     from singcheck import api
-    from singcheck.model.robot import require_polynomial
 
-    require_polynomial(machine.model, "plotting")
     written = []
     for spec in specs:
         report = api.check(machine, spec, tolerance=tolerance, regions=False)
@@ -347,9 +345,7 @@ def _plot_html(machine, specs, out_dir: str):
         raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
                         "pip install 'singcheck[html]'") from None
     from singcheck import api
-    from singcheck.model.robot import require_polynomial
 
-    require_polynomial(machine.model, "plotting")
     reports = [api.check(machine, s, regions=False).certificate for s in specs]
     return write_html(reports, os.path.join(out_dir, "singcheck.html"))
 

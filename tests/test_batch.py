@@ -395,3 +395,22 @@ def test_the_dask_run_gives_the_local_verdicts(local_cluster, tmp_path, orthogli
     assert [t["name"] for t in json.loads(doc.stdout)["trajectories"]] == list(local)
     assert {t["name"]: t["verdict"] for t in json.loads(doc.stdout)["trajectories"]} == \
         {n: d["verdict"] for n, d in local.items()}
+
+
+def test_the_region_statement_is_bounded_by_the_time_limit():
+    """The helix's region needs the 3-D workspace decomposed (seconds, no cache here):
+    with a 0.5 s limit the certified verdict stands and the region statement is left out
+    with the reason, promptly."""
+    import time
+
+    import singcheck as sc
+
+    robot = sc.load_robot(ORTHO, backend="flint", cache=False)
+    helix = sc.load_trajectory(str(ROOT / "trajectories" / "helix.yaml"), robot)
+    start = time.monotonic()
+    report = sc.check(robot, helix, time_limit=0.5)
+    assert time.monotonic() - start < 3  # unbounded, the decomposition takes 5 s or more
+    assert report.verdict == "singularity-free"
+    doc = report.to_dict()
+    assert "workspace" not in doc
+    assert "time limit (0.5 s) reached while naming the workspace region" in doc["reason"]

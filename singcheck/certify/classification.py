@@ -34,6 +34,7 @@ from flint import acb, arb
 
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
 from singcheck.algebra.radicals import evaluate_path
+from singcheck.budget import checkpoint
 from singcheck.certify.path import PathModel, joint_float
 from singcheck.certify.working_modes import (
     FEASIBLE,
@@ -240,7 +241,10 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
         return TrajectoryReport(path, VERDICT_UNKNOWN,
                                 "the trajectory lies on the singularity surface ξ(X) = 0, so "
                                 "μ(t) ≡ 0 gives no candidates", [], modes, "none")
-    candidates = [classify_candidate(path, modes, r, tolerance) for r in isolation.roots]
+    candidates = []
+    for r in isolation.roots:  # hundreds for high-degree μ
+        checkpoint()
+        candidates.append(classify_candidate(path, modes, r, tolerance))
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
     undecided = [(b.t, b.reason) for b in isolation.undecided

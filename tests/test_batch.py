@@ -414,3 +414,14 @@ def test_the_region_statement_is_bounded_by_the_time_limit():
     doc = report.to_dict()
     assert "workspace" not in doc
     assert "time limit (0.5 s) reached while naming the workspace region" in doc["reason"]
+
+
+def test_the_api_reads_several_documents(orthoglide_robot, tmp_path):
+    import singcheck as sc
+
+    many = tmp_path / "many.yaml"
+    many.write_text(_stream("heart1", "heart2"))
+    specs = sc.load_trajectories([many], orthoglide_robot)
+    assert [s.name for s in specs] == ["heart1", "heart2"]
+    assert [sc.check(orthoglide_robot, s, regions=False).verdict for s in specs] == \
+        ["singular", "singularity-free"]

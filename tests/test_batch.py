@@ -297,10 +297,12 @@ def _generated(tmp_path, count: int) -> list[str]:
     return [str(p) for p in write(tmp_path / "paths", count)]
 
 
-@pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP"])
-def test_a_signal_mid_batch_leaves_valid_jsonl_lines(tmp_path, sig):
+@pytest.mark.parametrize("sig, group", [("SIGTERM", False), ("SIGHUP", False),
+                                        ("SIGINT", True)])
+def test_a_signal_mid_batch_leaves_valid_jsonl_lines(tmp_path, sig, group):
     """Stopped mid-batch (forked workers busy), singcheck exits 130; every line it wrote
-    is a whole JSON object, and no worker printed a traceback."""
+    is a whole JSON object, and no worker printed a traceback.  Ctrl-C reaches the whole
+    process group (``group``), workers included."""
     import os
     import signal
     import subprocess
@@ -312,10 +314,14 @@ def test_a_signal_mid_batch_leaves_valid_jsonl_lines(tmp_path, sig):
                              str(DATA / "slow.yaml"), "--format", "jsonl", "--jobs", "2",
                              "--backend", "flint", "--no-regions"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT,
-                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)})
+                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)},
+                            start_new_session=group)
     first = proc.stdout.readline()  # a result streamed: the batch is under way
     time.sleep(0.5)
-    proc.send_signal(getattr(signal, sig))
+    if group:
+        os.killpg(proc.pid, getattr(signal, sig))
+    else:
+        proc.send_signal(getattr(signal, sig))
     rest = proc.stdout.read()  # (communicate() would skip what readline buffered)
     err = proc.stderr.read()
     proc.wait(timeout=60)

@@ -174,6 +174,10 @@ class _Parser:
 
 
 def _exact_number(text: str, column: int) -> Fraction:
+    mantissa, _, exponent = text.lower().partition("e")
+    if exponent and abs(int(exponent)) > MAX_BITS // 4:  # 10^e would need ~3.3·e bits
+        raise ExprError(f"the number {text!r} is too large (exponent beyond "
+                        f"±{MAX_BITS // 4})", column)
     try:
         return Fraction(text)  # exact decimal: Fraction("0.1") == 1/10
     except (ValueError, ZeroDivisionError):

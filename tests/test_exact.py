@@ -306,3 +306,39 @@ def test_a_singular_pose_at_the_join_of_two_segments_is_decided_exactly(tmp_path
     [candidate] = report.candidates
     assert candidate.t.contains(0.5)
     assert set(candidate.singular_modes) == {"++", "--"}
+
+
+def test_exact_decisions_with_a_square_root_in_the_robot_agree_with_50_digits():
+    # the linear Delta's rails sit at (R, 0), (-R/2, ±√3/2·R): √3 is a level of the tower
+    from pathlib import Path
+
+    from singcheck.certify.exact import AlgebraicPoint, det_a_vanishes_at
+    from singcheck.spec.files import load_robot, load_trajectory
+
+    root = Path(__file__).resolve().parent.parent
+    model = build_model(load_robot(root / "robots/linear-delta.yaml"))
+    projection = project_robot(model, get_backend("flint"))
+    path = build_path(projection, load_trajectory(root / "trajectories/linear-delta-cross.yaml",
+                                                  model.spec))
+    report = certify_path(path)
+    mpmath.mp.dps = 50
+    rails = [(mpmath.mpf(1), mpmath.mpf(0)), (-mpmath.mpf(1) / 2, mpmath.sqrt(3) / 2),
+             (-mpmath.mpf(1) / 2, -mpmath.sqrt(3) / 2)]
+
+    def det_a(t, label):  # independent: x = -1/4 + t/2, y = -1/4, z = t/4, rods of 3/2
+        x, y, z = -mpmath.mpf(1) / 4 + t / 2, -mpmath.mpf(1) / 4, t / 4
+        rows = []
+        for (cx, cy), sign in zip(rails, label, strict=True):
+            d2 = (x - cx) ** 2 + (y - cy) ** 2
+            r = z + (1 if sign == "+" else -1) * mpmath.sqrt(mpmath.mpf(9) / 4 - d2)
+            rows.append([2 * (x - cx), 2 * (y - cy), 2 * (z - r)])
+        return mpmath.det(mpmath.matrix(rows))
+
+    assert report.candidates
+    for c in report.candidates:
+        point = AlgebraicPoint(c.root.exact)
+        t = mpmath.mpf(float(c.t.mid()))
+        for m in c.modes:
+            eps = mpmath.mpf("1e-7")
+            crosses = det_a(t - eps, m.mode) * det_a(t + eps, m.mode) < 0
+            assert det_a_vanishes_at(path, point, m.mode) == crosses, (float(t), m.mode)

@@ -47,6 +47,7 @@ from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 
 from singcheck.algebra.intervals import excludes_zero, working_precision
 from singcheck.algebra.polynomials import constant_value
+from singcheck.algebra.radicals import radical_prime
 from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig, uses_t, uses_trig
 from singcheck.budget import checkpoint
 from singcheck.certify.path import PathModel
@@ -67,30 +68,68 @@ class NotExact(Exception):
 # det A along the path as a multilinear polynomial in the square roots r_i
 
 
-class ModeExpression:
-    """E(r) = det A along the path, multilinear in one rᵢ per quadratic leg.
+def multilinear_product(a: dict, b: dict, D: list[dict], mul, is_zero) -> dict:
+    """The product of two multilinear elements (dicts mask → coefficient) reduced with
+    r_q² = D[q], where D[q] is itself an element of the levels below q."""
+    out: dict = {}
+    for ma, va in a.items():
+        for mb, vb in b.items():
+            checkpoint()
+            part = {ma ^ mb: mul(va, vb)}
+            common, q = ma & mb, 0
+            while common:
+                if common & 1:
+                    part = multilinear_product(part, D[q], D, mul, is_zero)
+                common >>= 1
+                q += 1
+            for m, v in part.items():
+                out[m] = out[m] + v if m in out else v
+    return {m: v for m, v in out.items() if not is_zero(v)}
 
-    ``terms`` maps a bit mask of r's to its trig-polynomial coefficient; ``D[q]`` is the
-    discriminant whose square root r_q is; ``legs[q]`` the leg index of r_q.
+
+def _trig_mul(a: fmpq_mpoly, b: fmpq_mpoly) -> fmpq_mpoly:
+    return reduce_trig(a * b)
+
+
+def _is_zero(a) -> bool:
+    return a.is_zero()
+
+
+class ModeExpression:
+    """E(r) = det A along the path, multilinear in its square roots: first one level per
+    prime p of the robot's or the path's numbers (√p, always the positive root), then one
+    rᵢ per quadratic leg (√Dᵢ, Dᵢ in the levels below: it may involve the √p).
+
+    ``terms`` maps a bit mask of levels to its trig-polynomial coefficient; ``D[q]`` is
+    the element (a dict of the same kind, levels below q) whose square root level q is;
+    ``fixed`` is the number of √p levels; ``legs[j]`` the leg index of r_j.
     """
 
     def __init__(self, path: PathModel) -> None:
         model = path.projection.model
         if any(leg.revolute for leg in path.legs):
             raise NotExact("exact decisions are not implemented for revolute legs yet")
-        if path.mu.context() is not TRIG or any(x.context() is not TRIG
-                                                for x in path.coordinates):
-            raise NotExact("exact decisions are not implemented for square roots among "
-                           "the robot's or the path's numbers yet")
+        ring_in = path.coordinates[0].context() if path.coordinates else TRIG
+        path_names = ring_in.names()
+        primes = [radical_prime(v) for v in path_names[3:]]
+        if tuple(path_names[:3]) != ("t", "s", "c") or None in primes:
+            raise NotExact("the path ring has variables other than t, sin t, cos t and "
+                           "square roots")
         quadratic = [i for i, leg in enumerate(path.legs) if leg.leg.degree == 2]
-        names = ("t", "s", "c", *(f"r{q}" for q in range(len(quadratic))))
+        names = (*path_names, *(f"r{q}" for q in range(len(quadratic))))
         ring = fmpq_mpoly_ctx.get(names, "lex")
         pad = (0,) * len(quadratic)
 
         def lift(p: fmpq_mpoly) -> fmpq_mpoly:
+            if p.context() is not ring_in:
+                p = ring_in.from_dict({(*e, *(0,) * len(primes)): c for e, c in p.terms()}) \
+                    if p.context() is TRIG else None
+                if p is None:
+                    raise NotExact("a polynomial of the path outside its ring")
             return ring.from_dict({(*e, *pad): c for e, c in p.terms()})
 
-        r = ring.gens()[3:]
+        gens = dict(zip(names, ring.gens(), strict=True))
+        r = ring.gens()[len(path_names):]
         joints = []
         for i, leg in enumerate(path.legs):
             if leg.leg.degree == 2:
@@ -102,30 +141,43 @@ class ModeExpression:
         images = dict(zip((leg.leg.joint for leg in path.legs), joints, strict=True))
         images.update(zip(model.pose_variables, (lift(x) for x in path.coordinates),
                           strict=True))
-        names = model.det_A.context().names()
-        if any(v not in images for v in names):
-            raise NotExact("det A involves variables other than the joints and the pose")
-        full = model.det_A.compose(*(images[v] for v in names), ctx=ring)
-        self.D = [path.legs[i].discriminant for i in quadratic]
+        images.update({v: gens[v] for v in path_names[3:]})
+        det_names = model.det_A.context().names()
+        if any(v not in images for v in det_names):
+            raise NotExact("det A involves variables other than the joints, the pose and "
+                           "square roots of the path's ring")
+        full = model.det_A.compose(*(images[v] for v in det_names), ctx=ring)
+        self.fixed = len(primes)
         self.legs = quadratic
-        by_r: dict[tuple[int, ...], dict] = {}
-        for exps, coeff in full.terms():
-            by_r.setdefault(tuple(exps[3:]), {})[tuple(exps[:3])] = coeff
-        terms: dict[int, fmpq_mpoly] = {}
-        for r_exps, trig_terms in by_r.items():
+        self.D: list[dict] = [{0: TRIG.from_dict({(0, 0, 0): p})} for p in primes]
+        for i in quadratic:
+            self.D.append(self._split(lift(path.legs[i].discriminant)))
+        self.terms = self._split(full)
+
+    def _split(self, p: fmpq_mpoly) -> dict:
+        """A polynomial in t, s, c and the levels as a multilinear element (reduced with
+        level² = D)."""
+        by_levels: dict[tuple[int, ...], dict] = {}
+        for exps, coeff in p.terms():
+            by_levels.setdefault(tuple(exps[3:]), {})[tuple(exps[:3])] = coeff
+        out: dict = {}
+        for level_exps, trig_terms in by_levels.items():
             checkpoint()
-            value = TRIG.from_dict(trig_terms)
-            mask = 0
-            for q, e in enumerate(r_exps):
-                mask |= (e % 2) << q
+            value = {0: reduce_trig(TRIG.from_dict(trig_terms))}
+            for q, e in enumerate(level_exps):
+                factor = {(e % 2) << q: TRIG.from_dict({(0, 0, 0): 1})}
                 for _ in range(e // 2):
-                    value = value * self.D[q]
-            terms[mask] = terms.get(mask, TRIG.from_dict({})) + value
-        self.terms = {m: reduce_trig(v) for m, v in terms.items() if not v.is_zero()}
+                    factor = multilinear_product(factor, self.D[q], self.D, _trig_mul,
+                                                 _is_zero)
+                if e:
+                    value = multilinear_product(value, factor, self.D, _trig_mul, _is_zero)
+            for m, v in value.items():
+                out[m] = out[m] + v if m in out else v
+        return {m: v for m, v in out.items() if not v.is_zero()}
 
     def signs(self, label: str) -> list[int]:
-        """σ_q for a working mode label (one character per leg)."""
-        return [1 if label[i] == "+" else -1 for i in self.legs]
+        """σ per level for a working mode label: + for every √p, then the mode's signs."""
+        return [1] * self.fixed + [1 if label[i] == "+" else -1 for i in self.legs]
 
 
 _EXPRESSIONS: dict[int, tuple[PathModel, ModeExpression]] = {}
@@ -263,29 +315,18 @@ class _Tower:
     def __init__(self, expr: ModeExpression, base, signs: list[int]) -> None:
         self.base = base
         self.signs = signs
-        self.D = [base.of(d) for d in expr.D]
-        self.D_zero = [base.is_zero(d) for d in self.D]
-        self.E = {m: base.of(v) for m, v in expr.terms.items()}
-        self.E = {m: v for m, v in self.E.items() if not base.is_zero(v)}
+        self.D = [self._of(d) for d in expr.D]
+        self.E = self._of(expr.terms)
+        self.D_zero: list[bool] = []
+        for q, d in enumerate(self.D):  # level by level: each test uses the levels below
+            self.D_zero.append(self.reduce(d, q) is None)
 
-    # multilinear arithmetic (dicts mask → base element)
+    def _of(self, element: dict) -> dict:
+        out = {m: self.base.of(v) for m, v in element.items()}
+        return {m: v for m, v in out.items() if not self.base.is_zero(v)}
+
     def _mul(self, a: dict, b: dict) -> dict:
-        out: dict = {}
-        base = self.base
-        for ma, va in a.items():
-            for mb, vb in b.items():
-                checkpoint()
-                v = base.mul(va, vb)
-                common = ma & mb
-                q = 0
-                while common:
-                    if common & 1:
-                        v = base.mul(v, self.D[q])
-                    common >>= 1
-                    q += 1
-                m = ma ^ mb
-                out[m] = out[m] + v if m in out else v
-        return {m: v for m, v in out.items() if not base.is_zero(v)}
+        return multilinear_product(a, b, self.D, self.base.mul, self.base.is_zero)
 
     def _sub(self, a: dict, b: dict) -> dict:
         out = dict(a)
@@ -295,7 +336,7 @@ class _Tower:
 
     def reduce(self, e: dict | None = None, k: int | None = None):
         """None when the element (at this mode's signs) is exactly 0; otherwise a non-zero
-        base element whose zeros hold the element's (for the path field) / True."""
+        base element whose zeros hold the element's (for the path field)."""
         e = self.E if e is None else e
         k = len(self.D) if k is None else k
         checkpoint()
@@ -307,8 +348,7 @@ class _Tower:
         y = {m ^ bit: v for m, v in e.items() if m & bit}
         if not y or self.D_zero[k - 1] or self.reduce(y, k - 1) is None:
             return self.reduce(x, k - 1)
-        d = {0: self.D[k - 1]}
-        norm = self._sub(self._mul(x, x), self._mul(self._mul(y, y), d))
+        norm = self._sub(self._mul(x, x), self._mul(self._mul(y, y), self.D[k - 1]))
         found = self.reduce(norm, k - 1)
         if found is not None:
             return found
@@ -318,7 +358,7 @@ class _Tower:
         return self.reduce(x, k - 1)  # Ē = 0, so E = 2x ≠ 0
 
     def _which_vanishes(self, e: dict, k: int) -> bool:
-        """True when E is the zero one of {E, Ē} (flipping σ_k), decided by balls."""
+        """True when E is the zero one of {E, Ē} (flipping level k), decided by balls."""
         bits = 64
         while bits <= _MAX_BITS:
             checkpoint()
@@ -332,21 +372,7 @@ class _Tower:
             bits *= 2
         raise NotExact("ball arithmetic did not separate a mode from its conjugate")
 
-    def _ball(self, e: dict, k: int, flip: int | None):
-        bits = int(working_bits())
-        roots = []
-        for q in range(k):
-            if self.D_zero[q]:
-                roots.append(arb(0))
-                continue
-            d = self.base.ball(self.D[q], bits)
-            sigma = -self.signs[q] if q == flip else self.signs[q]
-            if d > 0:
-                roots.append(sigma * d.sqrt())
-            elif d < 0:
-                roots.append(acb(0, sigma * (-d).sqrt()))
-            else:
-                return None
+    def _value(self, e: dict, roots: list, bits: int):
         total = arb(0)
         for m, v in e.items():
             term = self.base.ball(v, bits)
@@ -358,6 +384,25 @@ class _Tower:
                 q += 1
             total = total + term
         return total
+
+    def _ball(self, e: dict, k: int, flip: int | None):
+        bits = int(working_bits())
+        roots: list = []
+        for q in range(k):
+            if self.D_zero[q]:
+                roots.append(arb(0))
+                continue
+            d = self._value(self.D[q], roots, bits)
+            if not isinstance(d, arb):
+                return None
+            sigma = -self.signs[q] if q == flip else self.signs[q]
+            if d > 0:
+                roots.append(sigma * d.sqrt())
+            elif d < 0:
+                roots.append(acb(0, sigma * (-d).sqrt()))
+            else:
+                return None
+        return self._value(e, roots, bits)
 
 
 def working_bits() -> int:

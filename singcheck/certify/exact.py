@@ -7,7 +7,9 @@ several modes vanishing at one time are singular.  This module decides those exa
 
 **det A along a mode.**  Each quadratic leg's joint is ρᵢ = (-bᵢ + rᵢ)/(2aᵢ) with
 rᵢ² = Dᵢ (its discriminant along the path) and aᵢ constant; a linear leg's joint is
--cᵢ/bᵢ.  Substituting into det A and reducing rᵢ² → Dᵢ gives one polynomial E(r),
+-cᵢ/bᵢ.  (Square roots √p among the robot's or the path's numbers come first, as levels
+with D = p and the positive sign.)  Substituting into det A and reducing rᵢ² → Dᵢ gives
+one polynomial E(r),
 multilinear in the r's, whose coefficients are trig polynomials in t, sin t, cos t.  A
 working mode picks rᵢ = σᵢ·√Dᵢ (σᵢ = ±1 from its label; i·√-Dᵢ where Dᵢ < 0, the
 convention of :meth:`~singcheck.certify.path.LegAlongPath.branches`).
@@ -60,8 +62,9 @@ _MAX_BITS = 1 << 16
 
 
 class NotExact(Exception):
-    """The root's time is not an algebraic number this module can compute with (a path
-    mixing t with sin t, at a time other than 0)."""
+    """The exact step does not apply (a path mixing t with sin t at a time other than a
+    multiple of π, which is transcendental; revolute legs), or ball arithmetic could not
+    separate a mode from its conjugate within the precision cap."""
 
 
 # ---------------------------------------------------------------------------------

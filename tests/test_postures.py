@@ -118,6 +118,12 @@ def test_the_posture_figure_is_written_with_one_panel_per_posture(case, tmp_path
     titles = [ax.get_title() for ax in fig.axes]
     assert titles[0].startswith("start · t = -3.141593 · mode")
     assert all(t.startswith("singular · t = ") for t in titles[1:])
+    if report.path.projection.model.spec.drawing_dimension == 3:  # the legs' common plane
+        from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+        shaded = [any(isinstance(c, Poly3DCollection) for c in ax.collections)
+                  for ax in fig.axes]
+        assert shaded == [False] + [True] * (len(titles) - 1)
     plt.close(fig)
     files = write_figures(report, tmp_path, ("png",), dpi=40)
     assert tmp_path / f"{traj_name}-postures.png" in files

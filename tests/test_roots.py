@@ -165,15 +165,15 @@ def _random_trig(rng, degree: int, with_t: bool = False):
     return reduce_trig(p)
 
 
-def test_half_angle_polynomial_is_the_substitution():
+def testhalf_angle_polynomial_is_the_substitution():
     import random
 
-    from singcheck.roots.half_angle import _half_angle_polynomial
+    from singcheck.roots.half_angle import half_angle_polynomial
 
     rng = random.Random(5)
     for _ in range(20):
         p = _random_trig(rng, 7)
-        m, d = _half_angle_polynomial(p)
+        m, d = half_angle_polynomial(p)
         for u in (fmpq(0), fmpq(3, 7), fmpq(-5, 2), fmpq(1)):
             w = 1 + u * u
             direct = p.subs({"s": 2 * u / w, "c": (1 - u * u) / w}).subs({"t": 0})

@@ -185,6 +185,30 @@ def drawing_box(drawings: list[list[DrawnBody]], traces: list[np.ndarray]) -> np
     return np.stack([centre - half, centre + half], axis=1)
 
 
+def _shade_common_plane(ax, bodies: list[DrawnBody]) -> None:
+    """When every moving point of a 3-D posture lies in one plane (the Orthoglide's legs
+    at a parallel singularity), shade their convex hull in that plane (drawing only)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = [b.points for b in bodies if not b.fixed] + \
+        [c for b in bodies if not b.fixed for c in b.chains]
+    pts = np.unique(np.round(np.concatenate([q for q in pts if len(q)]), 12), axis=0)
+    if len(pts) < 4:
+        return
+    centre = pts.mean(axis=0)
+    _, sv, basis = np.linalg.svd(pts - centre)
+    if sv[2] > 1e-6 * sv[0]:
+        return  # not coplanar
+    flat = (pts - centre) @ basis[:2].T
+    try:
+        hull = ConvexHull(flat)
+    except QhullError:
+        return
+    ax.add_collection3d(Poly3DCollection([pts[hull.vertices]], facecolor=_SINGULAR,
+                                         alpha=0.12, edgecolor=_SINGULAR, linewidth=0.6))
+
+
 def posture_figure(plt, report: TrajectoryReport, title: str, samples: int = 600):
     """One panel per posture: the bodies, the traced path, the posture's point on it."""
     posts = postures(report)
@@ -205,6 +229,8 @@ def posture_figure(plt, report: TrajectoryReport, title: str, samples: int = 600
     for k, post in enumerate(posts):
         ax = fig.add_subplot(rows, cols, k + 1, **({"projection": "3d"} if dim == 3 else {}))
         singular = post.kind == "singular"
+        if singular and dim == 3:
+            _shade_common_plane(ax, post.bodies)
         for trace in traces:
             ax.plot(*trace.T, color="grey", lw=0.8, ls="--")
         moving = 0

@@ -115,6 +115,16 @@ def load_trajectory(path: str, robot: Robot, interpolation: str | None = None) -
     return read_trajectory_spec(path, robot.spec, interpolation)
 
 
+def load_trajectories(paths, robot: Robot, interpolation: str | None = None
+                      ) -> list[TrajectorySpec]:
+    """Every trajectory of the files (``-``: standard input): a YAML file may hold several
+    documents, one trajectory each; names must be unique across them all (else
+    :class:`~singcheck.errors.SpecError`, naming the file, line and document)."""
+    from singcheck.spec.files import load_trajectories as read_trajectories
+
+    return read_trajectories(paths, robot.spec, interpolation)
+
+
 @dataclass
 class Report:
     """The certified answer for one trajectory: a verdict with its proofs."""

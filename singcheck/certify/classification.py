@@ -41,6 +41,7 @@ from flint import acb, arb
 
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
 from singcheck.algebra.radicals import evaluate_path
+from singcheck.budget import checkpoint
 from singcheck.certify.exact import (
     AlgebraicPoint,
     NotExact,
@@ -131,11 +132,14 @@ def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
     per_leg = [leg.branches(t) for leg in path.legs]
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}
+    complete = {}
     for mode in modes:
         js = [per_leg[i][b.label] for i, b in enumerate(mode.branches)]
         joints[mode.label] = js
-        values[mode.label] = None if any(j is None for j in js) else \
-            path.det_A(js, variables)
+        values[mode.label] = None
+        if not any(j is None for j in js):
+            complete[mode.label] = js
+    values.update(path.det_A_modes(complete, variables))  # the pose part once for all
     return pose, joints, values
 
 
@@ -286,7 +290,8 @@ def _classify_all(path: PathModel, modes: list[WorkingMode], roots, tolerance: f
     periodic = _periodic(path)
     done: dict[int, Candidate] = {}
     out = []
-    for r in roots:
+    for r in roots:  # hundreds for a high-degree μ
+        checkpoint()
         base = done.get(r.period[0]) if periodic and r.period is not None else None
         if base is None:
             candidate = classify_candidate(path, modes, r, tolerance)

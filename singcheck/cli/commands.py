@@ -386,9 +386,11 @@ Examples:
 def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
-    and the working modes in joint space with the joint-limit box (PNG and SVG).
-    With --regions, draw a plane of the workspace or joint space coloured by the
-    exact number of solutions of each region."""
+    and the working modes in joint space with the joint-limit box (PNG and SVG); when
+    the robot spec has a drawing, the robot at the start and at each proven singular
+    time (and, with --format html, animated along the path).
+    With --regions, draw a plane of the workspace or joint space: each region filled by
+    its exact number of solutions and labelled, the discriminant variety's curves."""
     progress = Progress(quiet)
     with exit_codes():
         if not trajectories and not spaces:

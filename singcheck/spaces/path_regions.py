@@ -32,6 +32,7 @@ from flint import acb, arb
 from singcheck.algebra.intervals import fraction_ball, working_precision
 from singcheck.algebra.polynomials import constant_value
 from singcheck.algebra.trig import uses_t, uses_trig
+from singcheck.budget import checkpoint
 from singcheck.certify.path import PathModel
 from singcheck.certify.working_modes import gap_points
 from singcheck.roots.enclosures import IdenticallyZeroError
@@ -125,6 +126,7 @@ def _crossings(path: PathModel, tolerance: float,
     events: list[tuple[arb, str]] = []
     undecided = []
     for label, poly in path_surfaces(path):
+        checkpoint()
         if label == XI and mu_roots is not None:
             events += [(t, label) for t in mu_roots]
             continue

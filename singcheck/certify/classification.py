@@ -132,11 +132,14 @@ def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
     per_leg = [leg.branches(t) for leg in path.legs]
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}
+    complete = {}
     for mode in modes:
         js = [per_leg[i][b.label] for i, b in enumerate(mode.branches)]
         joints[mode.label] = js
-        values[mode.label] = None if any(j is None for j in js) else \
-            path.det_A(js, variables)
+        values[mode.label] = None
+        if not any(j is None for j in js):
+            complete[mode.label] = js
+    values.update(path.det_A_modes(complete, variables))  # the pose part once for all
     return pose, joints, values
 
 

@@ -35,35 +35,38 @@ from singcheck.roots.rational import (
     real_roots_exact,
 )
 
-_ONE_PLUS_U2, _ONE_MINUS_U2, _TWO_U = (fmpq_poly(c) for c in ([1, 0, 1], [1, 0, -1], [0, 2]))
+_TWO_U = fmpq_poly([0, 2])
 
 
 
 def half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
     """M(u) = (1+u²)^d · p(2u/(1+u²), (1-u²)/(1+u²)) and d (p reduced, free of t).
 
-    With p = P₀(c) + s·P₁(c), M = H(P₀, d) + 2u·H(P₁, d-1) where
-    H(Σ aₖcᵏ, n) = Σ aₖ (1-u²)ᵏ (1+u²)ⁿ⁻ᵏ, summed by Horner's rule in 1-u²
-    (exact rational arithmetic throughout).
+    With p = P₀(c) + s·P₁(c), M = H(P₀, d)(u²) + 2u·H(P₁, d-1)(u²) where
+    H(Σ aₖcᵏ, n)(w) = Σ aₖ (1-w)ᵏ (1+w)ⁿ⁻ᵏ, a polynomial in w = u² (exact rational
+    arithmetic throughout).  Writing c = (1-w)/(1+w) = -1 + 2y with y = 1/(1+w),
+    (1+w)^m P(c) = y^(-m) P(-1 + 2y) is the reversal of P(-1 + 2y) taken at 1 + w: two
+    compositions with linear polynomials in FLINT and a reversal.
     """
     d = max((j + k for (_i, j, k), _ in p.terms()), default=0)
     by_s: list[dict[int, fmpq]] = [{}, {}]
     for (_i, j, k), c in p.terms():
         by_s[j][k] = c
-    one_plus = [fmpq_poly([1])]
-    for _ in range(d):
-        one_plus.append(one_plus[-1] * _ONE_PLUS_U2)
 
     def homogenised(coeffs: dict[int, fmpq], n: int) -> fmpq_poly:
         if not coeffs:
             return fmpq_poly([])
         top = max(coeffs)
-        r = fmpq_poly([coeffs[top]])
-        for k in range(top - 1, -1, -1):
-            r = r * _ONE_MINUS_U2 + coeffs.get(k, 0) * one_plus[top - k]
-        return r * one_plus[n - top]
+        shifted = fmpq_poly([coeffs.get(k, 0) for k in range(top + 1)])(_MINUS_ONE_PLUS_2Y)
+        cs = list(shifted.coeffs()) + [fmpq(0)] * (top + 1 - len(shifted.coeffs()))
+        return fmpq_poly(cs[::-1])(_ONE_PLUS_W) * _ONE_PLUS_W ** (n - top)
 
-    return homogenised(by_s[0], d) + _TWO_U * homogenised(by_s[1], d - 1), d
+    even = homogenised(by_s[0], d)(_U2)
+    odd = homogenised(by_s[1], d - 1)(_U2) if by_s[1] else fmpq_poly([])
+    return even + _TWO_U * odd, d
+
+
+_MINUS_ONE_PLUS_2Y, _ONE_PLUS_W, _U2 = (fmpq_poly(c) for c in ([-1, 2], [1, 1], [0, 0, 1]))
 
 
 @dataclass(frozen=True)

@@ -458,6 +458,41 @@ def spline_rows() -> list[dict]:
              "candidates": len(report.candidates)}]
 
 
+#: issue 12's robots: (robot, its paths, target per path in seconds, projection cached)
+ROBOT_PATHS = (
+    ("five-bar", ("five-bar-cross", "five-bar-free"), 0.050),
+    ("3-rpr", ("3-rpr-cross", "3-rpr-free"), 0.050),
+    ("3-prr", ("3-prr-cross", "3-prr-free"), 0.050),
+    ("linear-delta", ("linear-delta-cross", "linear-delta-free"), 0.200),
+    ("rotary-delta", ("rotary-delta-cross", "rotary-delta-free"), 0.200),
+    ("gough-stewart", ("gough-stewart-translate", "gough-stewart-rotate"), 5.0),
+)
+
+
+def robot_rows() -> list[dict]:
+    """Certification time per path of each bundled robot of issue 12 (flint, in-process):
+    with the projection cached (done once, as ``run`` does from its cache) and not cached
+    (projection included)."""
+    rows = []
+    for robot, paths, target in ROBOT_PATHS:
+        model = build_model(load_robot(ROOT / "robots" / f"{robot}.yaml"))
+        backend = get_backend("flint")
+        projection = project_robot(model, backend)
+        repeat = max(3, REPEAT // 3) if robot == "gough-stewart" else REPEAT
+        for name in paths:
+            spec = load_trajectory(ROOT / "trajectories" / f"{name}.yaml", model.spec)
+            report = certify_path(build_path(projection, spec))
+            cached, uncached = interleaved(
+                [lambda p=projection, s=spec: certify_path(build_path(p, s)),
+                 lambda s=spec, m=model, b=backend: certify_path(build_path(
+                     project_robot(m, b), s))],
+                repeat)
+            rows.append({"robot": robot, "trajectory": name, "verdict": report.verdict,
+                         "target_s": target, "cached": stats(cached),
+                         "uncached": stats(uncached)})
+    return rows
+
+
 def machine() -> dict:
     cpu = "unknown"
     try:
@@ -498,6 +533,14 @@ def main() -> None:
           "/ singcheck's; right answer: singcheck decided; branch-and-bound: same verdict "
           "and singular times as singcheck; sampling: sign changes at exactly singcheck's "
           "singular times)")
+    results["robots"] = robots = robot_rows()
+    print("\nbundled robots (issue 12): certification per path, flint, in-process; "
+          "projection cached / not cached")
+    for r in robots:
+        c, u = r["cached"], r["uncached"]
+        print(f"  {r['robot']:14} {r['trajectory']:24} {r['verdict']:17} cached median "
+              f"{ms(c['median_s'])} ms (target {ms(r['target_s'])} ms), not cached "
+              f"{ms(u['median_s'])} ms")
     results["spline"] = spline = spline_rows()
     print("\nwaypoints: read and certify, whole path (spline built exactly)")
     for r in spline:

@@ -216,9 +216,14 @@ def _yaml_error(e: yaml.YAMLError, path: str) -> SpecError:
     return SpecError(f"not valid YAML: {str(e).splitlines()[0]}", path=path)
 
 
+#: libyaml's safe loader when PyYAML was built with it (the same nodes and marks, parsed
+#: in C), else the pure-Python one
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
 def _compose(text: str, path: str):
     try:
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        node = yaml.compose(text, Loader=_LOADER)
     except yaml.YAMLError as e:
         raise _yaml_error(e, path) from None
     if node is None:
@@ -230,7 +235,7 @@ def _compose(text: str, path: str):
 def _compose_all(text: str, path: str) -> Iterator:
     """Every document of a YAML stream (``---`` between documents), composed one at a
     time; empty documents are skipped, a stream with none is an error."""
-    stream = yaml.compose_all(text, Loader=yaml.SafeLoader)
+    stream = yaml.compose_all(text, Loader=_LOADER)
     found = False
     while True:
         try:

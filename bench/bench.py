@@ -565,8 +565,8 @@ def main() -> None:
     results["command_line"] = cli = cli_rows()
     print("\ncommand line")
     for r in cli:
-        print(f"  {r['what']:66} median CPU {ms(r.get('cpu_median_s', r['median_s']))} ms,"
-              f" wall {ms(r['median_s'])} ms" +
+        cpu = f"median CPU {ms(r['cpu_median_s'])} ms, " if "cpu_median_s" in r else ""
+        print(f"  {r['what']:66} {cpu}wall {ms(r['median_s'])} ms" +
               (f"  {r['verdicts']}" if "verdicts" in r else ""))
     results["batch"] = batch = batch_rows()
     print_batch(batch)

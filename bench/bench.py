@@ -349,7 +349,7 @@ def batch_rows(counts=BATCH_COUNTS) -> list[dict]:
         from distributed import LocalCluster
 
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                               host="127.0.0.1", dashboard_address=None)
+                               host="127.0.0.1", dashboard_address="127.0.0.1:0")
     except ImportError:  # the dask extra is missing: no cluster rows
         pass
     with tempfile.TemporaryDirectory() as tmp:

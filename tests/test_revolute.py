@@ -336,3 +336,21 @@ def test_an_angle_path_that_is_not_k_t_is_certified_by_branch_and_bound():
     for ball, root in zip(got, expected, strict=True):
         assert abs(mpmath.mpf(ball.mid().str(30, radius=False)) - root) < 1e-8
     assert not report.certificate.undecided
+
+
+ORIENTED = """\
+name: oriented
+joints: [r1, r2]
+pose: [y, phi]
+constraints:
+  - (cos(phi) - r1)^2 + (y + sin(phi))^2 - 4
+  - (cos(phi + pi) - r2)^2 + (y + sin(phi + pi) - 1)^2 - 4
+"""
+
+
+@pytest.mark.parametrize("backend", ["singular", "macaulay2", "sympy"])
+def test_backends_agree_on_a_robot_with_orientation(backend):
+    """A pose angle (cos φ, sin φ kept, not eliminated) with prismatic legs whose det A
+    involves the joints: every backend eliminates the same ξ."""
+    assert _robot(ORIENTED, backend).singularity_surface == \
+        _robot(ORIENTED).singularity_surface

@@ -384,7 +384,27 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
             for v in model.context.names()]
     det_a = model.det_A.compose(*args, ctx=ring)
     legs = [(v, f.compose(*args, ctx=ring)) for v, f in norm_legs(model)]
-    return reduce_trig(restrict(norm_chain(det_a, legs), TRIG))
+    return reduce_trig(restrict(norm_chain(det_a, legs, reduce=_on_circle), TRIG))
+
+
+def _on_circle(p: fmpq_mpoly) -> fmpq_mpoly:
+    """``p`` (in a ring with the path's s = sin t, c = cos t) with s² replaced by 1 - c²:
+    degree ≤ 1 in s, the same function of t.  Keeps path-wise norms small."""
+    ctx = p.context()
+    names = ctx.names()
+    si = names.index("s")
+    if p.degrees()[si] < 2:
+        return p
+    one_minus_c2 = 1 - ctx.gens()[names.index("c")] ** 2
+    groups: dict[int, dict] = {}
+    for exps, coeff in p.terms():
+        e = list(exps)
+        half, e[si] = divmod(e[si], 2)
+        groups.setdefault(half, {})[tuple(e)] = coeff
+    out = ctx.from_dict({})
+    for half, terms in groups.items():
+        out += ctx.from_dict(terms) * one_minus_c2 ** half
+    return out
 
 
 _LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}

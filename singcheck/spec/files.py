@@ -354,7 +354,9 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     if not len(constraints) == len(joints) == len(pose):
         raise doc.error(top["constraints"][0], "constraints",
                         f"{len(constraints)} constraints for {len(joints)} joints and "
-                        f"{len(pose)} pose variables: the system must be square")
+                        f"{len(pose)} pose variables: the system must be square (one "
+                        "constraint per actuated joint; a passive joint must be eliminated "
+                        "first, e.g. by writing its leg as a squared distance)")
     limits: dict[str, tuple[Fraction, Fraction]] = {}
     if "joint_limits" in top:
         for jname, (knode, vnode) in doc.mapping(top["joint_limits"][1],

@@ -176,18 +176,26 @@ _DET_A_SPLITS: dict[int, tuple] = {}
 def _det_a_by_joints(model: RobotModel) -> list[tuple[tuple[tuple[int, int], ...], fmpq_mpoly]]:
     """det A as [(α, q_α)]: α the exponents of the joint variables (sparse pairs), q_α
     the polynomial in the other variables; once per model."""
-    hit = _DET_A_SPLITS.get(id(model))
-    if hit is None or hit[0] is not model:
+    def split(model: RobotModel) -> list:
         n_joint = len(model.joint_variables)
         groups: dict[tuple[int, ...], dict] = {}
         for exps, coeff in model.det_A.terms():
             rest = (0,) * n_joint + tuple(exps[n_joint:])
             groups.setdefault(tuple(exps[:n_joint]), {})[rest] = coeff
-        split = [(tuple((v, e) for v, e in enumerate(alpha) if e),
-                  model.context.from_dict(terms)) for alpha, terms in groups.items()]
-        if len(_DET_A_SPLITS) > 64:
-            _DET_A_SPLITS.clear()
-        hit = _DET_A_SPLITS[id(model)] = (model, split)
+        return [(tuple((v, e) for v, e in enumerate(alpha) if e),
+                 model.context.from_dict(terms)) for alpha, terms in groups.items()]
+
+    return memo_per_object(_DET_A_SPLITS, model, split)
+
+
+def memo_per_object(cache: dict, obj, compute, keep: int = 256):
+    """``compute(obj)``, once per object: the entry keeps the object, so its id is not
+    reused while it is there (the cache is emptied past ``keep`` entries)."""
+    hit = cache.get(id(obj))
+    if hit is None or hit[0] is not obj:
+        if len(cache) > keep:
+            cache.clear()
+        hit = cache[id(obj)] = (obj, compute(obj))
     return hit[1]
 
 
@@ -412,13 +420,8 @@ _LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}
 
 def _leg_coefficients(leg: Leg) -> tuple[fmpq_mpoly, ...]:
     """:func:`~singcheck.model.robot.leg_coefficients`, once per leg of a model (the same
-    legs serve every path of a batch); the entry keeps the leg, so its id is not reused."""
-    hit = _LEG_COEFFICIENTS.get(id(leg))
-    if hit is None or hit[0] is not leg:
-        if len(_LEG_COEFFICIENTS) > 256:
-            _LEG_COEFFICIENTS.clear()
-        hit = _LEG_COEFFICIENTS[id(leg)] = (leg, leg_coefficients(leg))
-    return hit[1]
+    legs serve every path of a batch)."""
+    return memo_per_object(_LEG_COEFFICIENTS, leg, leg_coefficients)
 
 
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:

@@ -32,6 +32,7 @@ TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": True, "pose": True}
 RESERVED = {"pi", "sin", "cos"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
+MAX_YAML_DEPTH = 16  # lists and mappings inside one another (specs need 3)
 
 
 @dataclass(frozen=True)
@@ -124,7 +125,7 @@ class _Doc:
         try:
             value = compile_constant(parse(text))
         except ExprError as e:
-            raise self.error(node, key, f"{e} in {text!r}") from None
+            raise self.error(node, key, f"{e} in {_excerpt(text)}") from None
         if value.pi_coefficient:
             raise self.error(node, key, f"must be an exact rational number, not {text!r}")
         return value.rational
@@ -134,8 +135,13 @@ class _Doc:
         try:
             return compile_(parse(text))
         except ExprError as e:
-            raise self.error(node, key, f"{e.message} in {text!r}" +
+            raise self.error(node, key, f"{e.message} in {_excerpt(text)}" +
                              (f" at column {e.column}" if e.column else "")) from None
+
+
+def _excerpt(text: str) -> str:
+    """An expression quoted in a message: the whole of a short one, the ends of a long one."""
+    return repr(text) if len(text) <= 80 else f"{text[:40]!r}…{text[-20:]!r}"
 
 
 def _kind(node) -> str:
@@ -143,8 +149,23 @@ def _kind(node) -> str:
             yaml.ScalarNode: "a single value"}.get(type(node), "nothing")
 
 
+def _check_depth(text: str, path: str) -> None:
+    """Refuse YAML nested deeper than MAX_YAML_DEPTH, from the event stream (PyYAML's
+    parser is a state machine; its composer, and our walks, recurse once per level)."""
+    depth = 0
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
+            depth += 1
+            if depth > MAX_YAML_DEPTH:
+                raise SpecError(f"lists and mappings are nested more than {MAX_YAML_DEPTH} "
+                                "levels deep", path=path, line=event.start_mark.line + 1)
+        elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
+            depth -= 1
+
+
 def _compose(text: str, path: str):
     try:
+        _check_depth(text, path)
         node = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.MarkedYAMLError as e:
         mark = e.problem_mark or e.context_mark

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import restrict, squarefree_part
+from singcheck.elimination.cache import CachedBackend
 from singcheck.elimination.requests import EliminationBackend, EliminationRequest, norm_chain
 from singcheck.errors import BackendError
 from singcheck.model.robot import RobotModel, leg_coefficients
@@ -122,9 +123,18 @@ def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str)
 def project_robot(model: RobotModel, backend: EliminationBackend) -> RobotProjection:
     """Every workspace surface of the robot, with ξ from ``backend`` (re-checked)."""
     pose_ctx = _pose_context(model)
-    result = backend.eliminate(singularity_surface_request(model))
+
+    def check(result) -> None:
+        recheck_singularity_surface(model, _single(result, "singularity surface"),
+                                    result.backend)
+
+    request = singularity_surface_request(model)
+    if isinstance(backend, CachedBackend):  # cache only what passes the re-check
+        result = backend.eliminate(request, check=check)
+    else:
+        result = backend.eliminate(request)
+        check(result)
     raw = _single(result, "singularity surface")
-    recheck_singularity_surface(model, raw, result.backend)
     xi = squarefree_part(raw)
     return RobotProjection(model, pose_ctx, xi, raw, workspace_boundary(model, pose_ctx),
                            joint_limit_surfaces(model, pose_ctx), result.backend, result.method)

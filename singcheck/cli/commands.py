@@ -92,6 +92,8 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     one (its decomposition is computed once and cached), and the certified time at which
     a path leaves the workspace.
     """
+    if plot_dir:
+        require_extra("plot")
     progress = Progress(quiet)
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
@@ -131,9 +133,9 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     code = _exit_code([r["verdict"] for r in results])
     text = _render(projection, results, tolerance, fmt, verbose, code, to_file=bool(output))
     if output:
-        from singcheck.atomic import write_atomically
+        from singcheck.atomic import write_output
 
-        write_atomically(output, text)
+        write_output(output, text)
     else:
         sys.stdout.write(text)
     return code
@@ -245,6 +247,7 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> N
     and the working modes in joint space with the joint-limit box (PNG and SVG).
     With --regions, draw a plane of the workspace or joint space coloured by the
     exact number of solutions of each region."""
+    require_extra("html" if fmt == "html" else "plot")
     progress = Progress(quiet)
     with exit_codes():
         if not trajectories and not spaces:
@@ -264,6 +267,30 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> N
             return
         for path in _plot_all(machine, specs, 1e-9, out_dir, progress):
             click.echo(str(path))
+
+
+#: The optional extras: the modules each needs, and the package that provides each.
+EXTRAS = {"plot": ("numpy", "matplotlib", "skimage"), "html": ("numpy", "plotly")}
+_PACKAGES = {"skimage": "scikit-image"}
+
+
+def require_extra(extra: str) -> None:
+    """Stop up front (exit 2, one line naming the extra to install) when an optional
+    dependency is missing, before any work is done."""
+    import importlib.util
+
+    missing = []
+    for module in EXTRAS[extra]:
+        try:
+            found = importlib.util.find_spec(module) is not None
+        except (ImportError, ValueError):
+            found = False
+        if not found:
+            missing.append(_PACKAGES.get(module, module))
+    if missing:
+        fail(f"this needs the optional extra '{extra}' ({', '.join(missing)} "
+             f"{'is' if len(missing) == 1 else 'are'} not installed): "
+             f"pip install 'singcheck[{extra}]'", ExitCode.USAGE)
 
 
 def _slices_by_space(robot, spaces, slices) -> dict[str, list[str]]:

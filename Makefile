@@ -5,10 +5,10 @@ BIN    := $(VENV)/bin
 ROBOT  ?= robots/orthoglide.yaml
 TRAJ   ?= trajectories/heart1.yaml
 
-.PHONY: help setup cas test test-fast lint demo examples bench clean
+.PHONY: help setup cas browser test test-fast lint demo examples bench clean
 
 help:
-	@echo "make setup      install Singular and Macaulay2 (apt), create $(VENV), install singcheck"
+	@echo "make setup      install Singular, Macaulay2 and Chromium (apt), create $(VENV), install singcheck"
 	@echo "make demo       set up, then certify the paper's Orthoglide on heart 1"
 	@echo "make examples   set up, then certify every bundled trajectory"
 	@echo "make test       set up, then run the whole test suite (slow tests included)"
@@ -16,7 +16,7 @@ help:
 	@echo "make lint       ruff"
 	@echo "make bench      benchmark singcheck against sampling; writes bench/results.json"
 
-setup: cas $(VENV)/.installed
+setup: cas browser $(VENV)/.installed
 
 # The external CAS backends (Debian packages). Skipped when both are already installed.
 cas:
@@ -25,6 +25,14 @@ cas:
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq singular macaulay2 >/dev/null; fi
+
+# Headless Chromium (Debian package chromium): the tests open the HTML figures page in it.
+browser:
+	@if command -v chromium >/dev/null; then :; else \
+	  echo "installing Chromium (Debian package chromium)"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium >/dev/null; fi
 
 # Debian's python3 lacks ensurepip until python3-venv is installed: install it when we can.
 $(VENV)/.installed: pyproject.toml

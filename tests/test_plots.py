@@ -42,7 +42,7 @@ def test_joint_space_shows_all_eight_modes_and_the_feasible_one_inside(heart1):
 def test_every_figure_is_written_non_empty(heart1, tmp_path):
     files = write_figures(heart1, tmp_path)
     assert sorted(p.name for p in files) == sorted(
-        f"heart1-{k}.{fmt}" for k in FIGURES for fmt in ("png", "svg"))
+        f"heart1-{k}.{fmt}" for k in (*FIGURES, "postures") for fmt in ("png", "svg"))
     assert all(p.stat().st_size > 1000 for p in files)
 
 
@@ -59,7 +59,7 @@ def test_plot_and_run_plot_commands(tmp_path):
     out = singcheck("plot", ORTHO, str(TRAJECTORIES / "heart2.yaml"), "--out", str(tmp_path),
                     "--backend", "flint")
     assert out.returncode == 0, out.stderr
-    assert len(out.stdout.split()) == 8
+    assert len(out.stdout.split()) == 10  # five figures (postures: the robot has a drawing)
     run = singcheck("run", ORTHO, str(TRAJECTORIES / "helix.yaml"), "--plot",
                     str(tmp_path / "run"), "--backend", "flint", "-q")
     assert run.returncode == 0
@@ -72,7 +72,7 @@ def test_html_page_is_self_contained_and_holds_every_figure(tmp_path):
                     "html", "--backend", "flint")
     assert out.returncode == 0, out.stderr
     page = (tmp_path / "singcheck.html").read_text()
-    assert page.count('class="plotly-graph-div"') == 8
+    assert page.count('class="plotly-graph-div"') == 10  # four figures and the animation, each
     assert "<script src=" not in page.replace('<script src="data', "")  # JS inlined
     assert "s3 real" in page and "s1 spurious" in page
     assert (tmp_path / "singcheck.html").stat().st_mode & 0o044  # readable by others

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 
+import mpmath
 import pytest
 from flint import arb, fmpq
 
@@ -96,7 +97,15 @@ def test_heart1_range_is_exactly_minus_pi_to_pi(orthoglide):
 BAD_ROBOTS = [
     # (text, line, key, phrase)
     (ROBOT.replace("(x - p)^2", "(x - w)^2"), 6, "constraints[0]", "undeclared name 'w'"),
-    (ROBOT.replace("(x - p)^2", "sin(x - p)"), 6, "constraints[0]", "must be polynomial"),
+    (ROBOT.replace("(x - p)^2", "sin(x*p)"), 6, "constraints[0]", "integer combination"),
+    (ROBOT.replace("(x - p)^2", "sin(x + 1)"), 6, "constraints[0]", "integer combination"),
+    (ROBOT.replace("(x - p)^2", "cos(x + pi/5)"), 6, "constraints[0]", "multiples of pi/12"),
+    (ROBOT.replace("(x - p)^2", "cos(p) + p"), 6, "constraints[0]", "is an angle"),
+    (ROBOT.replace("(x - p)^2", "sqrt(x)"), 6, "constraints[0]", "sqrt takes a rational"),
+    (ROBOT.replace("(x - p)^2", "sqrt(-2)"), 6, "constraints[0]", "not real"),
+    (ROBOT.replace("{l: 2}", "{l: sqrt(-1)}"), 4, "parameters.l", "not real"),
+    (ROBOT.replace("{l: 2}", "{l: pi*sqrt(2)}"), 4, "parameters.l", "not supported"),
+    (ROBOT.replace("{l: 2}", "{l: pi}"), 6, "constraints[0]", "contains pi"),
     (ROBOT.replace("(x - p)^2", "(x - p)/y"), 6, "constraints[0]", "division by a non-constant"),
     (ROBOT.replace("(x - p)^2", "(x - p)^-2"), 6, "constraints[0]", "non-negative integers"),
     (ROBOT.replace("(x - p)^2", "(x - p)^(1/2)"), 6, "constraints[0]", "non-negative integers"),
@@ -124,6 +133,23 @@ BAD_ROBOTS = [
     ("!!python/object/apply:os.system ['echo hacked']\n", 1, None, "not allowed"),
     ("name: !!python/name:os.system x\n", 1, None, "not allowed"),
     ("- just\n- a list\n", 1, None, "expected a mapping"),
+    (ROBOT + "drawing: 3\n", 9, "drawing", "expected a mapping"),
+    (ROBOT + "drawing: {}\n", 9, "drawing", "names no body"),
+    (ROBOT + "drawing:\n  legs: []\n", 10, "drawing.legs", "non-empty list"),
+    (ROBOT + "drawing:\n  legs:\n    - [[p, 0], [x, w]]\n", 11, "drawing.legs[0][1][1]",
+     "undeclared name 'w'"),
+    (ROBOT + "drawing:\n  legs:\n    - [[p, 0], [x, y/x]]\n", 11, "drawing.legs[0][1][1]",
+     "division by a non-constant"),
+    (ROBOT + "drawing:\n  legs:\n    - [[p, 0], [x, y]]\n    - [[q, 0, 0], [x, y, 0]]\n",
+     12, "drawing.legs[1][0]", "3-D point in a 2-D drawing (line 11)"),
+    (ROBOT + "drawing:\n  dots: [[x]]\n", 10, "drawing.dots[0]", "2 or 3 coordinates"),
+    (ROBOT + "drawing:\n  dots: [[x, y, 0, 1]]\n", 10, "drawing.dots[0]",
+     "2 or 3 coordinates"),
+    (ROBOT + "drawing:\n  legs: [[[p, 0]]]\n", 10, "drawing.legs[0]", "two end points"),
+    (ROBOT + "drawing:\n  legs: [[[p, 0], x]]\n", 10, "drawing.legs[0][1]",
+     "expected a point"),
+    (ROBOT + "drawing:\n  legs: 3\n", 10, "drawing.legs", "non-empty list"),
+    (ROBOT + "drawing:\n  dots: [[pi, 0]]\n", 10, "drawing.dots[0][0]", "pi is not allowed"),
 ]
 
 
@@ -138,6 +164,40 @@ def test_bad_robot_specs_get_one_located_line(text, line, key, phrase):
     if key:
         assert f" {key}:" in message, message
     assert phrase in message, message
+
+
+def test_drawing_bodies_are_exact_polynomials_in_joints_pose_and_parameters():
+    spec = parse_robot(ROBOT + """\
+drawing:
+  rail: [[[-l, 0], [2*l, 0]]]
+  legs:
+    - [[p, 0], [x, y]]
+    - [[0, q], [x, y], [x + 1/10, y]]
+  platform: [[x, y], [x/2, 0.5*y]]
+""", "r.yaml")
+    assert [b.name for b in spec.drawing] == ["rail", "legs", "platform"]
+    assert [b.line for b in spec.drawing] == [10, 11, 14]
+    assert spec.drawing_dimension == 2
+    p, q, x, y = spec.context.gens()
+    rail, legs, platform = spec.drawing
+    assert rail.chains == (((-2, 0), (4, 0)),) and not rail.points
+    assert legs.chains[0] == ((p, 0 * x), (x, y))
+    assert legs.chains[1][2] == (x + fmpq(1, 10), y)  # 0.1 is exactly 1/10
+    assert platform.points == ((x, y), (x / 2, y / 2)) and not platform.chains
+    assert parse_robot(ROBOT, "r.yaml").drawing == ()
+    assert parse_robot(ROBOT, "r.yaml").drawing_dimension is None
+
+
+@pytest.mark.parametrize("path", sorted(ROBOTS.glob("*.yaml")), ids=lambda p: p.stem)
+def test_every_bundled_robot_has_a_drawing_of_its_dimension(path):
+    spec = load_robot(path)
+    assert spec.drawing, f"{path.name} has no drawing key"
+    assert spec.drawing_dimension == (3 if len(spec.pose) >= 3 else 2)
+    # the drawing moves with every joint and every pose coordinate
+    used = {v for body in spec.drawing for chain in body.chains for point in chain
+            for c in point for v, d in zip(spec.context.names(), c.degrees(), strict=True)
+            if d}
+    assert set(spec.joints) <= used and set(spec.pose) <= used
 
 
 BAD_TRAJECTORIES = [
@@ -213,3 +273,80 @@ def test_specs_cannot_blow_up_memory_or_time(text, phrase):
     with pytest.raises(SpecError, match=phrase):
         parse_robot(text, "bomb.yaml")
     assert time.monotonic() - start < 5
+
+
+# ---------------------------------------------------------------------------------
+# angles (sin/cos of variables), exact square roots, pi
+
+ANGLE_ROBOT = """\
+name: angles
+joints: [th, r]
+pose: [x, phi]
+parameters: {R: 3/2, s3: sqrt(3), h: s3/2*R, a: pi/6}
+constraints:
+  - x*cos(2*th) - h*sin(th + phi) + cos(phi - pi/6) + sqrt(12)
+  - r^2 - (x - cos(phi + a))^2 - sin(3*phi)^2
+joint_limits: {th: [-pi/2, pi], r: [0, 4]}
+"""
+
+
+def _mp_eval(text: str, values: dict) -> mpmath.mpf:
+    """The test's own evaluation of a spec expression (trusted text, 50 digits)."""
+    env = {"sin": mpmath.sin, "cos": mpmath.cos, "sqrt": mpmath.sqrt, "pi": mpmath.pi,
+           **values}
+    return eval(text.replace("^", "**"), {"__builtins__": {}}, env)  # noqa: S307
+
+
+def test_angles_and_square_roots_compile_exactly():
+    """Each constraint, compiled with angles as (cos, sin) and √3 as a variable, equals
+    the expression evaluated directly at 50 digits, at random points."""
+    import random
+
+    from singcheck.algebra.intervals import evaluate, working_precision
+
+    text = ANGLE_ROBOT
+    spec = parse_robot(text, "angles.yaml")
+    assert spec.angles == {"th", "phi"}
+    assert spec.radicals == (3,)
+    assert spec.context.names() == ("cos(th)", "sin(th)", "r", "x", "cos(phi)", "sin(phi)",
+                                    "sqrt(3)")
+    lo, hi = spec.joint_limits["th"]
+    assert (lo, hi) == (LinearInPi(Fraction(0), Fraction(-1, 2)),
+                        LinearInPi(Fraction(0), Fraction(1)))
+    sources = [line.strip()[2:] for line in text.splitlines() if line.startswith("  - ")]
+    rng = random.Random(7)
+    mpmath.mp.dps = 50
+    for _ in range(5):
+        th, r, x, phi = (mpmath.mpf(rng.uniform(-3, 3)) for _ in range(4))
+        values = {"th": th, "r": r, "x": x, "phi": phi, "s3": mpmath.sqrt(3),
+                  "h": mpmath.sqrt(3) / 2 * mpmath.mpf(3) / 2, "a": mpmath.pi / 6}
+        point = [mpmath.cos(th), mpmath.sin(th), r, x, mpmath.cos(phi), mpmath.sin(phi),
+                 mpmath.sqrt(3)]
+        for poly, source in zip(spec.constraints, sources, strict=True):
+            expected = _mp_eval(source, values)
+            with working_precision(200):
+                got = evaluate(poly, [arb(mpmath.nstr(v, 60)) for v in point])
+            assert abs(mpmath.mpf(got.mid().str(50, radius=False)) - expected) < 1e-40
+
+
+def test_an_angle_trajectory_keeps_its_pi_offset():
+    spec = parse_robot(ANGLE_ROBOT, "angles.yaml")
+    traj = parse_trajectory("name: a\nparameter: t\nrange: [0, 1]\npose:\n"
+                            "  x: cos(t + pi/6)\n  phi: 2*t - pi/6\n", "a.yaml", spec)
+    assert str(traj.pose["phi"]) == "2*t" and traj.angle_offsets == {"phi": Fraction(-1, 6)}
+    assert traj.pose["x"].context().names() == ("t", "s", "c", "sqrt(3)")
+    assert str(traj.pose["x"]) == "-1/2*s + 1/2*c*sqrt(3)"
+    with pytest.raises(SpecError, match="pi may only be added"):
+        parse_trajectory("name: a\nparameter: t\nrange: [0, 1]\npose:\n"
+                         "  x: 0\n  phi: pi*t\n", "a.yaml", spec)
+
+
+@pytest.mark.parametrize("text, value", [
+    ("sqrt(12)", "2*sqrt(3)"), ("sqrt(3/4)", "1/2*sqrt(3)"), ("1/(1 + sqrt(2))", "-1 + sqrt(2)"),
+    ("sqrt(2)*sqrt(3) - sqrt(6)", "0"), ("(sqrt(3)/2)^2", "3/4"), ("2*sin(pi/3)", "sqrt(3)"),
+    ("cos(pi/12)", "1/4*sqrt(2) + 1/4*sqrt(6)"), ("pi/6 + 1", "1 + 1/6*pi"),
+])
+def test_parameter_values_are_exact_algebraic_numbers(text, value):
+    from singcheck.spec.grammar import compile_value
+
+    assert str(compile_value(parse(text), {})) == value

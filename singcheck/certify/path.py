@@ -97,6 +97,13 @@ class PathModel:
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
     model = projection.model
     phi = tuple(trajectory.pose[v] for v in model.pose)
+    if any(p.context() is not TRIG for p in phi):
+        from singcheck.errors import UnsupportedRobotError
+
+        raise UnsupportedRobotError(
+            "the trajectory uses square roots (sqrt, or sin/cos of t plus a multiple of pi): "
+            "this version certifies trajectories with rational coefficients only",
+            path=trajectory.path, line=trajectory.lines.get("pose"), key="pose")
     mu = compose_pose(projection.singularity_surface, phi, model.pose)
     legs = []
     for leg in model.legs:

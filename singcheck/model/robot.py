@@ -144,6 +144,12 @@ def build_model(spec: RobotSpec) -> RobotModel:
     Raises :class:`UnsupportedRobotError` (with the constraint's file and line) for a
     robot outside the leg-decoupled class, and when det A is identically zero.
     """
+    if spec.angles or spec.radicals:
+        what = "angles (sin/cos)" if spec.angles else "square roots"
+        raise UnsupportedRobotError(
+            f"the constraints use {what}: the spec language accepts them, but this version "
+            "certifies only polynomial constraints with rational coefficients",
+            path=spec.path, line=spec.lines.get("constraints"), key="constraints")
     constraints = tuple(spec.constraints)
     A = jacobian(constraints, spec.pose)
     B = jacobian(constraints, spec.joints)

@@ -11,6 +11,8 @@ Figures (each written as PNG and SVG):
      ξ(X) = 0 near it (marching cubes, or a contour for a planar robot).
   4. ``jointspace``: the path's image in joint space for every real working mode, with
      the joint-limit box; the feasible mode(s) drawn bold.
+  5. ``postures`` (robots with a ``drawing``): the robot at the start and at each proven
+     singular time (:mod:`singcheck.report.postures`).
 """
 
 from __future__ import annotations
@@ -220,7 +222,7 @@ def _limit_box(ax, limits) -> None:
 
 def write_figures(report: TrajectoryReport, out_dir: str | Path,
                   formats: tuple[str, ...] = ("png", "svg"), dpi: int = 120) -> list[Path]:
-    """Write the four figures for one trajectory; returns the files written."""
+    """Write the figures for one trajectory; returns the files written."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -239,9 +241,15 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
             f"{robot} · {name}: path and ξ(X) = 0"),
         "jointspace": lambda: _joint_figure(plt, d, f"{robot} · {name}: working modes"),
     }
+    from singcheck.report.postures import posture_figure
+
+    makers["postures"] = lambda: posture_figure(
+        plt, report, f"{robot} · {name}: the robot at the start and its singular postures")
     written = []
-    for key in FIGURES:
+    for key in makers:
         fig = makers[key]()
+        if fig is None:  # no drawing in the robot spec
+            continue
         for fmt in formats:
             target = out / f"{name}-{key}.{fmt}"
             fig.savefig(target, dpi=dpi, bbox_inches="tight")
@@ -252,7 +260,8 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
 
 def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
     """One self-contained interactive page (plotly, its JavaScript inlined once) with
-    the same four figures for every trajectory."""
+    the same four figures for every trajectory, and the robot moving along it
+    (:mod:`singcheck.report.animation`) when its spec has a drawing."""
     import plotly.graph_objects as go
 
     from singcheck.atomic import write_atomically
@@ -319,8 +328,12 @@ def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
         else:
             js.update_layout(xaxis_title=names[0], yaxis_title=names[1])
         figs.append(js)
-        for fig in figs:
-            parts.append(fig.to_html(full_html=False, include_plotlyjs=first))
+        from singcheck.report.animation import animation_figure
+
+        moving = animation_figure(report, d, f"{robot} · {report.name}: the robot along "
+                                  "the path")
+        for fig in figs + ([moving] if moving is not None else []):
+            parts.append(fig.to_html(full_html=False, include_plotlyjs=first, auto_play=False))
             first = False
     page = ("<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>singcheck figures"
             "</title></head><body>\n" + "\n".join(parts) + "\n</body></html>\n")

@@ -16,23 +16,43 @@ from fractions import Fraction
 import yaml
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
-from singcheck.algebra.trig import LinearInPi, TimeRange
+from singcheck.algebra.polynomials import restrict
+from singcheck.algebra.radicals import angle_names, radical_name, radical_variables
+from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
 from singcheck.errors import SpecError
 from singcheck.spec.grammar import (
+    Constant,
     ExprError,
+    Node,
+    angles_in,
+    compile_angle_coordinate,
     compile_constant,
     compile_polynomial,
     compile_trajectory_coordinate,
+    compile_value,
     parse,
 )
 
 ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
-              "parameters": False, "constraints": True, "joint_limits": False}
+              "parameters": False, "constraints": True, "joint_limits": False,
+              "drawing": False}
 TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": True, "pose": True}
-RESERVED = {"pi", "sin", "cos"}
+RESERVED = {"pi", "sin", "cos", "sqrt"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
 MAX_YAML_DEPTH = 16  # lists and mappings inside one another (specs need 3)
+MAX_DRAWING_POINTS = 1000  # every point of a drawing is evaluated once per frame drawn
+
+
+@dataclass(frozen=True)
+class DrawingBody:
+    """One body of a robot's drawing: chains of segments and single points, each point a
+    tuple of 2 or 3 exact polynomials in the joints and pose (parameters substituted)."""
+
+    name: str
+    chains: tuple[tuple[tuple[fmpq_mpoly, ...], ...], ...]  # each: ≥ 2 points joined in turn
+    points: tuple[tuple[fmpq_mpoly, ...], ...]
+    line: int
 
 
 @dataclass(frozen=True)
@@ -42,12 +62,41 @@ class RobotSpec:
     description: str
     joints: tuple[str, ...]
     pose: tuple[str, ...]
-    parameters: dict[str, Fraction]
-    context: fmpq_mpoly_ctx  # joints then pose
+    parameters: dict[str, Fraction | Constant]  # Fraction when rational
+    context: fmpq_mpoly_ctx  # joints then pose then radicals (see ``variables``)
     constraints: tuple[fmpq_mpoly, ...]
     constraint_lines: tuple[int, ...]
-    joint_limits: dict[str, tuple[Fraction, Fraction]]
+    joint_limits: dict[str, tuple]  # Fractions; LinearInPi (radians) for an angle joint
     lines: dict[str, int] = field(default_factory=dict)
+    angles: frozenset[str] = frozenset()  # joints and pose variables used inside sin/cos
+    radicals: tuple[int, ...] = ()  # primes p whose sqrt(p) is a variable of the context
+
+    def variables(self, name: str) -> tuple[str, ...]:
+        """The context's variables of a joint or pose variable: itself, or
+        ``(cos(v), sin(v))`` for an angle."""
+        return angle_names(name) if name in self.angles else (name,)
+
+    @property
+    def joint_variables(self) -> tuple[str, ...]:
+        return tuple(v for j in self.joints for v in self.variables(j))
+
+    @property
+    def pose_variables(self) -> tuple[str, ...]:
+        return tuple(v for x in self.pose for v in self.variables(x))
+
+    @property
+    def radical_variables(self) -> tuple[str, ...]:
+        return tuple(radical_name(p) for p in self.radicals)
+
+    drawing: tuple[DrawingBody, ...] = ()  # the optional ``drawing`` key
+
+    @property
+    def drawing_dimension(self) -> int | None:
+        """2 or 3 (every point of a drawing has as many coordinates), None without one."""
+        for body in self.drawing:
+            for point in (*body.points, *(p for chain in body.chains for p in chain)):
+                return len(point)
+        return None
 
 
 @dataclass(frozen=True)
@@ -58,6 +107,8 @@ class TrajectorySpec:
     range: TimeRange
     pose: dict[str, fmpq_mpoly]  # pose variable -> TRIG polynomial, robot's pose order
     lines: dict[str, int] = field(default_factory=dict)
+    #: an angle's coordinate is pose[v] + angle_offsets[v]·π (only angles have an entry)
+    angle_offsets: dict[str, Fraction] = field(default_factory=dict)
 
 
 class _Doc:
@@ -129,6 +180,17 @@ class _Doc:
         if value.pi_coefficient:
             raise self.error(node, key, f"must be an exact rational number, not {text!r}")
         return value.rational
+
+    def value(self, node, key: str, parameters: dict) -> Fraction | Constant:
+        """A parameter's exact value: a Fraction when rational, else a Constant."""
+        text = self.text(node, key)
+        try:
+            value = compile_value(parse(text), parameters)
+        except (ExprError, ValueError, ZeroDivisionError) as e:
+            raise self.error(node, key, f"{e} in {text!r}") from None
+        if not value.pi_coefficient and value.surd.is_rational():
+            return value.surd.rational_value()
+        return value
 
     def expression(self, node, key: str, compile_):
         text = self.text(node, key)
@@ -246,21 +308,33 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                 raise doc.error(knode, key, f"{pname!r} is not a valid parameter name")
             if pname in joints or pname in pose:
                 raise doc.error(knode, key, f"{pname!r} is already a joint or pose variable")
-            parameters[pname] = doc.number(vnode, key)
-    ctx = fmpq_mpoly_ctx.get(joints + pose, "lex")
-    variables = dict(zip(joints + pose, ctx.gens(), strict=True))
+            parameters[pname] = doc.value(vnode, key, parameters)
     cnode = top["constraints"][1]
     if not isinstance(cnode, yaml.SequenceNode) or not cnode.value:
         raise doc.error(cnode, "constraints", "expected a non-empty list of polynomials")
-    constraints, constraint_lines = [], []
+    trees = [doc.expression(item, f"constraints[{i}]", lambda n: n)
+             for i, item in enumerate(cnode.value)]
+    angles = frozenset().union(*(angles_in(t, joints + pose) for t in trees))
+    algebraic = [v for name in joints + pose
+                 for v in (angle_names(name) if name in angles else (name,))]
+    primes = sorted(_radical_primes(parameters, trees))
+    wide = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in primes)), "lex")
+    gens = dict(zip(wide.names(), wide.gens(), strict=True))
+    variables = {v: gens[v] for v in joints + pose if v not in angles}
+    pairs = {v: tuple(gens[n] for n in angle_names(v)) for v in angles}
+    compiled, constraint_lines = [], []
     for i, item in enumerate(cnode.value):
         key = f"constraints[{i}]"
-        poly = doc.expression(item, key,
-                              lambda n: compile_polynomial(n, ctx, variables, parameters))
+        poly = doc.expression(item, key, lambda n: compile_polynomial(n, wide, variables,
+                                                                      parameters, pairs))
         if poly.is_zero():
             raise doc.error(item, key, "is identically zero")
-        constraints.append(poly)
+        compiled.append(poly)
         constraint_lines.append(_line(item))
+    used = tuple(p for i, p in radical_variables(wide)
+                 if any(f.degrees()[i] > 0 for f in compiled))
+    ctx = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in used)), "lex")
+    constraints = [restrict(f, ctx) for f in compiled]
     if not len(constraints) == len(joints) == len(pose):
         raise doc.error(top["constraints"][0], "constraints",
                         f"{len(constraints)} constraints for {len(joints)} joints and "
@@ -275,12 +349,101 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                                             f"{', '.join(joints)})")
             if not isinstance(vnode, yaml.SequenceNode) or len(vnode.value) != 2:
                 raise doc.error(vnode, key, "expected [min, max]")
-            lo, hi = (doc.number(v, key) for v in vnode.value)
-            if not lo < hi:
-                raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
+            if jname in angles:
+                lo, hi = (doc.expression(v, key, compile_constant) for v in vnode.value)
+                if not _less(lo, hi):
+                    raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
+            else:
+                lo, hi = (doc.number(v, key) for v in vnode.value)
+                if not lo < hi:
+                    raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
             limits[jname] = (lo, hi)
+    final = dict(zip(ctx.names(), ctx.gens(), strict=True))
+    drawing = _drawing(doc, top["drawing"][1], ctx,
+                       {v: final[v] for v in joints + pose if v not in angles}, parameters,
+                       {v: tuple(final[n] for n in angle_names(v)) for v in angles}) \
+        if "drawing" in top else ()
     return RobotSpec(path, name, description, joints, pose, parameters, ctx,
-                     tuple(constraints), tuple(constraint_lines), limits, lines)
+                     tuple(constraints), tuple(constraint_lines), limits, lines,
+                     angles=angles, radicals=used, drawing=drawing)
+
+
+def _radical_primes(parameters: dict, trees: list[Node]) -> set[int]:
+    """Every prime whose square root a compiled expression may need: those of the
+    parameters, of each ``sqrt(q)`` written inline, and 2 and 3 (the sines and
+    cosines of multiples of π/12)."""
+    primes = {2, 3}
+    for value in parameters.values():
+        if isinstance(value, Constant):
+            primes |= value.surd.primes()
+
+    def walk(node: Node) -> None:
+        if node.kind == "call" and node.value == "sqrt":
+            try:
+                primes.update(compile_value(node, parameters).surd.primes())
+            except ExprError:
+                pass  # the compiler reports it, with its column
+        for a in node.args:
+            walk(a)
+
+    for tree in trees:
+        walk(tree)
+    return primes
+
+
+def _drawing(doc: _Doc, node, ctx, variables, parameters,
+             angles=None) -> tuple[DrawingBody, ...]:
+    """The ``drawing`` key: ``body: [item, ...]`` where an item is a point ``[e, e(, e)]``
+    or a chain of segments ``[[e, e(, e)], [e, e(, e)], ...]`` (two points: one segment),
+    every ``e`` a polynomial in the joints, pose and parameters; one dimension, 2 or 3,
+    for every point of the drawing."""
+    bodies = []
+    shape: dict[str, object] = {}  # the first point's dimension and where it is
+    count = 0
+
+    def point(pnode, key):
+        nonlocal count
+        if not isinstance(pnode, yaml.SequenceNode) or not 2 <= len(pnode.value) <= 3 or \
+                not all(isinstance(v, yaml.ScalarNode) for v in pnode.value):
+            raise doc.error(pnode, key, "expected a point: a list of 2 or 3 coordinates, "
+                                        "e.g. [x, y, z]")
+        if "dim" not in shape:
+            shape.update(dim=len(pnode.value), line=_line(pnode))
+        elif shape["dim"] != len(pnode.value):
+            raise doc.error(pnode, key, f"a {len(pnode.value)}-D point in a "
+                                        f"{shape['dim']}-D drawing (line {shape['line']})")
+        count += 1
+        if count > MAX_DRAWING_POINTS:
+            raise doc.error(pnode, key, f"more than {MAX_DRAWING_POINTS} points")
+        return tuple(doc.expression(
+            v, f"{key}[{i}]", lambda n: compile_polynomial(n, ctx, variables, parameters,
+                                                          angles))
+            for i, v in enumerate(pnode.value))
+
+    for bname, (knode, bnode) in doc.mapping(node, "drawing").items():
+        key = f"drawing.{bname}"
+        if not _IDENTIFIER.match(bname):
+            raise doc.error(knode, key, f"{bname!r} is not a valid body name")
+        if not isinstance(bnode, yaml.SequenceNode) or not bnode.value:
+            raise doc.error(bnode, key, "expected a non-empty list of segments "
+                                        "[[x1, y1], [x2, y2]] or points [x, y]")
+        chains, points = [], []
+        for i, item in enumerate(bnode.value):
+            ikey = f"{key}[{i}]"
+            if not isinstance(item, yaml.SequenceNode) or not item.value:
+                raise doc.error(item, ikey, "expected a segment [[x1, y1], [x2, y2]] or a "
+                                            "point [x, y]")
+            if all(isinstance(v, yaml.ScalarNode) for v in item.value):
+                points.append(point(item, ikey))
+            elif len(item.value) < 2:
+                raise doc.error(item, ikey, "a segment needs two end points")
+            else:
+                chains.append(tuple(point(p, f"{ikey}[{j}]")
+                                    for j, p in enumerate(item.value)))
+        bodies.append(DrawingBody(bname, tuple(chains), tuple(points), _line(knode)))
+    if not bodies:
+        raise doc.error(node, "drawing", "names no body")
+    return tuple(bodies)
 
 
 def load_robot(path: str | os.PathLike) -> RobotSpec:
@@ -340,12 +503,26 @@ def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
     if missing:
         raise doc.error(top["pose"][0], "pose",
                         f"missing coordinate(s) {', '.join(missing)} of robot {robot.name}")
-    coords = {}
+    trees = {v: doc.expression(pose_map[v][1], f"pose.{v}", lambda n: n) for v in robot.pose}
+    primes = sorted(_radical_primes(robot.parameters, list(trees.values())))
+    ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
+    coords, offsets = {}, {}
     for v in robot.pose:
-        coords[v] = doc.expression(
-            pose_map[v][1], f"pose.{v}",
-            lambda n: compile_trajectory_coordinate(n, parameter, robot.parameters))
-    return TrajectorySpec(path, name, parameter, TimeRange(start, end), coords, lines)
+        key = f"pose.{v}"
+        if v in robot.angles:
+            coords[v], offsets[v] = doc.expression(
+                pose_map[v][1], key,
+                lambda n: compile_angle_coordinate(n, parameter, robot.parameters, ring))
+        else:
+            coords[v] = doc.expression(
+                pose_map[v][1], key,
+                lambda n: compile_trajectory_coordinate(n, parameter, robot.parameters, ring))
+    used = [i for i, _ in radical_variables(ring)
+            if any(p.degrees()[i] > 0 for p in coords.values())]
+    names = ("t", "s", "c", *(ring.names()[i] for i in used))
+    small = TRIG if not used else fmpq_mpoly_ctx.get(names, "lex")
+    coords = {v: restrict(p, small) for v, p in coords.items()}
+    return TrajectorySpec(path, name, parameter, TimeRange(start, end), coords, lines, offsets)
 
 
 def load_trajectory(path: str | os.PathLike, robot: RobotSpec) -> TrajectorySpec:

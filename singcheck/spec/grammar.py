@@ -27,7 +27,15 @@ from fractions import Fraction
 
 from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
-from singcheck.algebra.trig import TRIG, LinearInPi, T, cos_multiple, reduce_trig, sin_multiple
+from singcheck.algebra.radicals import (
+    Surd,
+    cos_pi,
+    expand_trig,
+    reduce_relations,
+    sin_pi,
+    surd_polynomial,
+)
+from singcheck.algebra.trig import TRIG, LinearInPi, cos_multiple, reduce_trig, sin_multiple
 
 MAX_EXPONENT = 64
 MAX_LENGTH = 10_000
@@ -36,7 +44,7 @@ MAX_TERMS = 100_000
 MAX_BITS = 4096  # of any intermediate rational's numerator or denominator (1233 digits)
 MAX_LITERAL_BITS = 512  # of a number literal's numerator or denominator (1e154 is fine)
 MAX_NESTING = 64  # parentheses, calls and exponents inside one another
-FUNCTIONS = ("sin", "cos")
+FUNCTIONS = ("sin", "cos")  # sqrt is handled apart: it only takes constants
 
 
 class ExprError(ValueError):
@@ -272,6 +280,20 @@ def parse(text: str) -> Node:
 # compilers
 
 
+@dataclass(frozen=True)
+class Constant:
+    """An exact constant ``surd + pi_coefficient·π`` (a parameter's value)."""
+
+    surd: Surd
+    pi_coefficient: Fraction = Fraction(0)
+
+    def __str__(self) -> str:
+        parts = [] if not self.surd and self.pi_coefficient else [str(self.surd)]
+        if self.pi_coefficient:
+            parts.append(f"{self.pi_coefficient}*pi")
+        return " + ".join(parts)
+
+
 def _exponent(node: Node, value) -> int:
     if not isinstance(value, Fraction) or value.denominator != 1 or value < 0:
         raise ExprError("exponents must be non-negative integers", node.column)
@@ -284,77 +306,141 @@ def _exponent(node: Node, value) -> int:
 def _constant_of(p) -> Fraction | None:
     if isinstance(p, Fraction):
         return p
+    if isinstance(p, Surd):
+        return p.rational_value() if p.is_rational() else None
     if p.is_constant():
         c = p.leading_coefficient() if not p.is_zero() else fmpq(0)
         return Fraction(int(fmpq(c).p), int(fmpq(c).q))
     return None
 
 
-class _Compiler:
-    """Evaluate a tree over a ring, with hooks for names and calls."""
+def _scalar(x) -> bool:
+    return isinstance(x, (Fraction, Surd))
 
-    def __init__(self, ring, names, call=None, what="expression") -> None:
+
+def _simplify(x):
+    """A surd that is rational becomes a Fraction (the fast, backwards-compatible path)."""
+    if isinstance(x, Surd) and x.is_rational():
+        return x.rational_value()
+    return x
+
+
+class _Compiler:
+    """Evaluate a tree over a ring, with hooks for names, calls, square roots and π."""
+
+    def __init__(self, ring, names, call=None, what="expression", surd=None, pi=None,
+                 forbidden=None) -> None:
         self.ring = ring
-        self.names = names  # name -> ring element or Fraction
-        self.call = call
+        self.names = names  # name -> ring element, Fraction, Surd or Constant
+        self.call = call  # sin/cos hook
         self.what = what
+        self.surd = surd  # Surd -> ring element (None: square roots not allowed)
+        self.pi = pi  # the ring element standing for π (None: π not allowed)
+        self.forbidden = forbidden or {}  # name -> why it cannot be used bare
 
     def const(self, q: Fraction):
         return self.ring.from_dict({(0,) * self.ring.nvars(): fmpq(q.numerator, q.denominator)}) \
             if q else self.ring.from_dict({})
 
-    def lift(self, v):
-        return self.const(v) if isinstance(v, Fraction) else v
+    def lift(self, v, node: Node | None = None):
+        if isinstance(v, Fraction):
+            return self.const(v)
+        if isinstance(v, Surd):
+            if self.surd is None:
+                raise ExprError(f"square roots are not allowed in a {self.what}",
+                                node.column if node else None)
+            try:
+                return self.surd(v)
+            except ValueError as e:
+                raise ExprError(str(e), node.column if node else None) from None
+        return v
+
+    def _name(self, node: Node):
+        name = node.value
+        if name in self.forbidden:
+            raise ExprError(self.forbidden[name], node.column)
+        if name == "pi" and name not in self.names:
+            if self.pi is None:
+                raise ExprError(f"pi is not allowed in a {self.what} outside sin/cos (it is "
+                                "not algebraic; coefficients must be exact algebraic numbers)",
+                                node.column)
+            return self.pi
+        if name not in self.names:
+            declared = ", ".join(sorted(self.names)) or "none"
+            raise ExprError(f"undeclared name {name!r} (declared: {declared})", node.column)
+        value = self.names[name]
+        if isinstance(value, Constant):
+            if value.pi_coefficient:
+                if self.pi is None:
+                    raise ExprError(f"parameter {name!r} contains pi, which is allowed only "
+                                    "inside sin/cos or in an angle", node.column)
+                return self.lift(_simplify(value.surd), node) + self.pi * fmpq(
+                    value.pi_coefficient.numerator, value.pi_coefficient.denominator)
+            return _simplify(value.surd)
+        return value
+
+    def _call(self, node: Node):
+        if node.value == "sqrt":
+            arg = _simplify(self.run(node.args[0]))
+            q = _constant_of(arg)
+            if q is None:
+                raise ExprError("sqrt takes a rational constant (e.g. sqrt(3), sqrt(3/4))",
+                                node.column)
+            if q < 0:
+                raise ExprError("sqrt of a negative number is not real", node.column)
+            try:
+                return _simplify(Surd.sqrt(q))
+            except ValueError as e:
+                raise ExprError(str(e), node.column) from None
+        if self.call is None or node.value not in FUNCTIONS:
+            if node.value in FUNCTIONS:
+                raise ExprError(f"{node.value} is not allowed in a {self.what}: it must be "
+                                "polynomial", node.column)
+            raise ExprError(f"unknown function {node.value!r} (only sin, cos and sqrt)",
+                            node.column)
+        return self.call(node)
 
     def run(self, node: Node):
         k = node.kind
         if k == "num":
             return node.value
         if k == "name":
-            if node.value == "pi":
-                raise ExprError(f"pi is not allowed in a {self.what} (coefficients must be "
-                                "rational)", node.column)
-            if node.value not in self.names:
-                declared = ", ".join(sorted(self.names)) or "none"
-                raise ExprError(f"undeclared name {node.value!r} (declared: {declared})",
-                                node.column)
-            return self.names[node.value]
+            return self._name(node)
         if k == "call":
-            if self.call is None or node.value not in FUNCTIONS:
-                if node.value in FUNCTIONS:
-                    raise ExprError(f"{node.value} is not allowed in a {self.what}: it must be "
-                                    "polynomial", node.column)
-                raise ExprError(f"unknown function {node.value!r} (only sin and cos, in "
-                                "trajectories)", node.column)
-            return self.call(node)
+            return self._call(node)
         args = [self.run(a) for a in node.args]
         if k == "neg":
             return -args[0]
         if k == "pow":
-            e = _exponent(node.args[1], _constant_of(args[1]) if not isinstance(
-                args[1], Fraction) else args[1])
+            e = _exponent(node.args[1], _constant_of(args[1]))
             _check_power(args[0], e, node)
-            return _checked(args[0] ** e, node)
+            return _simplify(_checked(args[0] ** e, node))
         a, b = args
-        if k == "add":
-            return a + b if isinstance(a, Fraction) and isinstance(b, Fraction) \
-                else self.lift(a) + self.lift(b)
-        if k == "sub":
-            return a - b if isinstance(a, Fraction) and isinstance(b, Fraction) \
-                else self.lift(a) - self.lift(b)
-        if k == "mul":
-            if not (isinstance(a, Fraction) or isinstance(b, Fraction)) and \
-                    a.total_degree() + b.total_degree() > MAX_DEGREE:
+        if k in ("add", "sub", "mul"):
+            if _scalar(a) and _scalar(b):
+                value = a + b if k == "add" else a - b if k == "sub" else a * b
+                return _simplify(_checked(value, node))
+            a, b = self.lift(a, node), self.lift(b, node)
+            if k == "add":
+                return a + b
+            if k == "sub":
+                return a - b
+            if a.total_degree() + b.total_degree() > MAX_DEGREE:
                 raise ExprError(f"the expression's degree exceeds {MAX_DEGREE}", node.column)
-            return _checked(a * b if isinstance(a, Fraction) and isinstance(b, Fraction)
-                            else self.lift(a) * self.lift(b), node)
+            return _checked(a * b, node)
         if k == "div":
-            d = _constant_of(b)
+            d = b if isinstance(b, Surd) else _constant_of(b)
             if d is None:
                 raise ExprError(f"division by a non-constant expression is not polynomial in "
                                 f"a {self.what}", node.column)
-            if d == 0:
+            if not d:
                 raise ExprError("division by zero", node.column)
+            if isinstance(d, Surd) or isinstance(a, Surd):
+                inverse = Surd.rational(1) / d if isinstance(d, Surd) else \
+                    Surd.rational(1 / d)
+                if _scalar(a):
+                    return _simplify(_checked(a * inverse, node))
+                return a * self.lift(_simplify(inverse), node)
             if isinstance(a, Fraction):
                 return a / d
             return a / fmpq(d.numerator, d.denominator)
@@ -363,6 +449,8 @@ class _Compiler:
 
 def _check_power(base, e: int, node: Node) -> None:
     """Refuse a power before computing it when its size would explode."""
+    if isinstance(base, Surd):
+        return  # e ≤ MAX_EXPONENT and the terms stay few (one per squarefree product)
     if isinstance(base, Fraction):
         bits = max(abs(base.numerator).bit_length(), base.denominator.bit_length())
         if bits * e > MAX_BITS:
@@ -383,47 +471,244 @@ def _checked(value, node: Node):
     if isinstance(value, Fraction):
         if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) > MAX_BITS:
             raise ExprError("a number in the expression is too large", node.column)
+    elif isinstance(value, Surd):
+        for q in value.terms.values():
+            _checked(q, node)
     elif len(value) > MAX_TERMS:
         raise ExprError(f"the expanded expression has more than {MAX_TERMS} terms",
                         node.column)
     return value
 
 
+def angles_in(node: Node, names) -> set[str]:
+    """The names among ``names`` used inside a sin/cos argument: the angles."""
+    out: set[str] = set()
+
+    def walk(n: Node, inside: bool) -> None:
+        if n.kind == "name" and inside and n.value in names:
+            out.add(n.value)
+        for a in n.args:
+            walk(a, inside or (n.kind == "call" and n.value in ("sin", "cos")))
+
+    walk(node, False)
+    return out
+
+
+_ARGUMENT_FORM = ("the argument of sin/cos must be an integer combination of angles plus a "
+                  "multiple of pi/12 (e.g. cos(2*theta + pi/3))")
+
+
+def _linear_argument(node: Node, angles, parameters) -> tuple[dict[str, int], Fraction]:
+    """``({angle: k}, q)`` with the argument = Σ k·angle + q·π (k integers, 12q integer)."""
+    ring = fmpq_mpoly_ctx.get((*sorted(angles), "pi"), "lex")
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    pi = gens.pop("pi")
+    value = _Compiler(ring, {**parameters, **gens}, what="sin/cos argument", pi=pi).run(node)
+    value = _Compiler(ring, {}).lift(value, node)
+    coefficients: dict[str, int] = {}
+    q = Fraction(0)
+    for exps, coeff in value.terms():
+        c = Fraction(int(coeff.p), int(coeff.q))
+        if sum(exps) != 1:
+            raise ExprError(_ARGUMENT_FORM, node.column)
+        name = ring.names()[exps.index(1)]
+        if name == "pi":
+            q = c
+        elif c.denominator != 1:
+            raise ExprError(_ARGUMENT_FORM, node.column)
+        else:
+            coefficients[name] = int(c)
+    if (12 * q).denominator != 1:
+        raise ExprError("only multiples of pi/12 have exact sines and cosines here (e.g. "
+                        "theta + pi/4)", node.column)
+    if sum(abs(k) for k in coefficients.values()) > MAX_EXPONENT:
+        raise ExprError(f"the multiples in a sin/cos argument add up to more than "
+                        f"{MAX_EXPONENT}", node.column)
+    return coefficients, q
+
+
 def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmpq_mpoly],
-                       parameters: dict[str, Fraction]) -> fmpq_mpoly:
-    """The exact polynomial of ``node`` in ``ctx`` (parameters substituted)."""
-    compiler = _Compiler(ctx, {**parameters, **variables}, what="constraint")
-    return compiler.lift(compiler.run(node))
+                       parameters: dict[str, object],
+                       angles: dict[str, tuple[fmpq_mpoly, fmpq_mpoly]] | None = None
+                       ) -> fmpq_mpoly:
+    """The exact polynomial of ``node`` in ``ctx`` (parameters substituted).
 
+    ``angles[v] = (cos(v), sin(v))`` are the ring's variables of each angle v: ``sin`` and
+    ``cos`` of integer combinations of angles plus multiples of π/12 are expanded exactly
+    and reduced modulo cos² + sin² = 1; a bare angle is refused.  Square roots become
+    the ring's ``sqrt(p)`` variables (reduced modulo sqrt(p)² = p).
+    """
+    angles = angles or {}
 
-def _multiple_of(node: Node, parameter: str) -> int:
-    """k when ``node`` is k·parameter for an integer k (else ExprError)."""
-    try:
-        p = _Compiler(TRIG, {parameter: T}, what="sin/cos argument").run(node)
-    except ExprError:
-        p = None
-    terms = dict(p.terms()) if p is not None and not isinstance(p, Fraction) else {}
-    if set(terms) == {(1, 0, 0)}:
-        coeff = fmpq(terms[(1, 0, 0)])
-        if coeff.q == 1:
-            return int(coeff.p)
-    raise ExprError(f"the argument of sin/cos must be an integer multiple of {parameter} "
-                    f"(e.g. 3*{parameter})", node.column)
-
-
-def compile_trajectory_coordinate(node: Node, parameter: str,
-                                  parameters: dict[str, Fraction]) -> fmpq_mpoly:
-    """The trig polynomial (in ``TRIG``, reduced) of a trajectory coordinate."""
+    def constant(value: Surd):
+        return compiler.lift(_simplify(value))
 
     def call(n: Node):
-        k = _multiple_of(n.args[0], parameter)
+        coefficients, q = _linear_argument(n.args[0], angles, parameters)
+        c, s = expand_trig(coefficients, q, angles, constant)
+        return c if n.value == "cos" else s
+
+    forbidden = {v: f"{v!r} is an angle (it appears inside sin/cos): use it only through "
+                    f"sin({v}) and cos({v})" for v in angles}
+    compiler = _Compiler(ctx, {**parameters, **variables}, call, what="constraint",
+                         surd=lambda v: surd_polynomial(v, ctx), forbidden=forbidden)
+    return reduce_relations(compiler.lift(compiler.run(node), node))
+
+
+def compile_value(node: Node, parameters: dict[str, object]) -> Constant:
+    """The exact value ``surd + q·π`` of a constant expression (a parameter's value):
+    numbers, earlier parameters, ``pi``, ``sqrt`` of rationals, sin/cos of multiples of
+    π/12, ``+ - * / ^``."""
+    k = node.kind
+    if k == "num":
+        return Constant(Surd.rational(node.value))
+    if k == "name":
+        if node.value == "pi":
+            return Constant(Surd(), Fraction(1))
+        if node.value not in parameters:
+            raise ExprError(f"{node.value!r} is not allowed here: use numbers, pi, sqrt and "
+                            "parameters defined above", node.column)
+        v = parameters[node.value]
+        return v if isinstance(v, Constant) else Constant(Surd.rational(v))
+    if k == "call":
+        arg = compile_value(node.args[0], parameters)
+        if node.value == "sqrt":
+            if arg.pi_coefficient or not arg.surd.is_rational():
+                raise ExprError("sqrt takes a rational constant (e.g. sqrt(3))", node.column)
+            if arg.surd.rational_value() < 0:
+                raise ExprError("sqrt of a negative number is not real", node.column)
+            return Constant(Surd.sqrt(arg.surd.rational_value()))
+        if node.value in FUNCTIONS:
+            if arg.surd:
+                raise ExprError("sin/cos of a constant must be of a multiple of pi/12 (e.g. "
+                                "sin(pi/3))", node.column)
+            value = (cos_pi if node.value == "cos" else sin_pi)(arg.pi_coefficient)
+            if value is None:
+                raise ExprError("only multiples of pi/12 have exact sines and cosines here",
+                                node.column)
+            return Constant(value)
+        raise ExprError(f"unknown function {node.value!r} (only sin, cos and sqrt)", node.column)
+    args = [compile_value(a, parameters) for a in node.args]
+    if k == "neg":
+        return Constant(-args[0].surd, -args[0].pi_coefficient)
+    if k in ("add", "sub"):
+        a, b = args
+        sign = 1 if k == "add" else -1
+        return Constant(a.surd + b.surd * sign, a.pi_coefficient + sign * b.pi_coefficient)
+    if k == "mul":
+        a, b = args
+        if a.pi_coefficient and b.pi_coefficient:
+            raise ExprError("pi^2 is not allowed: use a + b*pi", node.column)
+        if a.pi_coefficient:
+            a, b = b, a
+        if b.pi_coefficient and not a.surd.is_rational():
+            raise ExprError("pi times a square root is not supported", node.column)
+        factor = a.surd.rational_value() if b.pi_coefficient else Fraction(0)
+        return Constant(_checked(a.surd * b.surd, node), factor * b.pi_coefficient)
+    if k == "div":
+        a, b = args
+        if b.pi_coefficient or not b.surd:
+            raise ExprError("can only divide by a non-zero number without pi", node.column)
+        if a.pi_coefficient and not b.surd.is_rational():
+            raise ExprError("pi divided by a square root is not supported", node.column)
+        pi = a.pi_coefficient / b.surd.rational_value() if a.pi_coefficient else Fraction(0)
+        return Constant(_checked(a.surd / b.surd, node), pi)
+    if k == "pow":
+        base, e = args
+        if e.pi_coefficient or not e.surd.is_rational():
+            raise ExprError("exponents must be non-negative integers", node.column)
+        n = _exponent(node.args[1], e.surd.rational_value())
+        if base.pi_coefficient:
+            raise ExprError("powers of pi are not allowed: use a + b*pi", node.column)
+        if base.surd.is_rational():
+            _check_power(base.surd.rational_value(), n, node)
+        return Constant(_checked(base.surd ** n, node))
+    raise AssertionError(k)  # pragma: no cover
+
+
+def _multiple_of(node: Node, parameter: str, parameters) -> tuple[int, Fraction]:
+    """(k, q) when ``node`` is k·parameter + q·π for an integer k and 12q an integer."""
+    ring = fmpq_mpoly_ctx.get((parameter, "pi"), "lex")
+    t, pi = ring.gens()
+    try:
+        p = _Compiler(ring, {**parameters, parameter: t}, what="sin/cos argument",
+                      pi=pi).run(node)
+        p = _Compiler(ring, {}).lift(p, node)
+    except ExprError:
+        p = None
+    terms = {e: Fraction(int(c.p), int(c.q)) for e, c in p.terms()} if p is not None else {}
+    k, q = terms.pop((1, 0), Fraction(0)), terms.pop((0, 1), Fraction(0))
+    if not terms and k.denominator == 1 and (12 * q).denominator == 1 and (k or q):
+        return int(k), q
+    raise ExprError(f"the argument of sin/cos must be an integer multiple of {parameter} "
+                    f"(e.g. 3*{parameter}), plus a multiple of pi/12", node.column)
+
+
+def compile_trajectory_coordinate(node: Node, parameter: str, parameters,
+                                  ring: fmpq_mpoly_ctx = TRIG) -> fmpq_mpoly:
+    """The trig polynomial (in ``ring``: ``TRIG``, or ``TRIG`` with ``sqrt(p)``
+    variables, reduced) of a trajectory coordinate."""
+    t, s, c = ring.gens()[:3]
+
+    def constant(value: Surd):
+        return compiler.lift(_simplify(value))
+
+    def call(n: Node):
+        k, q = _multiple_of(n.args[0], parameter, parameters)
         if abs(k) > MAX_DEGREE:
             raise ExprError(f"the multiple {k} of {parameter} is larger than {MAX_DEGREE}",
                             n.column)
-        return sin_multiple(k) if n.value == "sin" else cos_multiple(k)
+        ck, sk = (_into(cos_multiple(k), ring), _into(sin_multiple(k), ring))
+        cq, sq = constant(cos_pi(q)), constant(sin_pi(q))
+        return ck * cq - sk * sq if n.value == "cos" else sk * cq + ck * sq
 
-    compiler = _Compiler(TRIG, {**parameters, parameter: T}, call, what="trajectory")
-    return reduce_trig(compiler.lift(compiler.run(node)))
+    compiler = _Compiler(ring, {**parameters, parameter: t}, call, what="trajectory",
+                         surd=lambda v: surd_polynomial(v, ring))
+    return _reduce_path(compiler.lift(compiler.run(node), node))
+
+
+def compile_angle_coordinate(node: Node, parameter: str, parameters,
+                             ring: fmpq_mpoly_ctx = TRIG) -> tuple[fmpq_mpoly, Fraction]:
+    """``(P, q)`` with an angle's trajectory coordinate = P(t, sin t, cos t) + q·π."""
+    names = ring.names()
+    ring_pi = fmpq_mpoly_ctx.get((*names, "pi"), "lex")
+    p = compile_trajectory_coordinate_with_pi(node, parameter, parameters, ring_pi)
+    q = Fraction(0)
+    rest = {}
+    for exps, coeff in p.terms():
+        if exps[-1] == 0:
+            rest[exps[:-1]] = coeff
+        elif exps[-1] == 1 and not any(exps[:-1]):
+            q = Fraction(int(coeff.p), int(coeff.q))
+        else:
+            raise ExprError("pi may only be added to an angle (e.g. t + pi/6)", node.column)
+    return ring.from_dict(rest), q
+
+
+def compile_trajectory_coordinate_with_pi(node, parameter, parameters, ring_pi):
+    """A trajectory coordinate in a ring whose last variable stands for π."""
+    t = ring_pi.gens()[0]
+    base = fmpq_mpoly_ctx.get(ring_pi.names()[:-1], "lex")
+
+    def call(n: Node):
+        inner = compile_trajectory_coordinate(n, parameter, parameters, base)
+        return ring_pi.from_dict({(*e, 0): c for e, c in inner.terms()})
+
+    compiler = _Compiler(ring_pi, {**parameters, parameter: t}, call, what="trajectory",
+                         surd=lambda v: surd_polynomial(v, ring_pi), pi=ring_pi.gens()[-1])
+    return _reduce_path(compiler.lift(compiler.run(node), node))
+
+
+def _into(p: fmpq_mpoly, ring: fmpq_mpoly_ctx) -> fmpq_mpoly:
+    """A ``TRIG`` polynomial in a ring whose first variables are t, s, c."""
+    if ring is TRIG:
+        return p
+    extra = (0,) * (ring.nvars() - 3)
+    return ring.from_dict({(*e, *extra): c for e, c in p.terms()})
+
+
+def _reduce_path(p: fmpq_mpoly) -> fmpq_mpoly:
+    return reduce_trig(p) if p.context() is TRIG else reduce_relations(p)
 
 
 def compile_constant(node: Node) -> LinearInPi:

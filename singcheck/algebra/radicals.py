@@ -1,0 +1,342 @@
+"""Exact algebraic numbers built from square roots, and angles as (cos, sin) pairs.
+
+**Numbers.**  A :class:`Surd` is an exact element of the multiquadratic field
+Q(√2, √3, √5, …): a finite sum Σ q_m·√m over squarefree integers m ≥ 1 with rational
+q_m.  The square roots of distinct squarefree integers are linearly independent over Q,
+so this representation is canonical: equality and the zero test are exact comparisons
+of the dictionaries.  Products use √a·√b = g·√(ab/g²) (g = gcd(a, b)); an inverse
+multiplies by the conjugate in one prime at a time (x·σₚ(x) no longer involves √p).
+
+**In polynomials** a surd becomes a polynomial in one variable ``sqrt(p)`` per prime p
+(√6 = sqrt(2)·sqrt(3)), reduced modulo ``sqrt(p)² = p``; :func:`norm_radicals` takes a
+polynomial back to Q by resultants with ``sqrt(p)² - p`` (the product over both signs of
+each root: every conjugate's zero set together).
+
+**Angles.**  An angle v enters a polynomial as ``cos(v)`` and ``sin(v)`` with
+``cos(v)² + sin(v)² = 1``; :func:`reduce_relations` keeps the representative of degree
+≤ 1 in each ``sin(v)`` (and ≤ 1 in each ``sqrt(p)``), so two reduced polynomials are
+equal on the circles exactly when they are equal.  ``cos(Σ kᵢvᵢ + qπ)`` is expanded
+exactly by :func:`expand_trig` (de Moivre), with ``cos(qπ)``, ``sin(qπ)`` exact surds
+when 12q is an integer (:func:`cos_pi`).
+
+>>> str(Surd.sqrt(Fraction(12)) * Surd.sqrt(Fraction(3)))
+'6'
+>>> str(cos_pi(Fraction(1, 12)))
+'1/4*sqrt(2) + 1/4*sqrt(6)'
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from fractions import Fraction
+
+from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
+
+MAX_RADICAND_BITS = 64
+_RADICAL = re.compile(r"sqrt\((\d+)\)\Z")
+
+
+def radical_name(p: int) -> str:
+    """The polynomial variable of √p (p prime)."""
+    return f"sqrt({p})"
+
+
+def radical_prime(name: str) -> int | None:
+    """p when ``name`` is the variable of √p, else None."""
+    m = _RADICAL.match(name)
+    return int(m.group(1)) if m else None
+
+
+def angle_names(v: str) -> tuple[str, str]:
+    """The polynomial variables of an angle: ``(cos(v), sin(v))``."""
+    return f"cos({v})", f"sin({v})"
+
+
+def _squarefree(n: int) -> tuple[int, int]:
+    """(k, m) with n = k²·m and m squarefree (n ≥ 1)."""
+    k, m = 1, 1
+    for p, e in fmpz(n).factor():
+        k *= int(p) ** (e // 2)
+        if e % 2:
+            m *= int(p)
+    return k, m
+
+
+def _primes(m: int) -> list[int]:
+    return [int(p) for p, _ in fmpz(m).factor()] if m > 1 else []
+
+
+class Surd:
+    """An exact element Σ q_m·√m of Q(√2, √3, …) (m squarefree, q_m ≠ 0)."""
+
+    __slots__ = ("terms",)
+
+    def __init__(self, terms: dict[int, Fraction] | None = None) -> None:
+        self.terms = {m: Fraction(q) for m, q in (terms or {}).items() if q}
+
+    @classmethod
+    def rational(cls, q) -> Surd:
+        return cls({1: Fraction(q)})
+
+    @classmethod
+    def sqrt(cls, q: Fraction) -> Surd:
+        """√q of a rational q ≥ 0, exactly (√(a/b) = √(ab)/b)."""
+        q = Fraction(q)
+        if q < 0:
+            raise ValueError("the square root of a negative number is not real")
+        if q == 0:
+            return cls()
+        n = q.numerator * q.denominator
+        if max(n.bit_length(), 1) > MAX_RADICAND_BITS:
+            raise ValueError(f"the radicand {q} is too large")
+        k, m = _squarefree(n)
+        return cls({m: Fraction(k, q.denominator)})
+
+    def is_rational(self) -> bool:
+        return set(self.terms) <= {1}
+
+    def rational_value(self) -> Fraction:
+        if not self.is_rational():
+            raise ValueError(f"{self} is not rational")
+        return self.terms.get(1, Fraction(0))
+
+    def primes(self) -> set[int]:
+        return {p for m in self.terms for p in _primes(m)}
+
+    def __bool__(self) -> bool:
+        return bool(self.terms)
+
+    def __eq__(self, other) -> bool:
+        if isinstance(other, (int, Fraction)):
+            other = Surd.rational(other)
+        return isinstance(other, Surd) and self.terms == other.terms
+
+    def __hash__(self) -> int:
+        return hash(frozenset(self.terms.items()))
+
+    def __neg__(self) -> Surd:
+        return Surd({m: -q for m, q in self.terms.items()})
+
+    def __add__(self, other) -> Surd:
+        other = _as_surd(other)
+        out = dict(self.terms)
+        for m, q in other.terms.items():
+            out[m] = out.get(m, Fraction(0)) + q
+        return Surd(out)
+
+    __radd__ = __add__
+
+    def __sub__(self, other) -> Surd:
+        return self + (-_as_surd(other))
+
+    def __rsub__(self, other) -> Surd:
+        return _as_surd(other) - self
+
+    def __mul__(self, other) -> Surd:
+        other = _as_surd(other)
+        out: dict[int, Fraction] = {}
+        for a, p in self.terms.items():
+            for b, q in other.terms.items():
+                g = math.gcd(a, b)
+                m = (a // g) * (b // g)
+                out[m] = out.get(m, Fraction(0)) + p * q * g
+        return Surd(out)
+
+    __rmul__ = __mul__
+
+    def conjugate(self, p: int) -> Surd:
+        """σₚ: √p ↦ -√p."""
+        return Surd({m: (-q if m % p == 0 else q) for m, q in self.terms.items()})
+
+    def inverse(self) -> Surd:
+        if not self:
+            raise ZeroDivisionError("division by zero")
+        x, factor = self, Surd.rational(1)
+        while not x.is_rational():
+            p = min(x.primes())
+            c = x.conjugate(p)
+            factor, x = factor * c, x * c
+        return factor * Surd.rational(1 / x.rational_value())
+
+    def __truediv__(self, other) -> Surd:
+        return self * _as_surd(other).inverse()
+
+    def __rtruediv__(self, other) -> Surd:
+        return _as_surd(other) * self.inverse()
+
+    def __pow__(self, e: int) -> Surd:
+        out, base = Surd.rational(1), self
+        while e:
+            if e & 1:
+                out = out * base
+            base, e = base * base, e >> 1
+        return out
+
+    def ball(self) -> arb:
+        """A rigorous enclosure at the current working precision."""
+        total = arb(0)
+        for m, q in self.terms.items():
+            total += arb(fmpq(q.numerator, q.denominator)) * arb(m).sqrt()
+        return total
+
+    def __float__(self) -> float:
+        return float(sum(float(q) * math.sqrt(m) for m, q in self.terms.items()))
+
+    def __str__(self) -> str:
+        if not self.terms:
+            return "0"
+        parts = []
+        for m in sorted(self.terms):
+            q = self.terms[m]
+            if m == 1:
+                parts.append(str(q))
+            else:
+                coeff = "" if q == 1 else "-" if q == -1 else f"{q}*"
+                parts.append(f"{coeff}sqrt({m})")
+        return " + ".join(parts).replace("+ -", "- ")
+
+    __repr__ = __str__
+
+
+def _as_surd(x) -> Surd:
+    return x if isinstance(x, Surd) else Surd.rational(x)
+
+
+def cos_pi(q: Fraction) -> Surd | None:
+    """cos(qπ) exactly when 12q is an integer (the angles with surd cosines we use)."""
+    q = Fraction(q)
+    if (12 * q).denominator != 1:
+        return None
+    j = int(12 * q) % 24
+    if j > 12:
+        j = 24 - j  # cos is even and 2π-periodic
+    sign = 1
+    if j > 6:
+        j, sign = 12 - j, -1  # cos(π - x) = -cos x
+    table = {0: Surd.rational(1),
+             1: (Surd.sqrt(Fraction(6)) + Surd.sqrt(Fraction(2))) / 4,
+             2: Surd.sqrt(Fraction(3)) / 2,
+             3: Surd.sqrt(Fraction(2)) / 2,
+             4: Surd.rational(Fraction(1, 2)),
+             5: (Surd.sqrt(Fraction(6)) - Surd.sqrt(Fraction(2))) / 4,
+             6: Surd()}
+    return table[j] * sign
+
+
+def sin_pi(q: Fraction) -> Surd | None:
+    """sin(qπ) = cos((1/2 - q)π), exactly when 12q is an integer."""
+    return cos_pi(Fraction(1, 2) - Fraction(q))
+
+
+def surd_polynomial(value: Surd, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
+    """``value`` as a polynomial in the ``sqrt(p)`` variables of ``ctx``."""
+    names = ctx.names()
+    out = ctx.from_dict({})
+    for m, q in value.terms.items():
+        term = ctx.from_dict({(0,) * ctx.nvars(): fmpq(q.numerator, q.denominator)})
+        for p in _primes(m):
+            name = radical_name(p)
+            if name not in names:
+                raise ValueError(f"√{p} has no variable in this ring")
+            term *= ctx.gens()[names.index(name)]
+        out += term
+    return out
+
+
+def radical_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
+    """[(index, p)] for every ``sqrt(p)`` variable of ``ctx``."""
+    out = []
+    for i, name in enumerate(ctx.names()):
+        p = radical_prime(name)
+        if p is not None:
+            out.append((i, p))
+    return out
+
+
+def angle_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
+    """[(cos index, sin index)] for every angle pair ``cos(v)``, ``sin(v)`` of ``ctx``."""
+    names = ctx.names()
+    out = []
+    for i, name in enumerate(names):
+        if name.startswith("cos(") and name.endswith(")"):
+            partner = "sin(" + name[4:]
+            if partner in names:
+                out.append((i, names.index(partner)))
+    return out
+
+
+def reduce_relations(p: fmpq_mpoly) -> fmpq_mpoly:
+    """The representative of ``p`` modulo ``cos(v)² + sin(v)² = 1`` (each angle of its
+    ring) and ``sqrt(q)² = q`` (each radical): degree ≤ 1 in every ``sin(v)`` and
+    every ``sqrt(q)``.  A polynomial without those variables is returned unchanged."""
+    ctx = p.context()
+    angles = angle_variables(ctx)
+    radicals = radical_variables(ctx)
+    degrees = p.degrees()
+    if all(degrees[s] < 2 for _, s in angles) and all(degrees[i] < 2 for i, _ in radicals):
+        return p
+    groups: dict[tuple[int, ...], dict[tuple[int, ...], fmpq]] = {}
+    for exps, coeff in p.terms():
+        e = list(exps)
+        halves = []
+        for _, s in angles:
+            halves.append(e[s] // 2)
+            e[s] %= 2
+        for i, q in radicals:
+            coeff = coeff * fmpq(q) ** (e[i] // 2)
+            e[i] %= 2
+        bucket = groups.setdefault(tuple(halves), {})
+        bucket[tuple(e)] = bucket.get(tuple(e), fmpq(0)) + coeff
+    gens = ctx.gens()
+    one = ctx.from_dict({(0,) * ctx.nvars(): 1})
+    out = ctx.from_dict({})
+    for halves, terms in groups.items():
+        factor = one
+        for (c, _), h in zip(angles, halves, strict=True):
+            if h:
+                factor *= (1 - gens[c] ** 2) ** h
+        out += ctx.from_dict({k: v for k, v in terms.items() if v != 0}) * factor
+    return out
+
+
+def norm_radicals(p: fmpq_mpoly) -> fmpq_mpoly:
+    """∏ of ``p`` over both signs of every ``sqrt(q)`` it involves (resultants with
+    ``sqrt(q)² - q``), reduced: a polynomial free of radicals whose zero set is the
+    union of the conjugates' zero sets."""
+    ctx = p.context()
+    names = ctx.names()
+    for i, q in radical_variables(ctx):
+        if p.degrees()[i] == 0:
+            continue
+        r = ctx.gens()[i]
+        p = reduce_relations(p.resultant(r * r - q, names[i]))
+    return p
+
+
+def radical_balls(ctx: fmpq_mpoly_ctx, signs: dict[int, int] | None = None) -> dict[int, arb]:
+    """index → ball of ±√q for every radical variable (``signs``: prime → ±1)."""
+    signs = signs or {}
+    return {i: arb(q).sqrt() * signs.get(q, 1) for i, q in radical_variables(ctx)}
+
+
+def expand_trig(coefficients: dict[str, int], pi_part: Fraction,
+                pairs: dict[str, tuple[fmpq_mpoly, fmpq_mpoly]],
+                constant) -> tuple[fmpq_mpoly, fmpq_mpoly]:
+    """``(cos θ, sin θ)`` for θ = Σ kᵥ·v + qπ, exactly (de Moivre):
+    e^{iθ} = ∏ (cos v + i sin v)^{kᵥ} · (cos qπ + i sin qπ); ``pairs[v]`` is
+    ``(cos(v), sin(v))`` and ``constant`` turns a surd into a ring element."""
+    re_, im = constant(cos_pi(pi_part)), constant(sin_pi(pi_part))
+    for v, k in sorted(coefficients.items()):
+        c, s = pairs[v]
+        if k < 0:
+            s, k = -s, -k
+        pr, pi_ = constant(Surd.rational(1)), constant(Surd())
+        base_r, base_i = c, s
+        while k:
+            if k & 1:
+                pr, pi_ = pr * base_r - pi_ * base_i, pr * base_i + pi_ * base_r
+            base_r, base_i = base_r * base_r - base_i * base_i, 2 * base_r * base_i
+            k >>= 1
+        re_, im = re_ * pr - im * pi_, re_ * pi_ + im * pr
+    return reduce_relations(re_), reduce_relations(im)

@@ -1,0 +1,189 @@
+"""The robot drawn at the start of a path and at each of its proven singular times.
+
+What is drawn is the robot spec's ``drawing`` key: bodies of segments and points whose
+coordinates are exact polynomials in the joints and the pose.  A posture evaluates them
+in Arb ball arithmetic at the pose φ(t) and at the joints of one working mode (its IK
+branch per leg, :meth:`~singcheck.certify.path.LegAlongPath.branches`), at the
+certified enclosure of the time; the picture takes the balls' midpoints.  The times and
+the mode come from the certified report: the start of the range, and each singular time
+of each feasible mode (a candidate proven singular in that mode, so a *real*
+singularity).  Nothing here decides anything.
+
+The path is traced by every drawn point that depends on the pose only (the end
+effector, say), sampled in floats.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from flint import acb, arb
+
+from singcheck.algebra.intervals import evaluate
+from singcheck.algebra.trig import evaluate_trig
+from singcheck.certify.classification import TrajectoryReport
+from singcheck.certify.path import compose_pose
+from singcheck.spec.files import RobotSpec
+
+
+@dataclass
+class DrawnBody:
+    name: str
+    chains: list[np.ndarray]  # each (n ≥ 2, dim): segments joined in turn
+    points: np.ndarray  # (m, dim), possibly empty
+    fixed: bool = False  # no joint or pose variable in it (a rail, a base)
+
+
+@dataclass
+class Posture:
+    t: float  # midpoint of the certified time enclosure
+    t_interval: tuple[float, float]
+    mode: str
+    kind: str  # start | singular
+    feasible: bool
+    bodies: list[DrawnBody]
+
+
+def _mid(value) -> float:
+    if isinstance(value, acb):
+        value = value.real
+    return float(arb(value).mid())
+
+
+def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:
+    """The drawing at these joint and pose values (balls, or anything ``arb`` takes)."""
+    values = [v if isinstance(v, (arb, acb)) else arb(v) for v in (*joints, *pose)]
+
+    def point(coords) -> list[float]:
+        return [_mid(evaluate(c, values)) for c in coords]
+
+    dim = spec.drawing_dimension or 0
+    return [DrawnBody(body.name,
+                      [np.array([point(p) for p in chain]) for chain in body.chains],
+                      np.array([point(p) for p in body.points]).reshape(-1, dim),
+                      all(c.is_constant() for p in (*body.points, *sum(body.chains, ()))
+                          for c in p))
+            for body in spec.drawing]
+
+
+def joints_at(report: TrajectoryReport, label: str, t: arb) -> list | None:
+    path = report.path
+    per_leg = [leg.branches(t) for leg in path.legs]
+    joints = [per_leg[i][ch] for i, ch in enumerate(label)]
+    return None if any(j is None or isinstance(j, acb) for j in joints) else joints
+
+
+def postures(report: TrajectoryReport) -> list[Posture]:
+    """The start posture and one per proven singular time, for each feasible mode (for
+    a path with no feasible mode: the start posture of the first mode real there)."""
+    spec = report.path.projection.model.spec
+    if not spec.drawing:
+        return []
+    start = report.path.trajectory.range.start.ball()
+    feasible = [m for m in report.modes if m.feasible]
+    if not feasible:
+        feasible = [m for m in report.modes if joints_at(report, m.label, start)][:1]
+    out = []
+    for mode in feasible:
+        times = [("start", start)] + [("singular", c.t) for c in mode.singular_times]
+        for kind, t in times:
+            joints = joints_at(report, mode.label, t)
+            if joints is None:  # the branch's reality is not proven on this ball
+                continue
+            bodies = draw_bodies(spec, joints, report.path.pose_at(t))
+            out.append(Posture(_mid(t), (float(t.lower()), float(t.upper())), mode.label,
+                               kind, mode.feasible, bodies))
+    return out
+
+
+def traced_points(report: TrajectoryReport, t: np.ndarray) -> list[np.ndarray]:
+    """Each distinct drawn point that moves with the pose alone, sampled along the path:
+    arrays of shape (len(t), dim)."""
+    spec = report.path.projection.model.spec
+    model = report.path.projection.model
+    joint_index = [spec.context.names().index(j) for j in model.joints]
+    times = [arb(float(x)) for x in t]
+    seen, out = set(), []
+    for body in spec.drawing:
+        for p in (*body.points, *(q for chain in body.chains for q in chain)):
+            if any(c.degrees()[i] for c in p for i in joint_index) or \
+                    all(c.is_constant() for c in p) or tuple(map(str, p)) in seen:
+                continue
+            seen.add(tuple(map(str, p)))
+            along = [compose_pose(c, report.path.phi, model.pose) for c in p]
+            out.append(np.array([[_mid(evaluate_trig(c, x)) for c in along] for x in times]))
+    return out
+
+
+_SINGULAR = "#d62728"
+
+
+def drawing_box(drawings: list[list[DrawnBody]], traces: list[np.ndarray]) -> np.ndarray:
+    """One cube (dim × [lo, hi]) holding every drawn point and trace, a margin around."""
+    pts = [b.points for bodies in drawings for b in bodies] + \
+        [c for bodies in drawings for b in bodies for c in b.chains] + traces
+    allp = np.concatenate([q for q in pts if len(q)])
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2, 0.5) * 1.08
+    return np.stack([centre - half, centre + half], axis=1)
+
+
+def posture_figure(plt, report: TrajectoryReport, title: str, samples: int = 600):
+    """One panel per posture: the bodies, the traced path, the posture's point on it."""
+    posts = postures(report)
+    if not posts:
+        return None
+    spec = report.path.projection.model.spec
+    dim = spec.drawing_dimension
+    axes = report.path.projection.model.pose  # named when they are the drawing's axes
+    lo, hi = float(report.path.trajectory.range.start), float(report.path.trajectory.range.end)
+    traces = traced_points(report, np.linspace(lo, hi, samples))
+    box = drawing_box([p.bodies for p in posts], traces)
+    n = len(posts)
+    cols = min(n, 3)
+    rows = -(-n // cols)
+    fig = plt.figure(figsize=(4.2 * cols, 4.0 * rows + 0.4))
+    colours = plt.get_cmap("tab10").colors
+    for k, post in enumerate(posts):
+        ax = fig.add_subplot(rows, cols, k + 1, **({"projection": "3d"} if dim == 3 else {}))
+        singular = post.kind == "singular"
+        for trace in traces:
+            ax.plot(*trace.T, color="grey", lw=0.8, ls="--")
+        moving = 0
+        for body in post.bodies:
+            colour = "0.45" if body.fixed else colours[moving % len(colours)]
+            moving += not body.fixed
+            for chain in body.chains:
+                if singular and not body.fixed:  # the singular posture: a red halo
+                    ax.plot(*chain.T, color=_SINGULAR, lw=7, alpha=0.3, solid_capstyle="round")
+                ax.plot(*chain.T, color=colour, lw=1.4 if body.fixed else 2.4,
+                        label=body.name if chain is body.chains[0] else None)
+            if len(body.points):
+                ax.plot(*body.points.T, ls="none", marker="o", ms=6, color=colour,
+                        markeredgecolor=_SINGULAR if singular else "black",
+                        label=None if body.chains else body.name)
+        what = "singular" if singular else "start"
+        mode = post.mode + ("" if post.feasible else " (infeasible)")
+        ax.set_title(f"{what} · t = {post.t:.6f} · mode {mode}", fontsize=9,
+                     color=_SINGULAR if singular else "black")
+        if len(axes) == dim:
+            ax.set_xlabel(axes[0], fontsize=8)
+            ax.set_ylabel(axes[1], fontsize=8)
+            if dim == 3:
+                ax.set_zlabel(axes[2], fontsize=8)
+        ax.set_xlim(*box[0])
+        ax.set_ylim(*box[1])
+        if dim == 3:
+            ax.set_zlim(*box[2])
+            ax.set_box_aspect((1, 1, 1))
+            ax.view_init(elev=22, azim=35)
+            ax.tick_params(labelsize=6)
+        else:
+            ax.set_aspect("equal")
+            ax.tick_params(labelsize=7)
+        if k == 0:
+            ax.legend(fontsize=7, loc="upper left")
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,118 @@
+"""The robot drawn at its singular postures: which panels, and that every drawn point is
+the spec's drawing at the model's joints and pose there, recomputed here independently
+(the YAML read by PyYAML, its expressions by SymPy, the IK solved and evaluated with
+50-digit mpmath)."""
+
+from __future__ import annotations
+
+import mpmath
+import pytest
+import sympy
+import yaml
+
+from singcheck import api
+from singcheck.report.postures import postures
+from tests.conftest import ROBOTS, TRAJECTORIES
+
+CASES = [("orthoglide", "heart1"), ("skew-biglide", "skew-biglide-ellipse")]
+
+
+@pytest.fixture(scope="module", params=CASES, ids=lambda c: c[1])
+def case(request):
+    robot_name, traj_name = request.param
+    robot = api.load_robot(ROBOTS / f"{robot_name}.yaml", backend="flint", cache=False)
+    traj = api.load_trajectory(TRAJECTORIES / f"{traj_name}.yaml", robot)
+    report = api.check(robot, traj, regions=False).certificate
+    return robot_name, traj_name, report
+
+
+def _sympy(text, names):
+    return sympy.parse_expr(str(text).replace("^", "**"), local_dict=names)
+
+
+def _independent(robot_name, traj_name, mode, t):
+    """The drawing's points at time t in working mode ``mode``, from the spec files."""
+    mpmath.mp.dps = 50
+    robot = yaml.safe_load((ROBOTS / f"{robot_name}.yaml").read_text())
+    traj = yaml.safe_load((TRAJECTORIES / f"{traj_name}.yaml").read_text())
+    names = {n: sympy.Symbol(n) for n in robot["joints"] + robot["pose"]}
+    params = {sympy.Symbol(k): sympy.Rational(str(v)) for k, v in
+              robot.get("parameters", {}).items()}
+    tt = sympy.Symbol("t")
+    values = {names[v]: sympy.N(_sympy(traj["pose"][v], {"t": tt}).subs(tt, mpmath.mpf(t)), 50)
+              for v in robot["pose"]}
+    for joint, constraint, branch in zip(robot["joints"], robot["constraints"], mode,
+                                         strict=True):
+        f = sympy.Poly(_sympy(constraint, names).subs(params), names[joint])
+        a, b, c = (sympy.N(f.coeff_monomial(names[joint] ** k).subs(values), 50)
+                   for k in (2, 1, 0))
+        root = mpmath.sqrt(mpmath.mpf(str(b * b - 4 * a * c)))
+        sign = 1 if branch == "+" else -1
+        values[names[joint]] = (-mpmath.mpf(str(b)) + sign * root) / (2 * mpmath.mpf(str(a)))
+    out = {}
+    for body, items in robot["drawing"].items():
+        pts = []
+        for item in items:
+            for p in (item if isinstance(item[0], list) else [item]):
+                pts.append([float(sympy.N(_sympy(e, names).subs(params).subs(values), 30))
+                            for e in p])
+        out[body] = pts
+    return out
+
+
+def test_one_panel_at_the_start_and_at_each_real_singular_time(case):
+    _, _, report = case
+    posts = postures(report)
+    real = sorted(float(c.t.mid()) for c in report.candidates if c.status == "real")
+    assert real, "the case must have real singularities"
+    assert [p.kind for p in posts] == ["start"] + ["singular"] * len(real)
+    assert [p.t for p in posts[1:]] == pytest.approx(real, abs=1e-12)
+    assert posts[0].t == pytest.approx(float(report.path.trajectory.range.start))
+    feasible = [m.label for m in report.modes if m.feasible]
+    assert {p.mode for p in posts} == set(feasible) and len(feasible) == 1
+
+
+def test_drawn_points_are_the_model_at_those_times(case):
+    robot_name, traj_name, report = case
+    for post in postures(report):
+        expected = _independent(robot_name, traj_name, post.mode, post.t)
+        for body in post.bodies:
+            drawn = [float(v) for chain in body.chains for p in chain for v in p] + \
+                [float(v) for p in body.points for v in p]
+            want = [v for p in expected[body.name] for v in p]
+            assert drawn == pytest.approx(want, abs=1e-7), (post.t, body.name)
+
+
+def test_at_a_singular_posture_the_legs_are_degenerate(case):
+    """Independent meaning of the picture: on the skew biglide the two legs are aligned
+    (their directions' cross product vanishes); on the Orthoglide the three leg
+    directions are coplanar (their determinant vanishes)."""
+    import numpy as np
+
+    _, _, report = case
+    for post in postures(report):
+        legs = next(b for b in post.bodies if b.name == "legs")
+        directions = np.array([c[1] - c[0] for c in legs.chains])
+        det = np.linalg.det(directions) if len(directions) == 3 else \
+            directions[0, 0] * directions[1, 1] - directions[0, 1] * directions[1, 0]
+        assert (abs(det) < 1e-7) == (post.kind == "singular"), (post.kind, det)
+
+
+def test_the_posture_figure_is_written_with_one_panel_per_posture(case, tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from singcheck.report.plots import write_figures
+    from singcheck.report.postures import posture_figure
+
+    _, traj_name, report = case
+    fig = posture_figure(plt, report, "t")
+    assert len(fig.axes) == len(postures(report))
+    titles = [ax.get_title() for ax in fig.axes]
+    assert titles[0].startswith("start · t = -3.141593 · mode")
+    assert all(t.startswith("singular · t = ") for t in titles[1:])
+    plt.close(fig)
+    files = write_figures(report, tmp_path, ("png",), dpi=40)
+    assert tmp_path / f"{traj_name}-postures.png" in files

@@ -23,8 +23,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from singcheck.budget import TimeLimitExceeded, deadline
-from singcheck.certify.classification import Candidate, TrajectoryReport, certify_path
-from singcheck.certify.path import PathModel, build_path
+from singcheck.certify.classification import Candidate, TrajectoryReport
+from singcheck.certify.path import PathModel
+from singcheck.certify.pieces import certify_trajectory
 from singcheck.certify.working_modes import WorkingMode
 from singcheck.elimination.projection import RobotProjection, project_robot
 from singcheck.model.robot import RobotModel, build_model
@@ -102,9 +103,11 @@ def load_robot(path: str, backend: str = "auto", *, timeout: float = 600.0,
                            notify=notify)
 
 
-def load_trajectory(path: str, robot: Robot) -> TrajectorySpec:
-    """Read a trajectory spec (YAML) for ``robot``: its pose variables are checked."""
-    return read_trajectory_spec(path, robot.spec)
+def load_trajectory(path: str, robot: Robot, interpolation: str | None = None) -> TrajectorySpec:
+    """Read a trajectory spec (YAML, or a CSV table of poses interpolated
+    ``interpolation``: linear or cubic, the default) for ``robot``: its pose variables
+    are checked."""
+    return read_trajectory_spec(path, robot.spec, interpolation)
 
 
 @dataclass
@@ -179,12 +182,12 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
     """
     with deadline(time_limit):
         try:
-            path = build_path(robot.projection, trajectory)
-            certificate = certify_path(path, tolerance)
+            certificate = certify_trajectory(robot.projection, trajectory, tolerance)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions:
+        if not regions or not _one_piece(trajectory):
             return Report(trajectory, certificate)
+        path = certificate.path
         from singcheck.spaces.path_regions import path_in_workspace
 
         mu_roots = ([c.t for c in certificate.candidates]
@@ -195,6 +198,12 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
         except TimeLimitExceeded as e:
             return Report(trajectory, certificate, time_limited=str(e))
         return Report(trajectory, certificate, where)
+
+
+def _one_piece(trajectory: TrajectorySpec) -> bool:
+    """Whether the workspace statement applies: one piece in the user's own time (the
+    regions of a multi-piece or rescaled path are not placed yet)."""
+    return not trajectory.segments and trajectory.time_scale is None
 
 
 # state inherited by forked workers (set just before the pool starts)
@@ -223,8 +232,9 @@ def check_batch(robot: Robot, trajectories: list[TrajectorySpec], *,
             if regions:
                 from singcheck.spaces.path_regions import prepare_region_maps
 
-                prepare_region_maps(robot.projection, trajectories, robot.region_cache,
-                                    notify)
+                prepare_region_maps(robot.projection,
+                                    [t for t in trajectories if _one_piece(t)],
+                                    robot.region_cache, notify)
             with multiprocessing.get_context("fork").Pool(jobs) as pool:
                 yield from pool.imap(_check_index, range(n),
                                      chunksize=max(1, n // (jobs * 16)))

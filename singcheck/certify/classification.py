@@ -37,6 +37,7 @@ from singcheck.certify.working_modes import (
 )
 from singcheck.roots.enclosures import IdenticallyZeroError, RealRoot
 from singcheck.roots.isolation import isolate_real_roots
+from singcheck.spec.files import TrajectorySpec
 
 SINGULAR, REGULAR = "singular", "regular"
 BY_ELIMINATION = "elimination"
@@ -64,6 +65,7 @@ class Candidate:
     joints: dict[str, dict[str, float | None]]  # feasible mode -> joint -> value
     modes: list[ModeAtCandidate]
     status: str = UNKNOWN  # real | spurious | unknown
+    segment: int = 1  # the piece of a multi-piece path it lies on (1 = the first)
 
     @property
     def t(self) -> arb:
@@ -84,10 +86,17 @@ class TrajectoryReport:
     root_method: str
     undecided: list = field(default_factory=list)  # (t ball, reason) left unproven
     mu_roots_complete: bool = False  # every root of μ isolated (the candidates are all)
+    spec: TrajectorySpec | None = None  # the whole path (None: path.trajectory)
+    pieces: list[TrajectoryReport] = field(default_factory=list)  # per segment, if several
+
+    @property
+    def trajectory(self) -> TrajectorySpec:
+        """The whole path's spec (all its segments)."""
+        return self.spec or self.path.trajectory
 
     @property
     def name(self) -> str:
-        return self.path.trajectory.name
+        return self.trajectory.name
 
 
 def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
@@ -203,12 +212,14 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
     undecided = [(b.t, b.reason) for b in isolation.undecided
                  if not _clear_undecided(path, modes, b)]
-    verdict, reason = _verdict(modes, candidates, undecided)
+    verdict, reason = verdict_of(modes, candidates, undecided)
     return TrajectoryReport(path, verdict, reason, candidates, modes, isolation.method,
                             undecided, not isolation.undecided)
 
 
-def _verdict(modes, candidates, undecided) -> tuple[str, str]:
+def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
+    """The verdict and its one-sentence reason from the modes' feasibility, the
+    classified candidates and what root isolation left undecided."""
     feasible = [m for m in modes if m.status == FEASIBLE]
     unsure = [m for m in modes if m.status == UNKNOWN]
     singular = [(m.label, c) for c in candidates for m in feasible

@@ -95,6 +95,9 @@ class PathModel:
 
 
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
+    """The model along one piece (a multi-piece path: one per ``trajectory.pieces``)."""
+    if trajectory.segments:
+        raise ValueError("build_path takes one piece: use trajectory.pieces")
     model = projection.model
     phi = tuple(trajectory.pose[v] for v in model.pose)
     if any(p.context() is not TRIG for p in phi):

@@ -125,8 +125,9 @@ def _everywhere(predicate, interval: TimeRange) -> bool:
     return True
 
 
-def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float):
-    """Status of both branches of a quadratic leg with respect to step 1."""
+def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when):
+    """Status of both branches of a quadratic leg with respect to step 1 (``when``
+    writes a time ball in the user's parameter)."""
     joint = leg.leg.joint
     if _everywhere(lambda t: evaluate_trig(leg.discriminant, t) > 0, interval):
         return FEASIBLE, "", None
@@ -136,7 +137,7 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float):
             "(serial singularity)", None
     if iso.roots:
         t = iso.roots[0].t
-        return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {float(t.mid()):.6g} " \
+        return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {when(t)} " \
             "(serial singularity: the path reaches the workspace boundary)", t
     for box in iso.undecided:
         if not evaluate_trig(leg.discriminant, box.t) > 0:
@@ -164,7 +165,7 @@ def _inside(value, lo, hi) -> bool | None:
 
 
 def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
-                   tolerance: float, crossings: dict) -> BranchFeasibility:
+                   tolerance: float, crossings: dict, when) -> BranchFeasibility:
     """Whether this branch stays strictly inside the joint limits along the whole path.
 
     ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
@@ -203,12 +204,12 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         if verdict is None:
             return BranchFeasibility(joint, label, UNKNOWN,
                                      f"could not place {joint} against its limits at "
-                                     f"t = {float(point):.6g}")
+                                     f"t = {when(point)}")
         if verdict is False:
             crossing = max((e for e in events if e < point), key=lambda b: b.mid(),
                            default=None)
             reason = f"{joint} is outside {bounds} from the start" if crossing is None else \
-                f"{joint} leaves {bounds} at t ≈ {float(crossing.mid()):.6g}"
+                f"{joint} leaves {bounds} at t ≈ {when(crossing)}"
             return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing)
     return BranchFeasibility(joint, label, FEASIBLE)
 
@@ -217,21 +218,25 @@ def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibili
     """Feasibility of every branch of every leg (outer list in joint order)."""
     interval = path.trajectory.range
     limits_of = path.projection.model.spec.joint_limits
+
+    def when(t: arb) -> str:
+        return f"{float(path.trajectory.to_global(arb(t)).mid()):.6g}"
+
     out = []
     for leg in path.legs:
         joint = leg.leg.joint
         if leg.leg.degree == 2:
-            status, reason, when = _leg_reality(leg, interval, tolerance)
+            status, reason, event = _leg_reality(leg, interval, tolerance, when)
         else:
-            status, reason, when = FEASIBLE, "", None
+            status, reason, event = FEASIBLE, "", None
         branches = []
         crossings: dict = {}
         for label in leg.labels:
             if status != FEASIBLE:
-                branches.append(BranchFeasibility(joint, label, status, reason, when))
+                branches.append(BranchFeasibility(joint, label, status, reason, event))
             elif joint in limits_of:
                 branches.append(_branch_limits(leg, label, interval, limits_of[joint],
-                                               tolerance, crossings))
+                                               tolerance, crossings, when))
             else:
                 branches.append(BranchFeasibility(joint, label, FEASIBLE))
         out.append(branches)

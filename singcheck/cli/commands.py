@@ -73,12 +73,17 @@ def cli() -> None:
               help="Processes certifying trajectories in parallel (used for more than 4).")
 @click.option("--plot", "plot_dir", type=click.Path(file_okay=False),
               help="Also write the figures (see `singcheck plot`) to this directory.")
+@click.option("--interpolation", type=click.Choice(["linear", "cubic"]), default="cubic",
+              show_default=True,
+              help="How a CSV table of poses (TRAJECTORY ending in .csv) is joined: straight "
+                   "lines, or the natural cubic spline through its rows.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
 def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs, plot_dir,
-        quiet, verbose) -> None:
-    """Certify each TRAJECTORY of ROBOT (YAML spec files).
+        interpolation, quiet, verbose) -> None:
+    """Certify each TRAJECTORY of ROBOT (YAML spec files; a trajectory may also be a
+    CSV table of poses).
 
     For every trajectory it prints the candidate singular times (certified
     enclosures of the roots of μ(t)), the pose and joints there, which working
@@ -97,7 +102,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     progress = Progress(quiet)
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
-                    verbose, progress, jobs, plot_dir)
+                    verbose, progress, jobs, plot_dir, interpolation)
     sys.exit(int(code))
 
 
@@ -110,12 +115,12 @@ def _exit_code(verdicts: list[str]) -> ExitCode:
 
 
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
-         progress, jobs, plot_dir=None):
+         progress, jobs, plot_dir=None, interpolation="cubic"):
     from singcheck import api
     from singcheck.spec.files import load_robot, load_trajectory
 
     spec = load_robot(robot)
-    specs = [load_trajectory(path, spec) for path in trajectories]
+    specs = [load_trajectory(path, spec, interpolation) for path in trajectories]
     engine = api.elimination_engine(backend_name, timeout, not no_cache, progress.note)
     with progress.status(f"projecting {spec.name} onto its workspace ({engine.name})"):
         machine = api.robot_from_spec(spec, cache=not no_cache, engine=engine)
@@ -180,6 +185,9 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
 
         spec = load_robot(robot)
         traj = load_trajectory(trajectory, spec) if trajectory else None
+        if traj is not None and traj.segments:
+            raise SpecError(f"project prints the formulas of a one-piece trajectory; this one "
+                            f"has {len(traj.segments)} segments", path=traj.path)
         engine = api.elimination_engine(backend, cache=False)
         machine = api.robot_from_spec(spec, cache=False, engine=engine)
         epsilon = None if no_epsilon else joint_space_singularities(machine.model, engine)

@@ -43,7 +43,13 @@ def candidate_json(report: TrajectoryReport, c) -> dict[str, Any]:
         "singular_modes": c.singular_modes,
         "status": c.status,
         "modes": [{"mode": m.mode, "status": m.status, "proof": m.proof} for m in c.modes],
+        "segment": c.segment,
     }
+
+
+def _range(spec) -> list[str]:
+    rng = spec.global_range
+    return [str(rng.start), str(rng.end)]
 
 
 def _trajectory_head(spec) -> dict[str, Any]:
@@ -51,8 +57,19 @@ def _trajectory_head(spec) -> dict[str, Any]:
         "name": spec.name,
         "path": spec.path,
         "parameter": spec.parameter,
-        "range": [str(spec.range.start), str(spec.range.end)],
+        "range": _range(spec),
     }
+
+
+def segments_json(report: TrajectoryReport) -> list[dict[str, Any]]:
+    """Per piece of the path (one for a one-piece path): its range in the user's
+    parameter, how its roots were isolated, and its time rescaling if any."""
+    pieces = report.pieces or [report]
+    return [{"segment": i, "range": _range(spec), "root_isolation": piece.root_method,
+             "time_scale": None if spec.time_scale is None else f"tau = {spec.time_scale}*pi*"
+                                                                 f"{spec.parameter}"}
+            for i, (spec, piece) in enumerate(zip(report.trajectory.pieces, pieces,
+                                                  strict=True), 1)]
 
 
 def time_limited_json(spec, reason: str) -> dict[str, Any]:
@@ -63,7 +80,7 @@ def time_limited_json(spec, reason: str) -> dict[str, Any]:
 
 def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
     return {
-        **_trajectory_head(report.path.trajectory),
+        **_trajectory_head(report.trajectory),
         "verdict": report.verdict,
         "reason": report.reason,
         "root_isolation": report.root_method,
@@ -80,6 +97,7 @@ def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
             for m in report.modes
         ],
         "undecided": [{"t_interval": _interval(t), "reason": r} for t, r in report.undecided],
+        "segments": segments_json(report),
     }
 
 
@@ -150,12 +168,14 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
 
     joints, pose = robot["joints"], robot["pose"]
     for t in trajectories:
+        segments = t.get("segments") or []
+        pieces = f", {len(segments)} segments" if len(segments) > 1 else ""
         title = (f"{robot['name']} · {t['name']}  ({t['parameter']} ∈ [{t['range'][0]}, "
-                 f"{t['range'][1]}], roots by {t['root_isolation']})")
+                 f"{t['range'][1]}]{pieces}, roots by {t['root_isolation']})")
         feasible = [m["label"] for m in t["working_modes"] if m["feasible"]]
         if t["candidates"]:
             table = Table(title=title, title_justify="left")
-            for col in ("#", t["parameter"], *pose,
+            for col in ("#", *(["segment"] if pieces else []), t["parameter"], *pose,
                         *[j + (f" [{feasible[0]}]" if feasible else "") for j in joints]):
                 table.add_column(col, justify="right")
             table.add_column("singular modes")
@@ -163,7 +183,8 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
             for i, c in enumerate(t["candidates"], 1):
                 shown = c["joints"].get(feasible[0], {}) if feasible else {}
                 style = {"real": "red", "spurious": "green"}.get(c["status"], "magenta")
-                table.add_row(str(i), _num(c["t"], 9), *[_num(c["pose"][v], 4) for v in pose],
+                table.add_row(str(i), *([str(c.get("segment", 1))] if pieces else []),
+                              _num(c["t"], 9), *[_num(c["pose"][v], 4) for v in pose],
                               *[_num(shown.get(j), 4) for j in joints],
                               ", ".join(c["singular_modes"]) or "none",
                               f"[{style}]{c['status']}[/{style}]")
@@ -193,6 +214,10 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
             lo, hi = u["t_interval"]
             console.print(f"  undecided for {t['parameter']} in [{lo:.9g}, {hi:.9g}]: "
                           f"{u['reason']}")
+        if pieces:
+            console.print("  segments: " + "; ".join(
+                f"{s['segment']}: [{s['range'][0]}, {s['range'][1]}] ({s['root_isolation']})"
+                for s in segments))
         if t.get("workspace"):
             console.print(workspace_line(t["workspace"]))
         style = _VERDICT_STYLE.get(t["verdict"], "bold")

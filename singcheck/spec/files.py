@@ -18,25 +18,34 @@ from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import restrict
 from singcheck.algebra.radicals import angle_names, radical_name, radical_variables
-from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
 from singcheck.errors import SpecError
 from singcheck.spec.grammar import (
     Constant,
     ExprError,
-    Node,
     angles_in,
-    compile_angle_coordinate,
     compile_constant,
     compile_polynomial,
-    compile_trajectory_coordinate,
     compile_value,
     parse,
 )
+from singcheck.spec.paths import multi_piece, parse_csv
+from singcheck.spec.trajectory import (
+    TrajectorySpec,
+    exactly_less,
+    pose_nodes,
+    radical_primes,
+    time_range,
+    trajectory_piece,
+)
+
+__all__ = ["RobotSpec", "TrajectorySpec", "load_robot", "load_trajectory", "parse_robot",
+           "parse_trajectory"]
 
 ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
               "parameters": False, "constraints": True, "joint_limits": False,
               "drawing": False}
-TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": True, "pose": True}
+TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": False, "pose": False,
+                   "segments": False, "waypoints": False, "interpolation": False}
 RESERVED = {"pi", "sin", "cos", "sqrt"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
@@ -97,18 +106,6 @@ class RobotSpec:
             for point in (*body.points, *(p for chain in body.chains for p in chain)):
                 return len(point)
         return None
-
-
-@dataclass(frozen=True)
-class TrajectorySpec:
-    path: str
-    name: str
-    parameter: str
-    range: TimeRange
-    pose: dict[str, fmpq_mpoly]  # pose variable -> TRIG polynomial, robot's pose order
-    lines: dict[str, int] = field(default_factory=dict)
-    #: an angle's coordinate is pose[v] + angle_offsets[v]·π (only angles have an entry)
-    angle_offsets: dict[str, Fraction] = field(default_factory=dict)
 
 
 class _Doc:
@@ -317,7 +314,7 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     angles = frozenset().union(*(angles_in(t, joints + pose) for t in trees))
     algebraic = [v for name in joints + pose
                  for v in (angle_names(name) if name in angles else (name,))]
-    primes = sorted(_radical_primes(parameters, trees))
+    primes = sorted(radical_primes(parameters, trees))
     wide = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in primes)), "lex")
     gens = dict(zip(wide.names(), wide.gens(), strict=True))
     variables = {v: gens[v] for v in joints + pose if v not in angles}
@@ -351,7 +348,7 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                 raise doc.error(vnode, key, "expected [min, max]")
             if jname in angles:
                 lo, hi = (doc.expression(v, key, compile_constant) for v in vnode.value)
-                if not _less(lo, hi):
+                if not exactly_less(lo, hi):
                     raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
             else:
                 lo, hi = (doc.number(v, key) for v in vnode.value)
@@ -366,29 +363,6 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     return RobotSpec(path, name, description, joints, pose, parameters, ctx,
                      tuple(constraints), tuple(constraint_lines), limits, lines,
                      angles=angles, radicals=used, drawing=drawing)
-
-
-def _radical_primes(parameters: dict, trees: list[Node]) -> set[int]:
-    """Every prime whose square root a compiled expression may need: those of the
-    parameters, of each ``sqrt(q)`` written inline, and 2 and 3 (the sines and
-    cosines of multiples of π/12)."""
-    primes = {2, 3}
-    for value in parameters.values():
-        if isinstance(value, Constant):
-            primes |= value.surd.primes()
-
-    def walk(node: Node) -> None:
-        if node.kind == "call" and node.value == "sqrt":
-            try:
-                primes.update(compile_value(node, parameters).surd.primes())
-            except ExprError:
-                pass  # the compiler reports it, with its column
-        for a in node.args:
-            walk(a)
-
-    for tree in trees:
-        walk(tree)
-    return primes
 
 
 def _drawing(doc: _Doc, node, ctx, variables, parameters,
@@ -454,27 +428,7 @@ def load_robot(path: str | os.PathLike) -> RobotSpec:
 # trajectories
 
 
-def _less(a: LinearInPi, b: LinearInPi) -> bool:
-    """Exactly a < b (π is irrational, so unequal values separate at some precision)."""
-    from singcheck.algebra.intervals import working_precision
-
-    if a == b:
-        return False
-    for bits in (64, 256, 1024, 4096):
-        with working_precision(bits):
-            d = b.ball() - a.ball()
-            if d > 0:
-                return True
-            if d < 0:
-                return False
-    raise AssertionError("unreachable: distinct a + bπ values separate")  # pragma: no cover
-
-
-def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
-    doc = _Doc(path)
-    top = doc.keys(_compose(text, path), TRAJECTORY_KEYS, "trajectory")
-    lines = {k: _line(knode) for k, (knode, _) in top.items()}
-    name = doc.text(top["name"][1], "name")
+def trajectory_parameter(doc: _Doc, top, robot: RobotSpec) -> str:
     pnode = top["parameter"][1]
     parameter = doc.text(pnode, "parameter")
     if not _IDENTIFIER.match(parameter) or parameter in RESERVED:
@@ -482,48 +436,35 @@ def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
     if parameter in robot.pose or parameter in robot.joints or parameter in robot.parameters:
         raise doc.error(pnode, "parameter",
                         f"{parameter!r} is already a name of robot {robot.name}")
+    return parameter
+
+
+def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
+    doc = _Doc(path)
+    root = _compose(text, path)
+    top = doc.keys(root, TRAJECTORY_KEYS, "trajectory")
+    lines = {k: _line(knode) for k, (knode, _) in top.items()}
+    name = doc.text(top["name"][1], "name")
+    parameter = trajectory_parameter(doc, top, robot)
+    if "segments" in top or "waypoints" in top or "interpolation" in top:
+        return multi_piece(doc, root, top, name, parameter, robot, lines)
+    for k in ("range", "pose"):
+        if k not in top:
+            raise doc.error(root, k, "missing required key in a trajectory spec (or give "
+                                     "segments or waypoints)")
     rnode = top["range"][1]
-    if not isinstance(rnode, yaml.SequenceNode) or len(rnode.value) != 2:
-        raise doc.error(rnode, "range", "expected [start, end], e.g. [-pi, pi]")
-    ends = []
-    for i, item in enumerate(rnode.value):
-        ends.append(doc.expression(item, f"range[{i}]", compile_constant))
-    start, end = ends
-    if not _less(start, end):
-        raise doc.error(rnode, "range", f"empty range: start {start} must be smaller than "
-                                        f"end {end}")
-    pose_map = doc.mapping(top["pose"][1], "pose")
-    missing = [v for v in robot.pose if v not in pose_map]
-    extra = [v for v in pose_map if v not in robot.pose]
-    if extra:
-        knode = pose_map[extra[0]][0]
-        raise doc.error(knode, f"pose.{extra[0]}",
-                        f"{extra[0]!r} is not a pose variable of robot {robot.name} "
-                        f"(pose: {', '.join(robot.pose)})")
-    if missing:
-        raise doc.error(top["pose"][0], "pose",
-                        f"missing coordinate(s) {', '.join(missing)} of robot {robot.name}")
-    trees = {v: doc.expression(pose_map[v][1], f"pose.{v}", lambda n: n) for v in robot.pose}
-    primes = sorted(_radical_primes(robot.parameters, list(trees.values())))
-    ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
-    coords, offsets = {}, {}
-    for v in robot.pose:
-        key = f"pose.{v}"
-        if v in robot.angles:
-            coords[v], offsets[v] = doc.expression(
-                pose_map[v][1], key,
-                lambda n: compile_angle_coordinate(n, parameter, robot.parameters, ring))
-        else:
-            coords[v] = doc.expression(
-                pose_map[v][1], key,
-                lambda n: compile_trajectory_coordinate(n, parameter, robot.parameters, ring))
-    used = [i for i, _ in radical_variables(ring)
-            if any(p.degrees()[i] > 0 for p in coords.values())]
-    names = ("t", "s", "c", *(ring.names()[i] for i in used))
-    small = TRIG if not used else fmpq_mpoly_ctx.get(names, "lex")
-    coords = {v: restrict(p, small) for v, p in coords.items()}
-    return TrajectorySpec(path, name, parameter, TimeRange(start, end), coords, lines, offsets)
+    rng = time_range(doc, rnode, "range")
+    nodes = pose_nodes(doc, top["pose"][1], "pose", robot, top["pose"][0])
+    rng, coords, scale, offsets = trajectory_piece(doc, rng, rnode, nodes, "pose", parameter,
+                                                   robot)
+    return TrajectorySpec(path, name, parameter, rng, coords, lines, offsets, scale)
 
 
-def load_trajectory(path: str | os.PathLike, robot: RobotSpec) -> TrajectorySpec:
-    return parse_trajectory(_read(path), os.fspath(path), robot)
+def load_trajectory(path: str | os.PathLike, robot: RobotSpec,
+                    interpolation: str | None = None) -> TrajectorySpec:
+    """A trajectory spec: YAML, or a CSV table of poses (``*.csv``) interpolated
+    ``interpolation`` (linear or cubic; default cubic)."""
+    p = os.fspath(path)
+    if p.lower().endswith(".csv"):
+        return parse_csv(_read(path), p, robot, interpolation or "cubic")
+    return parse_trajectory(_read(path), p, robot)

@@ -626,8 +626,8 @@ def compile_value(node: Node, parameters: dict[str, object]) -> Constant:
     raise AssertionError(k)  # pragma: no cover
 
 
-def _multiple_of(node: Node, parameter: str, parameters) -> tuple[int, Fraction]:
-    """(k, q) when ``node`` is k·parameter + q·π for an integer k and 12q an integer."""
+def _argument_terms(node: Node, parameter: str, parameters) -> dict | None:
+    """The argument of sin/cos as {(t-degree, π-degree): coefficient}, or None."""
     ring = fmpq_mpoly_ctx.get((parameter, "pi"), "lex")
     t, pi = ring.gens()
     try:
@@ -635,26 +635,59 @@ def _multiple_of(node: Node, parameter: str, parameters) -> tuple[int, Fraction]
                       pi=pi).run(node)
         p = _Compiler(ring, {}).lift(p, node)
     except ExprError:
-        p = None
-    terms = {e: Fraction(int(c.p), int(c.q)) for e, c in p.terms()} if p is not None else {}
+        return None
+    return {e: Fraction(int(c.p), int(c.q)) for e, c in p.terms()}
+
+
+def pi_multiples(node: Node, parameter: str, parameters=None) -> list[Fraction]:
+    """Every k of a sin/cos argument k·π·parameter (+ a multiple of π) in the tree, to pick
+    the rescaling τ = g·π·parameter under which each is an integer multiple of τ."""
+    out = []
+    if node.kind == "call" and node.value in FUNCTIONS and node.args:
+        terms = _argument_terms(node.args[0], parameter, parameters or {})
+        if terms and terms.get((1, 1)):
+            out.append(terms[(1, 1)])
+    for a in node.args:
+        out += pi_multiples(a, parameter, parameters)
+    return out
+
+
+def _multiple_of(node: Node, parameter: str, parameters,
+                 pi_scale: Fraction | None = None) -> tuple[int, Fraction]:
+    """(k, q) when ``node`` is k·parameter + q·π for an integer k and 12q an integer; on a
+    piece rescaled by τ = g·π·parameter (``pi_scale`` g), when it is (k·g)·π·parameter
+    + q·π = k·τ + q·π."""
+    terms = _argument_terms(node, parameter, parameters) or {}
     k, q = terms.pop((1, 0), Fraction(0)), terms.pop((0, 1), Fraction(0))
+    k_pi = terms.pop((1, 1), Fraction(0))
+    if k_pi and pi_scale is None or k and pi_scale is not None:
+        raise ExprError(f"sin/cos of k*{parameter} and of k*pi*{parameter} cannot be mixed "
+                        "in one piece (give each its own segment)", node.column)
+    if pi_scale is not None:
+        k = k_pi / pi_scale
     if not terms and k.denominator == 1 and (12 * q).denominator == 1 and (k or q):
         return int(k), q
     raise ExprError(f"the argument of sin/cos must be an integer multiple of {parameter} "
-                    f"(e.g. 3*{parameter}), plus a multiple of pi/12", node.column)
+                    f"or a rational multiple of pi*{parameter} (e.g. 3*{parameter}, "
+                    f"2*pi*{parameter}), plus a multiple of pi/12", node.column)
 
 
 def compile_trajectory_coordinate(node: Node, parameter: str, parameters,
-                                  ring: fmpq_mpoly_ctx = TRIG) -> fmpq_mpoly:
+                                  ring: fmpq_mpoly_ctx = TRIG,
+                                  pi_scale: Fraction | None = None) -> fmpq_mpoly:
     """The trig polynomial (in ``ring``: ``TRIG``, or ``TRIG`` with ``sqrt(p)``
-    variables, reduced) of a trajectory coordinate."""
+    variables, reduced) of a trajectory coordinate.
+
+    With ``pi_scale`` g the coordinate is written in τ = g·π·parameter: sin(k·π·t)
+    becomes sin((k/g)·τ) (k/g must be an integer), and a bare parameter is refused (it
+    would be τ/(gπ), not rational)."""
     t, s, c = ring.gens()[:3]
 
     def constant(value: Surd):
         return compiler.lift(_simplify(value))
 
     def call(n: Node):
-        k, q = _multiple_of(n.args[0], parameter, parameters)
+        k, q = _multiple_of(n.args[0], parameter, parameters, pi_scale)
         if abs(k) > MAX_DEGREE:
             raise ExprError(f"the multiple {k} of {parameter} is larger than {MAX_DEGREE}",
                             n.column)
@@ -662,17 +695,21 @@ def compile_trajectory_coordinate(node: Node, parameter: str, parameters,
         cq, sq = constant(cos_pi(q)), constant(sin_pi(q))
         return ck * cq - sk * sq if n.value == "cos" else sk * cq + ck * sq
 
+    forbidden = {} if pi_scale is None else {parameter: (
+        f"{parameter} outside sin/cos cannot be mixed with sin/cos of k*pi*{parameter} (it "
+        "would need an irrational coefficient)")}
     compiler = _Compiler(ring, {**parameters, parameter: t}, call, what="trajectory",
-                         surd=lambda v: surd_polynomial(v, ring))
+                         surd=lambda v: surd_polynomial(v, ring), forbidden=forbidden)
     return _reduce_path(compiler.lift(compiler.run(node), node))
 
 
 def compile_angle_coordinate(node: Node, parameter: str, parameters,
-                             ring: fmpq_mpoly_ctx = TRIG) -> tuple[fmpq_mpoly, Fraction]:
+                             ring: fmpq_mpoly_ctx = TRIG,
+                             pi_scale: Fraction | None = None) -> tuple[fmpq_mpoly, Fraction]:
     """``(P, q)`` with an angle's trajectory coordinate = P(t, sin t, cos t) + q·π."""
     names = ring.names()
     ring_pi = fmpq_mpoly_ctx.get((*names, "pi"), "lex")
-    p = compile_trajectory_coordinate_with_pi(node, parameter, parameters, ring_pi)
+    p = compile_trajectory_coordinate_with_pi(node, parameter, parameters, ring_pi, pi_scale)
     q = Fraction(0)
     rest = {}
     for exps, coeff in p.terms():
@@ -685,17 +722,20 @@ def compile_angle_coordinate(node: Node, parameter: str, parameters,
     return ring.from_dict(rest), q
 
 
-def compile_trajectory_coordinate_with_pi(node, parameter, parameters, ring_pi):
+def compile_trajectory_coordinate_with_pi(node, parameter, parameters, ring_pi, pi_scale=None):
     """A trajectory coordinate in a ring whose last variable stands for π."""
     t = ring_pi.gens()[0]
     base = fmpq_mpoly_ctx.get(ring_pi.names()[:-1], "lex")
 
     def call(n: Node):
-        inner = compile_trajectory_coordinate(n, parameter, parameters, base)
+        inner = compile_trajectory_coordinate(n, parameter, parameters, base, pi_scale)
         return ring_pi.from_dict({(*e, 0): c for e, c in inner.terms()})
 
+    forbidden = {} if pi_scale is None else {parameter: (
+        f"{parameter} outside sin/cos cannot be mixed with sin/cos of k*pi*{parameter}")}
     compiler = _Compiler(ring_pi, {**parameters, parameter: t}, call, what="trajectory",
-                         surd=lambda v: surd_polynomial(v, ring_pi), pi=ring_pi.gens()[-1])
+                         surd=lambda v: surd_polynomial(v, ring_pi), pi=ring_pi.gens()[-1],
+                         forbidden=forbidden)
     return _reduce_path(compiler.lift(compiler.run(node), node))
 
 

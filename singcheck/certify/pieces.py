@@ -1,0 +1,170 @@
+"""Certification of a path made of pieces (segments, waypoints, splines, rescaled time).
+
+Each piece is certified on its own closed sub-range (:func:`certify_path`): its
+candidates, its working modes' feasibility, its undecided boxes.  The whole path's
+answer is composed from them, in the user's parameter t:
+
+* **Times.**  A piece written in τ = g·π·t reports balls in τ; they are mapped to t by
+  t = τ/(gπ) in ball arithmetic (rigorous).  Candidates carry their segment number.
+* **Joins.**  The pose is continuous at a join (checked exactly when the spec was read),
+  so μ takes the same value ξ(X_join) on both sides.  Two candidates whose balls hold
+  the join are one root exactly when μ vanishes *at* the join, which is decided
+  exactly (:func:`singcheck.algebra.trig_values.sum_is_zero`); it is then counted once.
+* **Working modes.**  A mode is feasible for the path only when it is feasible on every
+  piece, each on its closed range, and continuous at every join.  Continuity: every
+  leg's constraint a·ρ² + b·ρ + c has a constant leading coefficient a and the same
+  coefficients on both sides of the join (same pose), so the branch labelled ``+``
+  (resp. ``-``) is the same root on both sides; feasibility on the closed ranges
+  proves the discriminant > 0 at the join (a serial singularity there makes the mode
+  infeasible on both pieces).  The joint values of both sides at the join are also
+  compared in ball arithmetic: provably different values would break the mode.
+* **Verdict.**  From the composed modes and candidates, as for one piece; when every
+  piece has a feasible mode but none is feasible throughout, the reason names the join
+  where the feasible mode changes.
+"""
+
+from __future__ import annotations
+
+from flint import arb
+
+from singcheck.algebra.intervals import working_precision
+from singcheck.algebra.trig_values import sum_is_zero
+from singcheck.budget import checkpoint
+from singcheck.certify.classification import (
+    REGULAR,
+    SINGULAR,
+    VERDICT_INFEASIBLE,
+    Candidate,
+    TrajectoryReport,
+    certify_path,
+    verdict_of,
+)
+from singcheck.certify.path import build_path
+from singcheck.certify.working_modes import FEASIBLE, INFEASIBLE, UNKNOWN, WorkingMode
+from singcheck.elimination.projection import RobotProjection
+from singcheck.roots.enclosures import RealRoot
+from singcheck.spec.files import TrajectorySpec
+
+
+def certify_trajectory(projection: RobotProjection, spec: TrajectorySpec,
+                       tolerance: float = 1e-9) -> TrajectoryReport:
+    """The verdict for a whole path, one piece or many (see the module docstring)."""
+    if not spec.segments and spec.time_scale is None:
+        return certify_path(build_path(projection, spec), tolerance)
+    reports = []
+    for piece in spec.pieces:
+        checkpoint()
+        reports.append(certify_path(build_path(projection, piece), tolerance))
+    return compose(spec, reports)
+
+
+def joins(spec: TrajectorySpec) -> list:
+    """The exact times (in t) where one piece ends and the next starts."""
+    return [p.global_range.end for p in spec.pieces[:-1]]
+
+
+def _global_candidate(c: Candidate, piece: TrajectorySpec, segment: int) -> Candidate:
+    root = RealRoot(piece.to_global(c.t), c.root.multiplicity)
+    return Candidate(root, c.pose, c.joints, c.modes, c.status, segment)
+
+
+def _same_root_at_join(report: TrajectoryReport, left: Candidate, right: Candidate,
+                       at) -> bool:
+    """True when both candidates are the root of μ exactly at the join ``at``."""
+    ball = at.ball()
+    if not (left.t.overlaps(ball) and right.t.overlaps(ball)):
+        return False
+    piece = report.path.trajectory
+    return sum_is_zero([(report.path.mu, piece.local_time(at))]) is True
+
+
+def _branch_values(report: TrajectoryReport, at) -> list[dict]:
+    t = report.path.trajectory.local_time(at).ball()
+    with working_precision(128):
+        return [leg.branches(t) for leg in report.path.legs]
+
+
+def _continuous(label: str, left: list[dict], right: list[dict]) -> bool:
+    """False when the branches of ``label`` provably differ on the two sides."""
+    for ch, a, b in zip(label, left, right, strict=True):
+        va, vb = a[ch], b[ch]
+        if isinstance(va, arb) and isinstance(vb, arb) and not va.overlaps(vb):
+            return False
+    return True
+
+
+def _compose_modes(spec, reports) -> list[WorkingMode]:
+    at_joins = [(_branch_values(reports[i], j), _branch_values(reports[i + 1], j))
+                for i, j in enumerate(joins(spec))]
+    out = []
+    for k, first in enumerate(reports[0].modes):
+        per_piece = [r.modes[k] for r in reports]
+        status, reason = FEASIBLE, ""
+        for state in (INFEASIBLE, UNKNOWN):
+            hit = next(((i, m) for i, m in enumerate(per_piece) if m.status == state), None)
+            if hit:
+                status, reason = state, f"segment {hit[0] + 1}: {hit[1].reason}"
+                break
+        if status == FEASIBLE:
+            for i, (left, right) in enumerate(at_joins):
+                if not _continuous(first.label, left, right):
+                    status = INFEASIBLE
+                    reason = (f"its IK branch is not the same on both sides of the join of "
+                              f"segments {i + 1} and {i + 2}")
+                    break
+        out.append(WorkingMode(first.label, first.branches, status, reason,
+                               first.joints_at_start))
+    return out
+
+
+def _restatus(c: Candidate, feasible: set[str]) -> Candidate:
+    """The candidate's status against the path's feasible modes (not the piece's)."""
+    states = {m.status for m in c.modes if m.mode in feasible}
+    c.status = "real" if SINGULAR in states else \
+        "spurious" if states <= {REGULAR} else "unknown"
+    c.joints = {label: v for label, v in c.joints.items() if label in feasible}
+    return c
+
+
+def compose(spec: TrajectorySpec, reports: list[TrajectoryReport]) -> TrajectoryReport:
+    """The whole path's report from its pieces' reports (in order)."""
+    modes = _compose_modes(spec, reports)
+    feasible = {m.label for m in modes if m.status == FEASIBLE}
+    candidates: list[Candidate] = []
+    at = joins(spec)
+    for i, (piece, report) in enumerate(zip(spec.pieces, reports, strict=True)):
+        for c in report.candidates:
+            g = _global_candidate(c, piece, i + 1)
+            if (i and candidates and candidates[-1].segment == i and
+                    _same_root_at_join(report, candidates[-1], g, at[i - 1])):
+                continue  # the root at the join, already counted in the previous piece
+            candidates.append(_restatus(g, feasible))
+    for mode in modes:
+        mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
+    undecided = [(piece.to_global(t), f"segment {i + 1}: {why}")
+                 for i, (piece, report) in enumerate(zip(spec.pieces, reports, strict=True))
+                 for t, why in report.undecided]
+    verdict, reason = verdict_of(modes, candidates, undecided)
+    if verdict == VERDICT_INFEASIBLE:
+        reason = _mode_change(spec, reports) or reason
+    methods = list(dict.fromkeys(r.root_method for r in reports))
+    return TrajectoryReport(reports[0].path, verdict, reason, candidates, modes,
+                            methods[0] if len(methods) == 1 else " + ".join(methods),
+                            undecided, all(r.mu_roots_complete for r in reports), spec,
+                            reports)
+
+
+def _mode_change(spec, reports) -> str | None:
+    """Where the feasible working mode changes, when every piece has one."""
+    sets = [{m.label for m in r.modes if m.status == FEASIBLE} for r in reports]
+    if not all(sets):
+        return None
+    common = sets[0]
+    for i, s in enumerate(sets[1:]):
+        if not common & s:
+            return (f"no working mode is feasible along the whole path: the feasible mode "
+                    f"changes at the join of segments {i + 1} and {i + 2} "
+                    f"({spec.parameter} = {joins(spec)[i]}: {', '.join(sorted(common))} "
+                    f"before, {', '.join(sorted(s))} after)")
+        common &= s
+    return None  # pragma: no cover - some mode is feasible throughout

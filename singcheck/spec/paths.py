@@ -1,0 +1,295 @@
+"""Paths as people have them: segments, waypoints, natural cubic splines, CSV tables.
+
+Every form becomes a multi-piece :class:`~singcheck.spec.files.TrajectorySpec` whose
+``segments`` are one-piece specs over consecutive sub-ranges of the global parameter:
+
+* ``segments:`` — a list of ``{range: [a, b], pose: {...}}``, each pose anything a
+  one-piece trajectory may be (polynomials, sin/cos of integer multiples of t, of
+  rational multiples of π·t);
+* ``waypoints:`` — a list of ``{t: .., x: .., ...}`` (exact numbers), joined by
+  straight lines (``interpolation: linear``) or the natural cubic spline through them
+  (``interpolation: cubic``, the default);
+* a CSV table (``t,x,y,z`` header, one pose per row, decimals read exactly), interpolated
+  the same way.
+
+Everything is exact: spline coefficients are the rational solution of the spline's
+tridiagonal system.  Consecutive segments must share their end and start times, and
+the pose at the end of one must *equal* the pose at the start of the next, decided
+exactly by :func:`singcheck.algebra.trig_values.sum_is_zero`; otherwise the spec is
+refused with one line naming both segments.
+"""
+
+from __future__ import annotations
+
+import re
+from fractions import Fraction
+
+import yaml
+from flint import fmpq, fmpq_mpoly
+
+from singcheck.algebra.intervals import working_precision
+from singcheck.algebra.trig import TRIG, LinearInPi, T, TimeRange, evaluate_trig
+from singcheck.algebra.trig_values import sum_is_zero
+from singcheck.budget import checkpoint
+from singcheck.errors import SpecError
+from singcheck.spec.trajectory import TrajectorySpec, pose_nodes, time_range, trajectory_piece
+
+INTERPOLATIONS = ("linear", "cubic")
+
+
+def _line(node) -> int:
+    return node.start_mark.line + 1
+
+
+MAX_WAYPOINTS = 5000
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?:/\d+)?\Z")
+
+
+def multi_piece(doc, root, top, name: str, parameter: str, robot,
+                lines: dict[str, int]) -> TrajectorySpec:
+    """The ``segments:`` or ``waypoints:`` form of a trajectory document."""
+    if "segments" in top and "waypoints" in top:
+        raise doc.error(top["waypoints"][0], "waypoints",
+                        "give either segments or waypoints, not both")
+    if "interpolation" in top and "waypoints" not in top:
+        raise doc.error(top["interpolation"][0], "interpolation",
+                        "only applies to waypoints")
+    form = "segments" if "segments" in top else "waypoints"
+    for k in ("range", "pose"):
+        if k in top:
+            raise doc.error(top[k][0], k, f"not allowed with {form} (each piece has its own)")
+    node = top[form][1]
+    if form == "segments":
+        pieces = _segments(doc, node, name, parameter, robot)
+    else:
+        kind = "cubic"
+        if "interpolation" in top:
+            kind = doc.text(top["interpolation"][1], "interpolation")
+            if kind not in INTERPOLATIONS:
+                raise doc.error(top["interpolation"][1], "interpolation",
+                                f"{kind!r} is not one of {', '.join(INTERPOLATIONS)}")
+        times, values, row_lines = _waypoints(doc, node, parameter, robot)
+        pieces = interpolated_pieces(doc.path, name, parameter, times, values, kind,
+                                     row_lines)
+        lines = {**lines, "interpolation": kind}
+    return _whole(doc.path, name, parameter, pieces, lines)
+
+
+def _whole(path: str, name: str, parameter: str, pieces, lines) -> TrajectorySpec:
+    rng = TimeRange(pieces[0].global_range.start, pieces[-1].global_range.end)
+    return TrajectorySpec(path, name, parameter, rng, {}, lines, segments=tuple(pieces))
+
+
+def _segments(doc, node, name: str, parameter: str, robot):
+    if not isinstance(node, yaml.SequenceNode) or not node.value:
+        raise doc.error(node, "segments", "expected a non-empty list of "
+                                          "{range: [a, b], pose: {...}}")
+    pieces, nodes = [], []
+    for i, item in enumerate(node.value):
+        key = f"segments[{i + 1}]"
+        m = doc.mapping(item, key)
+        for k, (knode, _) in m.items():
+            if k not in ("range", "pose"):
+                raise doc.error(knode, f"{key}.{k}", "unknown key in a segment "
+                                                     "(allowed: range, pose)")
+        for k in ("range", "pose"):
+            if k not in m:
+                raise doc.error(item, f"{key}.{k}", "missing required key in a segment")
+        rnode = m["range"][1]
+        rng = time_range(doc, rnode, f"{key}.range")
+        coords = pose_nodes(doc, m["pose"][1], f"{key}.pose", robot, m["pose"][0])
+        rng, poly, scale, offsets = trajectory_piece(doc, rng, rnode, coords, f"{key}.pose",
+                                                     parameter, robot)
+        piece = TrajectorySpec(doc.path, f"{name}[{i + 1}]", parameter, rng, poly,
+                               {"segment": _line(item)}, angle_offsets=offsets,
+                               time_scale=scale)
+        if pieces and pieces[-1].global_range.end != piece.global_range.start:
+            raise doc.error(rnode, f"{key}.range",
+                            f"segment {i + 1} starts at {piece.global_range.start} but "
+                            f"segment {i} ends at {pieces[-1].global_range.end}: ranges "
+                            "must be consecutive")
+        pieces.append(piece)
+        nodes.append(item)
+    check_joins(pieces, doc.path, [_line(n) for n in nodes])
+    return pieces
+
+
+def check_joins(pieces, path: str, lines: list[int | None]) -> None:
+    """Each segment must start exactly where the previous one ends (same pose)."""
+    for i, (left, right) in enumerate(zip(pieces, pieces[1:], strict=False)):
+        checkpoint()
+        at = left.global_range.end
+        for v in left.pose:
+            where = f"segments {i + 1} and {i + 2} at {left.parameter} = {at}"
+            if left.pose[v].context() is not TRIG or right.pose[v].context() is not TRIG:
+                raise SpecError(f"cannot check exactly that {where} meet: square roots in "
+                                "segments are not supported", path=path, line=lines[i + 1],
+                                key=v)
+            pi = LinearInPi(Fraction(0), Fraction(1))  # an angle's offset q·π is q·t at t = π
+            offset = left.angle_offsets.get(v, 0) - right.angle_offsets.get(v, 0)
+            same = sum_is_zero([(left.pose[v], left.local_time(at)),
+                                (-right.pose[v], right.local_time(at)),
+                                (T * _q(Fraction(offset)), pi)])
+            if same is True:
+                continue
+            if same is None:
+                raise SpecError(f"cannot check exactly that {where} meet (put joins at "
+                                "rational times or rational multiples of pi)", path=path,
+                                line=lines[i + 1], key=v)
+            with working_precision(128):
+                a = evaluate_trig(left.pose[v], left.local_time(at).ball())
+                b = evaluate_trig(right.pose[v], right.local_time(at).ball())
+            raise SpecError(f"the pose jumps between {where}: {v} is {float(a.mid()):.9g} "
+                            f"at the end of segment {i + 1} and {float(b.mid()):.9g} at the "
+                            f"start of segment {i + 2}", path=path, line=lines[i + 1], key=v)
+
+
+def _waypoints(doc, node, parameter: str, robot):
+    if not isinstance(node, yaml.SequenceNode):
+        fields = ", ".join(f"{v}: .." for v in (parameter, *robot.pose))
+        raise doc.error(node, "waypoints", f"expected a list of {{{fields}}}")
+    names = (parameter, *robot.pose)
+    times: list[Fraction] = []
+    values: dict[str, list[Fraction]] = {v: [] for v in robot.pose}
+    lines = []
+    for i, item in enumerate(node.value):
+        key = f"waypoints[{i + 1}]"
+        m = doc.mapping(item, key)
+        for k, (knode, _) in m.items():
+            if k not in names:
+                raise doc.error(knode, f"{key}.{k}", f"{k!r} is neither the parameter nor a "
+                                                     f"pose variable ({', '.join(names)})")
+        missing = [k for k in names if k not in m]
+        if missing:
+            raise doc.error(item, key, f"missing {', '.join(missing)}")
+        times.append(doc.number(m[parameter][1], f"{key}.{parameter}"))
+        for v in robot.pose:
+            values[v].append(doc.number(m[v][1], f"{key}.{v}"))
+        lines.append(_line(item))
+    _check_table(doc.path, parameter, times, lines, getattr(node, "start_mark", None)
+                 and _line(node))
+    return times, values, lines
+
+
+def _check_table(path: str, parameter: str, times, lines, where) -> None:
+    if len(times) < 2:
+        raise SpecError(f"at least two waypoints are needed, got {len(times)}", path=path,
+                        line=lines[0] if lines else where)
+    if len(times) > MAX_WAYPOINTS:
+        raise SpecError(f"more than {MAX_WAYPOINTS} waypoints", path=path, line=lines[-1])
+    for i in range(1, len(times)):
+        if not times[i - 1] < times[i]:
+            raise SpecError(f"{parameter} must increase from one waypoint to the next "
+                            f"({times[i - 1]} then {times[i]})", path=path, line=lines[i])
+
+
+def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec:
+    """A CSV table of poses: header ``PARAMETER,POSE...`` then one exact row per waypoint."""
+    rows = [(n, line) for n, line in enumerate(text.splitlines(), 1)
+            if line.strip() and not line.lstrip().startswith("#")]
+    if not rows:
+        raise SpecError("the file is empty", path=path, line=1)
+    header_line, header = rows[0]
+    names = [c.strip() for c in header.split(",")]
+    parameter = names[0]
+    if not re.fullmatch(r"[A-Za-z_][A-Za-z_0-9]*", parameter) or parameter in robot.pose:
+        raise SpecError(f"the first column must name the parameter (e.g. t), not "
+                        f"{parameter!r}", path=path, line=header_line)
+    for v in names[1:]:
+        if v not in robot.pose:
+            raise SpecError(f"column {v!r} is not a pose variable of robot {robot.name} "
+                            f"(pose: {', '.join(robot.pose)})", path=path, line=header_line)
+        if names.count(v) > 1:
+            raise SpecError(f"column {v!r} appears twice", path=path, line=header_line)
+    missing = [v for v in robot.pose if v not in names]
+    if missing:
+        raise SpecError(f"missing column(s) {', '.join(missing)} (header: "
+                        f"{','.join(names)})", path=path, line=header_line)
+    times: list[Fraction] = []
+    values: dict[str, list[Fraction]] = {v: [] for v in robot.pose}
+    lines = []
+    for n, line in rows[1:]:
+        cells = [c.strip() for c in line.split(",")]
+        if len(cells) != len(names):
+            raise SpecError(f"{len(cells)} values for {len(names)} columns", path=path,
+                            line=n)
+        exact = []
+        for name, cell in zip(names, cells, strict=True):
+            if not _NUMBER.match(cell):
+                raise SpecError(f"{name}: {cell!r} is not a number", path=path, line=n)
+            try:
+                exact.append(Fraction(cell))
+            except ZeroDivisionError:
+                raise SpecError(f"{name}: {cell!r} divides by zero", path=path,
+                                line=n) from None
+        times.append(exact[0])
+        for name, value in zip(names[1:], exact[1:], strict=True):
+            values[name].append(value)
+        lines.append(n)
+    _check_table(path, parameter, times, lines, header_line)
+    stem = re.sub(r"\.csv\Z", "", path.replace("\\", "/").rsplit("/", 1)[-1], flags=re.I)
+    pieces = interpolated_pieces(path, stem, parameter, times, values, interpolation, lines)
+    return _whole(path, stem, parameter, pieces, {"interpolation": interpolation})
+
+
+def interpolated_pieces(path: str, name: str, parameter: str, times: list[Fraction],
+                        values: dict[str, list[Fraction]], kind: str, lines: list[int]):
+    """One polynomial piece per interval between waypoints (in the global t)."""
+    per_coord = {v: (linear_pieces if kind == "linear" else natural_cubic_spline)(times, ys)
+                 for v, ys in values.items()}
+    pieces = []
+    for i in range(len(times) - 1):
+        rng = TimeRange(LinearInPi(times[i]), LinearInPi(times[i + 1]))
+        pieces.append(TrajectorySpec(path, f"{name}[{i + 1}]", parameter, rng,
+                                     {v: polys[i] for v, polys in per_coord.items()},
+                                     {"segment": lines[i]}))
+    check_joins(pieces, path, [*lines])
+    return pieces
+
+
+def _q(x: Fraction) -> fmpq:
+    return fmpq(x.numerator, x.denominator)
+
+
+def linear_pieces(ts: list[Fraction], ys: list[Fraction]) -> list[fmpq_mpoly]:
+    """The straight line from each waypoint to the next, as polynomials in t."""
+    one = TRIG.from_dict({(0, 0, 0): 1})
+    return [one * _q(y0) + (T - _q(t0)) * _q((y1 - y0) / (t1 - t0))
+            for t0, t1, y0, y1 in zip(ts, ts[1:], ys, ys[1:], strict=False)]
+
+
+def natural_cubic_spline(ts: list[Fraction], ys: list[Fraction]) -> list[fmpq_mpoly]:
+    """The natural cubic spline through the points, exactly: its second derivatives Mᵢ
+    solve hᵢ₋₁Mᵢ₋₁ + 2(hᵢ₋₁ + hᵢ)Mᵢ + hᵢMᵢ₊₁ = 6(Δᵢ − Δᵢ₋₁), M₀ = Mₙ = 0 (Thomas'
+    algorithm over Q), and on [tᵢ, tᵢ₊₁]
+    S = Mᵢ(tᵢ₊₁ − t)³/6h + Mᵢ₊₁(t − tᵢ)³/6h + (yᵢ/h − Mᵢh/6)(tᵢ₊₁ − t)
+    + (yᵢ₊₁/h − Mᵢ₊₁h/6)(t − tᵢ)."""
+    n = len(ts) - 1
+    t = [_q(x) for x in ts]
+    y = [_q(v) for v in ys]
+    h = [t[i + 1] - t[i] for i in range(n)]
+    slope = [(y[i + 1] - y[i]) / h[i] for i in range(n)]
+    m = [fmpq(0)] * (n + 1)
+    if n > 1:  # interior unknowns M₁ … Mₙ₋₁
+        diag, rhs = [], []
+        for i in range(1, n):
+            checkpoint()
+            d = 2 * (h[i - 1] + h[i])
+            r = 6 * (slope[i] - slope[i - 1])
+            if diag:
+                w = h[i - 1] / diag[-1]
+                d -= w * h[i - 1]
+                r -= w * rhs[-1]
+            diag.append(d)
+            rhs.append(r)
+        for i in range(n - 1, 0, -1):
+            nxt = m[i + 1] if i + 1 < n else fmpq(0)
+            m[i] = (rhs[i - 1] - h[i] * nxt) / diag[i - 1]
+    one = TRIG.from_dict({(0, 0, 0): 1})
+    out = []
+    for i in range(n):
+        a, b = one * t[i + 1] - T, T - one * t[i]
+        out.append(a ** 3 * (m[i] / (6 * h[i])) + b ** 3 * (m[i + 1] / (6 * h[i]))
+                   + a * (y[i] / h[i] - m[i] * h[i] / 6)
+                   + b * (y[i + 1] / h[i] - m[i + 1] * h[i] / 6))
+    return out

@@ -1,0 +1,189 @@
+"""A trajectory spec, one piece or many, and the parsing of one piece.
+
+A piece is a pose φ(t) over a closed range, exact (trig polynomials in ``TRIG``).  A
+piece whose sin/cos arguments are rational multiples of π·t is rescaled to τ = g·π·t
+(g the gcd of those multiples), under which they are integer multiples of τ: its pose
+and range are stored in τ, and :meth:`TrajectorySpec.to_global` maps times back to t.
+The parsing helpers take the file's located-error helper (``doc``) and the robot spec.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from fractions import Fraction
+
+import yaml
+from flint import fmpq_mpoly, fmpq_mpoly_ctx
+
+from singcheck.algebra.polynomials import restrict
+from singcheck.algebra.radicals import radical_name, radical_variables
+from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
+from singcheck.spec.grammar import (
+    Constant,
+    ExprError,
+    Node,
+    compile_angle_coordinate,
+    compile_constant,
+    compile_trajectory_coordinate,
+    compile_value,
+    pi_multiples,
+)
+
+
+@dataclass(frozen=True)
+class TrajectorySpec:
+    path: str
+    name: str
+    parameter: str
+    range: TimeRange
+    pose: dict[str, fmpq_mpoly]  # pose variable -> TRIG polynomial, robot's pose order
+    lines: dict[str, int] = field(default_factory=dict)
+    #: an angle's coordinate is pose[v] + angle_offsets[v]·π (only angles have an entry)
+    angle_offsets: dict[str, Fraction] = field(default_factory=dict)
+    #: g when the pose is written in τ = g·π·t (sin/cos of k·π·t): ``pose`` and ``range``
+    #: are then in τ, and :meth:`to_global` maps a time back to t.
+    time_scale: Fraction | None = None
+    #: the pieces of a multi-piece path (segments, waypoints, CSV), each a one-piece spec
+    #: over its own global sub-range; ``range`` is then the whole path's and ``pose`` empty.
+    segments: tuple[TrajectorySpec, ...] = ()
+
+    @property
+    def pieces(self) -> tuple[TrajectorySpec, ...]:
+        """The one-piece specs to certify, in order (the spec itself for one piece)."""
+        return self.segments or (self,)
+
+    @property
+    def global_range(self) -> TimeRange:
+        """The range in the user's parameter t (``range`` is in τ on a rescaled piece)."""
+        if self.time_scale is None:
+            return self.range
+        g = self.time_scale
+        return TimeRange(LinearInPi(self.range.start.pi_coefficient / g),
+                         LinearInPi(self.range.end.pi_coefficient / g))
+
+    def local_time(self, t: LinearInPi) -> LinearInPi:
+        """The exact time τ at which this piece is at the user's time t (rational t on a
+        rescaled piece)."""
+        if self.time_scale is None:
+            return t
+        return LinearInPi(Fraction(0), self.time_scale * t.rational)
+
+    def to_global(self, t):
+        """A ball in this piece's time mapped to a ball in t (t = τ/(gπ), rigorous)."""
+        if self.time_scale is None:
+            return t
+        from flint import arb, fmpq
+
+        g = self.time_scale
+        return t / (arb.pi() * arb(fmpq(g.numerator, g.denominator)))
+
+
+def exactly_less(a: LinearInPi, b: LinearInPi) -> bool:
+    """Exactly a < b (π is irrational, so unequal values separate at some precision)."""
+    from singcheck.algebra.intervals import working_precision
+
+    if a == b:
+        return False
+    for bits in (64, 256, 1024, 4096):
+        with working_precision(bits):
+            d = b.ball() - a.ball()
+            if d > 0:
+                return True
+            if d < 0:
+                return False
+    raise AssertionError("unreachable: distinct a + bπ values separate")  # pragma: no cover
+
+
+def time_range(doc, rnode, key: str) -> TimeRange:
+    """``[start, end]`` with start < end, exact (a + b·π)."""
+    if not isinstance(rnode, yaml.SequenceNode) or len(rnode.value) != 2:
+        raise doc.error(rnode, key, "expected [start, end], e.g. [-pi, pi]")
+    start, end = (doc.expression(item, f"{key}[{i}]", compile_constant)
+                  for i, item in enumerate(rnode.value))
+    if not exactly_less(start, end):
+        raise doc.error(rnode, key, f"empty range: start {start} must be smaller than "
+                                    f"end {end}")
+    return TimeRange(start, end)
+
+
+def pose_nodes(doc, pnode, key: str, robot, at) -> dict:
+    """The pose mapping's value nodes, in the robot's pose order (every coordinate, no
+    other name); ``at``: the node to name when one is missing."""
+    pose_map = doc.mapping(pnode, key)
+    extra = [v for v in pose_map if v not in robot.pose]
+    if extra:
+        raise doc.error(pose_map[extra[0]][0], f"{key}.{extra[0]}",
+                        f"{extra[0]!r} is not a pose variable of robot {robot.name} "
+                        f"(pose: {', '.join(robot.pose)})")
+    missing = [v for v in robot.pose if v not in pose_map]
+    if missing:
+        raise doc.error(at, key,
+                        f"missing coordinate(s) {', '.join(missing)} of robot {robot.name}")
+    return {v: pose_map[v][1] for v in robot.pose}
+
+
+def _scale_of(multiples: list[Fraction]) -> Fraction | None:
+    """g with every k/g an integer (the gcd of the k), or None without any."""
+    from math import gcd, lcm
+
+    ks = [k for k in multiples if k]
+    if not ks:
+        return None
+    return Fraction(gcd(*(k.numerator for k in ks)), lcm(*(k.denominator for k in ks)))
+
+
+def radical_primes(parameters: dict, trees: list[Node]) -> set[int]:
+    """Every prime whose square root a compiled expression may need: those of the
+    parameters, of each ``sqrt(q)`` written inline, and 2 and 3 (the sines and
+    cosines of multiples of π/12)."""
+    primes = {2, 3}
+    for value in parameters.values():
+        if isinstance(value, Constant):
+            primes |= value.surd.primes()
+
+    def walk(node: Node) -> None:
+        if node.kind == "call" and node.value == "sqrt":
+            try:
+                primes.update(compile_value(node, parameters).surd.primes())
+            except ExprError:
+                pass  # the compiler reports it, with its column
+        for a in node.args:
+            walk(a)
+
+    for tree in trees:
+        walk(tree)
+    return primes
+
+
+def trajectory_piece(doc, rng: TimeRange, rnode, nodes: dict, key: str, parameter: str,
+                     robot) -> tuple[TimeRange, dict, Fraction | None, dict]:
+    """A piece's pose compiled exactly (with its angles' π offsets), its range in its own
+    time: sin/cos of k·π·t (rational k) rescale the piece to τ = g·π·t (then the range
+    must be rational, and becomes [g·π·start, g·π·end])."""
+    trees = {v: doc.expression(node, f"{key}.{v}", lambda n: n) for v, node in nodes.items()}
+    scale = _scale_of([k for tree in trees.values()
+                       for k in pi_multiples(tree, parameter, robot.parameters)])
+    primes = sorted(radical_primes(robot.parameters, list(trees.values())))
+    ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
+    coords, offsets = {}, {}
+    for v, node in nodes.items():
+        if v in robot.angles:
+            coords[v], offsets[v] = doc.expression(
+                node, f"{key}.{v}", lambda n: compile_angle_coordinate(
+                    n, parameter, robot.parameters, ring, scale))
+        else:
+            coords[v] = doc.expression(
+                node, f"{key}.{v}", lambda n: compile_trajectory_coordinate(
+                    n, parameter, robot.parameters, ring, scale))
+    used = [i for i, _ in radical_variables(ring)
+            if any(p.degrees()[i] > 0 for p in coords.values())]
+    names = ("t", "s", "c", *(ring.names()[i] for i in used))
+    small = TRIG if not used else fmpq_mpoly_ctx.get(names, "lex")
+    coords = {v: restrict(p, small) for v, p in coords.items()}
+    if scale is not None:
+        if rng.start.pi_coefficient or rng.end.pi_coefficient:
+            raise doc.error(rnode, "range", f"with sin/cos of k*pi*{parameter} the range "
+                                            "must be rational (no pi)")
+        rng = TimeRange(LinearInPi(Fraction(0), scale * rng.start.rational),
+                        LinearInPi(Fraction(0), scale * rng.end.rational))
+    return rng, coords, scale, offsets

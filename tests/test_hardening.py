@@ -311,8 +311,8 @@ def test_a_forged_region_map_is_recomputed(tmp_path, monkeypatch, capsys, cache_
 SETSID_CAS = VERSION + """\
 import os, subprocess, sys, time
 pids = os.environ["FAKE_PIDS"]
-child = subprocess.Popen([sys.executable, "-c", "import os, time; os.setsid(); "
-                          "time.sleep(300)"], start_new_session=True)
+child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(300)"],
+                         start_new_session=True)  # setsid(): out of the CAS's group
 with open(pids, "w") as f:
     f.write(f"{os.getpid()} {child.pid}\\n")
 if os.environ.get("FAKE_HANG"):
@@ -353,6 +353,7 @@ def test_sigterm_and_sighup_kill_the_cas_and_its_setsid_grandchild(tmp_path, sig
         time.sleep(0.05)
     cas, grandchild = map(int, pids_file.read_text().split())
     assert _alive(cas) and _alive(grandchild)
+    assert os.getsid(grandchild) == grandchild != os.getpgid(cas)  # escaped the group
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=30)
     assert proc.returncode == 130, err

@@ -478,3 +478,86 @@ def test_undecided_boxes_and_a_known_root_are_kept_when_no_mode_is_feasible(
     assert [c["t_interval"] for c in doc["candidates"]] == [[0.0, 0.0]]
     assert all(lo <= 0 <= hi for lo, hi in (u["t_interval"] for u in doc["undecided"]))
     assert doc["undecided"]
+
+
+# -- 3. costly small specs: refused up front, or stopped at the time limit --------------
+
+
+def test_a_path_whose_mu_would_explode_is_refused_up_front(tmp_path, monkeypatch, capsys,
+                                                           cache_env):
+    spec = trajectory(tmp_path, {"x": "(sin(t)+cos(t)+t)^64", "y": "0", "z": "1"})
+    start = time.monotonic()
+    code, _, err = run_cli(monkeypatch, capsys, "run", ORTHO, spec, "-q", "--backend", "flint")
+    one_line_error(code, err, 2, "too costly")
+    assert time.monotonic() - start < 10
+
+
+def test_mu_size_bound_holds_for_a_composed_path(orthoglide_projection):
+    """The a-priori bound is an upper bound of what composition gives (checked on a path
+    mixing t, sin and cos, composed here)."""
+    from singcheck.certify.path import compose_pose, mu_size_bound
+    from singcheck.spec.grammar import compile_trajectory_coordinate, parse
+
+    phi = tuple(compile_trajectory_coordinate(parse(text), "t", {}) for text in
+                ("(sin(t) + cos(t) + t)^3", "t^2 - sin(2*t)", "1"))
+    xi = orthoglide_projection.singularity_surface
+    deg_t, deg_sc, terms = mu_size_bound(xi, phi, ("x", "y", "z"))
+    mu = compose_pose(xi, phi, ("x", "y", "z"))
+    assert len(mu) <= terms
+    assert mu.degrees()[0] <= deg_t and mu.degrees()[1] + mu.degrees()[2] <= deg_sc
+
+
+@pytest.mark.parametrize("robot, pose, rng", [
+    (ORTHO, {"x": "3*sin(t) + cos(256*t)", "y": "0", "z": "1"}, "0, 1"),
+    (BIGLIDE, {"x": "sin(100*t)", "y": "t"}, "0, 1"),
+    (ORTHO, {"x": "sin(t)", "y": "cos(t)", "z": "t/20"}, "-1000000, 1000000"),
+])
+def test_costly_paths_stop_at_the_time_limit(tmp_path, cache_env, robot, pose, rng):
+    from singcheck import api
+
+    machine = api.load_robot(robot, backend="flint")
+    spec = api.load_trajectory(trajectory(tmp_path, pose, rng), machine)
+    start = time.monotonic()
+    report = api.check(machine, spec, time_limit=3)
+    elapsed = time.monotonic() - start
+    assert elapsed < 3 + 10, elapsed
+    if report.verdict == "unknown":
+        assert "time limit" in report.reason
+    else:  # finished in time: then it must be a proven answer
+        assert report.certificate is not None
+
+
+def test_near_double_roots_of_huge_size_are_separated():
+    """x² + Bx + C with roots a and a + 2⁻¹⁰, a = -2²⁴⁵ (what the workspace decomposition
+    of a robot with the constant (2147483648-364349)^8 meets): the isolating intervals
+    are halved until they are apart, however many rounds that takes (it took more than
+    the former cap of 200)."""
+    from flint import fmpq, fmpq_poly
+
+    from singcheck.spaces.cad import separated_roots
+
+    a = fmpq(-(2 ** 245))
+    b = a + fmpq(1, 2 ** 10)
+    roots = separated_roots(fmpq_poly([a * b, -(a + b), 1]))
+    assert len(roots) == 2 and roots[0].hi < roots[1].lo
+    assert roots[0].lo <= a <= roots[0].hi and roots[1].lo <= b <= roots[1].hi
+
+
+def test_a_robot_with_a_huge_constant_is_decided(tmp_path, monkeypatch, capsys, cache_env):
+    robot = tmp_path / "big.yaml"
+    robot.write_text(textwrap.dedent("""\
+        name: big
+        joints: [p, q]
+        pose: [x, y]
+        constraints:
+          - (x - p)^2 + y^2 - 4
+          - (x - q)^2 + y^2 - (2147483648-364349)^8
+        joint_limits: {p: [-4, 4], q: [-4, 4]}
+        """))
+    spec = trajectory(tmp_path, {"x": "t", "y": "1/2 + t/4"})
+    code, out, err = run_cli(monkeypatch, capsys, "run", str(robot), spec, "-q", "--backend",
+                             "flint", "--format", "json")
+    assert code == 1 and "Traceback" not in err, err
+    (doc,) = json.loads(out)["trajectories"]
+    # q = x ± √(C - y²) with C ≈ 2^247: far outside [-4, 4] from the start
+    assert doc["verdict"] == "infeasible" and "q is outside [-4, 4]" in doc["reason"]

@@ -25,15 +25,16 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 
-from generate import write  # noqa: E402
+from generate import waypoints_yaml, write  # noqa: E402
 
 from singcheck.certify.classification import certify_path  # noqa: E402
 from singcheck.certify.path import build_path  # noqa: E402
+from singcheck.certify.pieces import certify_trajectory  # noqa: E402
 from singcheck.elimination.cas import get_backend  # noqa: E402
 from singcheck.elimination.projection import project_robot  # noqa: E402
 from singcheck.model.robot import build_model  # noqa: E402
 from singcheck.report.plots import numpy_polynomial  # noqa: E402
-from singcheck.spec.files import load_robot, load_trajectory  # noqa: E402
+from singcheck.spec.files import load_robot, load_trajectory, parse_trajectory  # noqa: E402
 
 REPEAT = int(os.environ.get("BENCH_REPEAT", "15"))
 
@@ -270,6 +271,24 @@ def growth_rows() -> list[dict]:
     return rows
 
 
+def spline_rows() -> list[dict]:
+    """A 100-waypoint natural cubic spline through the Orthoglide's workspace: reading it
+    (the exact spline) and certifying its 99 pieces, wall-clock and CPU seconds."""
+    model = build_model(load_robot(ROOT / "robots" / "orthoglide.yaml"))
+    projection = project_robot(model, get_backend("flint"))
+    text = waypoints_yaml(100)
+    walls, cpus, report = [], [], None
+    for _ in range(max(3, REPEAT // 3)):
+        wall, cpu = time.perf_counter(), time.process_time()
+        report = certify_trajectory(projection, parse_trajectory(text, "spline-100.yaml",
+                                                                 model.spec))
+        walls.append(time.perf_counter() - wall)
+        cpus.append(time.process_time() - cpu)
+    return [{"case": "orthoglide/spline-100 (99 cubic pieces)", **stats(walls),
+             "cpu_median_s": statistics.median(cpus), "verdict": report.verdict,
+             "candidates": len(report.candidates)}]
+
+
 def machine() -> dict:
     cpu = "unknown"
     try:
@@ -302,6 +321,11 @@ def main() -> None:
         print(f"{r['case']:38} {r['contender']:32} {ms(r['median_s'])} {ms(r['min_s'])} "
               f"{ms(r['max_s'])} {r['ratio_to_singcheck']:7.2f}  "
               f"{'yes' if r['found'] else 'NO'}")
+    results["spline"] = spline = spline_rows()
+    print("\nwaypoints: read and certify, whole path (spline built exactly)")
+    for r in spline:
+        print(f"  {r['case']:42} median {ms(r['median_s'])} ms wall, "
+              f"{ms(r['cpu_median_s'])} ms CPU; {r['verdict']}, {r['candidates']} candidates")
     results["projection"] = proj = projection_rows()
     print("\nprojection of the Orthoglide (ξ, workspace and joint-limit surfaces), no cache")
     for r in proj:

@@ -36,6 +36,20 @@ def heart_like(rng: random.Random, name: str, harmonics: int = 4) -> str:
             "  z: 1\n")
 
 
+def waypoints_yaml(n: int = 100, name: str = "spline-100") -> str:
+    """n waypoints wandering through the Orthoglide's workspace (3-decimal poses, t = 0 …
+    n − 1), joined by the natural cubic spline (the default interpolation)."""
+    import math
+
+    rows = []
+    for i in range(n):
+        x = round(0.45 + 0.35 * math.sin(0.37 * i), 3)
+        y = round(0.55 + 0.35 * math.cos(0.23 * i), 3)
+        z = round(1 + 0.25 * math.sin(0.11 * i), 3)
+        rows.append(f"  - {{t: {i}, x: {x}, y: {y}, z: {z}}}")
+    return f"name: {name}\nparameter: t\nwaypoints:\n" + "\n".join(rows) + "\n"
+
+
 def write(out: Path, count: int, harmonics: int = 4, seed: int = 2015) -> list[Path]:
     rng = random.Random(seed)
     out.mkdir(parents=True, exist_ok=True)

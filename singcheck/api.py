@@ -27,7 +27,7 @@ from singcheck.certify.classification import Candidate, TrajectoryReport
 from singcheck.certify.path import PathModel
 from singcheck.certify.pieces import certify_trajectory
 from singcheck.certify.working_modes import WorkingMode
-from singcheck.elimination.projection import RobotProjection, project_robot
+from singcheck.elimination.projection import MAX_SURFACE_TERMS, RobotProjection, project_robot
 from singcheck.model.robot import RobotModel, build_model
 from singcheck.spec.files import RobotSpec, TrajectorySpec
 from singcheck.spec.files import load_robot as read_robot_spec
@@ -75,17 +75,20 @@ class Robot:
 
     @property
     def singularity_surface(self):
-        """ξ(X), squarefree, exact (an ``fmpq_mpoly`` in the pose variables)."""
+        """ξ(X), squarefree, exact (an ``fmpq_mpoly`` in the pose variables); None when it
+        was too big to expand (``projection.not_expanded`` says why)."""
         return self.projection.singularity_surface
 
 
 def robot_from_spec(spec: RobotSpec, backend: str = "auto", *, timeout: float = 600.0,
-                    cache: bool = True, notify: Notify = _quiet, engine=None) -> Robot:
+                    cache: bool = True, notify: Notify = _quiet, engine=None,
+                    max_surface_terms: int = MAX_SURFACE_TERMS) -> Robot:
     """A :class:`Robot` from an already-read spec (``engine``: a ready backend, else one is
-    built from ``backend``, ``timeout`` and ``cache``)."""
+    built from ``backend``, ``timeout`` and ``cache``).  ξ(X) is not expanded when its
+    bound exceeds ``max_surface_terms`` (0: never; each path then eliminates along itself)."""
     model = build_model(spec)
     engine = engine or elimination_engine(backend, timeout, cache, notify)
-    projection = project_robot(model, engine)
+    projection = project_robot(model, engine, max_surface_terms)
     region_cache = None
     if cache:
         from singcheck.spaces.region_map import RegionMapCache
@@ -95,12 +98,13 @@ def robot_from_spec(spec: RobotSpec, backend: str = "auto", *, timeout: float = 
 
 
 def load_robot(path: str, backend: str = "auto", *, timeout: float = 600.0,
-               cache: bool = True, notify: Notify = _quiet) -> Robot:
+               cache: bool = True, notify: Notify = _quiet,
+               max_surface_terms: int = MAX_SURFACE_TERMS) -> Robot:
     """Read a robot spec (YAML) and project it: the elimination runs here, once (or comes
     from the cache); raises :class:`~singcheck.errors.SpecError` for a bad file and
     :class:`~singcheck.errors.BackendError` when the backend is missing or fails."""
     return robot_from_spec(read_robot_spec(path), backend, timeout=timeout, cache=cache,
-                           notify=notify)
+                           notify=notify, max_surface_terms=max_surface_terms)
 
 
 def load_trajectory(path: str, robot: Robot, interpolation: str | None = None) -> TrajectorySpec:

@@ -163,11 +163,13 @@ def test_cubic_spline_agrees_with_the_independent_spline_and_times(orthoglide_pr
                                                                    robot_spec):
     pieces = _cubic_pieces()
     spec = parse_trajectory(LINEAR_YAML.format(kind="cubic"), "p.yaml", robot_spec)
-    t = sympy.Symbol("t")
-    for (_, _, coords), piece in zip(pieces, spec.pieces, strict=True):
+    t, u = sympy.symbols("t u")
+    for (t0, _, coords), piece in zip(pieces, spec.pieces, strict=True):
+        assert piece.time_offset == t0  # each piece is written in u = t - t0
         for v, expr in zip("xyz", coords, strict=True):
             mine = {e[0]: Fraction(int(c.p), int(c.q)) for e, c in piece.pose[v].terms()}
-            theirs = {k: Fraction(str(c)) for (k,), c in sympy.Poly(expr, t).terms() if c}
+            local = sympy.expand(expr.subs(t, u + t0))
+            theirs = {k: Fraction(str(c)) for (k,), c in sympy.Poly(local, u).terms() if c}
             assert mine == theirs, v
     report = certify_trajectory(orthoglide_projection, spec)
     _assert_matches(report, singular_times(pieces))
@@ -289,7 +291,7 @@ def test_csv_decimals_are_exact(robot_spec, tmp_path):
     csv = tmp_path / "p.csv"
     csv.write_text("t,x,y,z\n0,0.1,0.3,1\n0.5,0.2,0.3,1\n")
     spec = load_trajectory(csv, robot_spec, "linear")
-    x = spec.pieces[0].pose["x"]
+    x = spec.pieces[0].pose["x"]  # 0.1 + (0.2 - 0.1)/0.5 * t, exactly
     assert {e[0]: Fraction(int(c.p), int(c.q)) for e, c in x.terms()} == \
         {0: Fraction(1, 10), 1: Fraction(1, 5)}
 

@@ -60,6 +60,14 @@ def _independent(robot_name, traj_name, mode, t):
     return out
 
 
+def _assert_drawn(post, expected):
+    for body in post.bodies:
+        drawn = [float(v) for chain in body.chains for p in chain for v in p] + \
+            [float(v) for p in body.points for v in p]
+        want = [v for p in expected[body.name] for v in p]
+        assert drawn == pytest.approx(want, abs=1e-7), (post.t, body.name)
+
+
 def test_one_panel_at_the_start_and_at_each_real_singular_time(case):
     _, _, report = case
     posts = postures(report)
@@ -76,11 +84,7 @@ def test_drawn_points_are_the_model_at_those_times(case):
     robot_name, traj_name, report = case
     for post in postures(report):
         expected = _independent(robot_name, traj_name, post.mode, post.t)
-        for body in post.bodies:
-            drawn = [float(v) for chain in body.chains for p in chain for v in p] + \
-                [float(v) for p in body.points for v in p]
-            want = [v for p in expected[body.name] for v in p]
-            assert drawn == pytest.approx(want, abs=1e-7), (post.t, body.name)
+        _assert_drawn(post, expected)
 
 
 def test_at_a_singular_posture_the_legs_are_degenerate(case):
@@ -116,3 +120,34 @@ def test_the_posture_figure_is_written_with_one_panel_per_posture(case, tmp_path
     plt.close(fig)
     files = write_figures(report, tmp_path, ("png",), dpi=40)
     assert tmp_path / f"{traj_name}-postures.png" in files
+
+
+HEART_IN_TWO = """\
+name: heart1-in-two
+parameter: t
+segments:
+  - range: [-1, 0]
+    pose: {x: 8/7*sin(pi*t)^3, z: 1,
+           y: 13/14*cos(pi*t) - 5/14*cos(2*pi*t) - 1/10*cos(3*pi*t) - 1/14*cos(4*pi*t)}
+  - range: [0, 1]
+    pose: {x: 8/7*sin(pi*t)^3, z: 1,
+           y: 13/14*cos(pi*t) - 5/14*cos(2*pi*t) - 1/10*cos(3*pi*t) - 1/14*cos(4*pi*t)}
+"""
+
+
+def test_a_path_in_two_rescaled_pieces_is_drawn_at_its_own_times(tmp_path):
+    """Heart 1 as two segments in t = τ/π: the postures are heart 1's, at times
+    divided by π, and each is drawn from the segment holding it."""
+    import math
+
+    path = tmp_path / "heart1-in-two.yaml"
+    path.write_text(HEART_IN_TWO)
+    robot = api.load_robot(ROBOTS / "orthoglide.yaml", backend="flint", cache=False)
+    report = api.check(robot, api.load_trajectory(path, robot), regions=False).certificate
+    assert len(report.pieces) == 2
+    posts = postures(report)
+    assert [p.kind for p in posts] == ["start", "singular", "singular"]
+    assert posts[0].t == -1
+    for post in posts:
+        expected = _independent("orthoglide", "heart1", post.mode, post.t * math.pi)
+        _assert_drawn(post, expected)

@@ -336,15 +336,54 @@ def test_cli_run_states_the_region():
 def test_region_figure_colours_by_exact_counts(orthoglide_projection, tmp_path):
     import numpy as np
 
-    from singcheck.report.region_plots import count_image, write_region_figure
+    from singcheck.report.region_plots import (
+        THIN,
+        cell_images,
+        label_points,
+        write_region_figure,
+    )
 
     analysis = analyse(WORKSPACE, orthoglide_projection.model,
                        workspace_variety(orthoglide_projection), {"z": Fraction(1)})
-    image, _ = count_image(analysis, size=60)
+    image, regions, window = cell_images(analysis, size=240)
     assert set(np.unique(image).tolist()) == {0.0, 1.0, 8.0}  # no pixel left unknown
-    files = write_region_figure(analysis, tmp_path)
+    assert regions.min() >= 1
+    # a pixel's count is the independent count at its centre, wherever that count holds
+    # half a pixel around it (the picture locates curves to a fraction of a pixel)
+    x0, x1, y0, y1 = window
+    xs, ys = np.linspace(x0, x1, 240), np.linspace(y0, y1, 240)
+    hx, hy = (x1 - x0) / 478, (y1 - y0) / 478
+    checked = 0
+    for r in range(0, 240, 7):
+        for c in range(0, 240, 7):
+            around = {_ik_count_mp(orthoglide_projection.model,
+                                   (Fraction(float(xs[c] + dx)), Fraction(float(ys[r] + dy)),
+                                    Fraction(1)))
+                      for dx in (-hx, 0, hx) for dy in (-hy, 0, hy)}
+            if len(around) == 1:
+                assert image[r, c] == around.pop(), (r, c)
+                checked += 1
+    assert checked > 1000
+    # each label sits deep inside its region, where the independent count is the region's
+    points = label_points(regions, window)
+    inside = {c.region for c in analysis.cells if c.count}
+    assert inside <= set(points)
+    for number in inside:
+        x, y, depth = points[number]
+        assert depth >= THIN * 240, number  # none of the z = 1 regions with solutions is thin
+        pose = (Fraction(x), Fraction(y), Fraction(1))
+        assert _ik_count_mp(orthoglide_projection.model, pose) == analysis.region_count(number)
+    # the heart-1 crescent regions R8, R10, R19, R20 around R9: labels apart from each other
+    xy = np.array([points[n][:2] for n in inside])
+    gaps = np.linalg.norm(xy[:, None] - xy[None], axis=-1) + np.eye(len(xy)) * 9
+    assert gaps.min() > 0.3
+    files = write_region_figure(analysis, tmp_path, size=240)
     assert [f.suffix for f in files] == [".png", ".svg"]
     assert files[0].read_bytes()[:4] == b"\x89PNG"
+    svg = files[1].read_text()
+    for label in ("parallel singularity: ξ(X)", "serial singularity: leg rho1",
+                  "joint limit: rho1 = 0 (min)", "R9", "R21", "8 solutions"):
+        assert label in svg, label
 
 
 def test_cli_plot_regions_needs_a_plane(tmp_path):

@@ -23,7 +23,7 @@ from collections import OrderedDict
 from dataclasses import dataclass
 from fractions import Fraction
 
-from flint import arb, arb_poly, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz_poly
+from flint import arb, arb_poly, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly, fmpz_poly
 
 #: Q[t, s, c]; exponents are (t, s, c).
 TRIG = fmpq_mpoly_ctx.get(("t", "s", "c"), "lex")
@@ -143,9 +143,12 @@ def evaluate_trig(p: fmpq_mpoly, t: arb) -> arb:
     encloses every value of p over the ball; the split is built once per polynomial
     and working precision (coefficients rounded at that precision) and memoised.
     """
+    split = _split(p)
+    if isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
+        return split(t)
     s, c = t.sin_cos()
     total = arb(0)
-    for p0, p1 in reversed(_split(p)):
+    for p0, p1 in reversed(split):
         total = total * t + p0(c) + s * p1(c)
     return total
 
@@ -154,15 +157,25 @@ _SPLITS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, list]] = OrderedDict()
 _SPLITS_KEPT = 512
 
 
-def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]]:
-    """[(P₀ᵢ, P₁ᵢ) for i = 0 … deg_t p] as ball polynomials at the current precision."""
+def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | arb_poly:
+    """[(P₀ᵢ, P₁ᵢ) for i = 0 … deg_t p] as ball polynomials at the current precision
+    (a polynomial free of sin and cos: one ball polynomial in t)."""
     key = (id(p), ctx.prec)
     hit = _SPLITS.get(key)
     if hit is not None and hit[0] is p:  # the entry holds p, so its id is not reused
         _SPLITS.move_to_end(key)
         return hit[1]
     q = reduce_trig(p)
-    dt, _, dc = q.degrees()
+    dt, ds, dc = q.degrees()
+    if ds == 0 and dc == 0:
+        by_t = [fmpq(0)] * (dt + 1)
+        for (i, _, _), a in q.terms():
+            by_t[i] = a
+        split = arb_poly(fmpq_poly(by_t))
+        _SPLITS[key] = (p, split)
+        if len(_SPLITS) > _SPLITS_KEPT:
+            _SPLITS.popitem(last=False)
+        return split
     coeffs = [[[fmpq(0)] * (dc + 1) for _ in range(2)] for _ in range(dt + 1)]
     for (i, j, k), a in q.terms():
         coeffs[i][j][k] = a

@@ -3,7 +3,8 @@
 Composing with φ is exact (``fmpq_mpoly.compose`` into ``Q[t, s, c]`` then
 :func:`~singcheck.trig.reduce_trig`).  The results are:
 
-* ``mu`` = ξ(φ(t)), whose real roots are every candidate singular time,
+* ``mu`` = ξ(φ(t)), whose real roots are every candidate singular time (when ξ(X) was too
+  big to expand, μ is computed directly: :func:`eliminate_along_path`),
 * per leg, the coefficients of its constraint in its joint, its discriminant D(t) and
   its joint-limit polynomials, from which the IK branches ρ = (-b ± √D)/(2a) along the
   path and their limit crossings are certified.
@@ -13,12 +14,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from flint import acb, arb, fmpq, fmpq_mpoly
+from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.intervals import evaluate, fraction_ball
+from singcheck.algebra.polynomials import restrict
 from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig
 from singcheck.elimination.projection import RobotProjection
-from singcheck.model.robot import Leg, leg_coefficients
+from singcheck.elimination.requests import norm_chain
+from singcheck.model.robot import Leg, RobotModel, leg_coefficients
 from singcheck.spec.files import TrajectorySpec
 
 
@@ -132,6 +135,26 @@ class PathModel:
         return evaluate(self.projection.model.det_A, [*joints, *pose])
 
 
+def eliminate_along_path(model: RobotModel, phi: tuple[fmpq_mpoly, ...]) -> fmpq_mpoly:
+    """μ(t) without ξ(X): substitute X = φ(t) first, then eliminate the joints.
+
+    det A and every leg constraint are composed with φ into Q[ρ, t, s, c], and the joints
+    are eliminated by the same norm as ξ (:func:`~singcheck.elimination.requests.norm_chain`,
+    a chain of resultants, one factor of det A at a time).  Each leg's leading
+    coefficient in its joint is a non-zero constant, so the resultants commute with the
+    substitution: the result is ξ(φ(t)) up to a constant factor and multiplicities, and
+    has exactly its zeros.  Only polynomials in one parameter (and s, c) are formed, never
+    ξ(X) in every pose variable.
+    """
+    ring = fmpq_mpoly_ctx.get((*model.joints, "t", "s", "c"), "lex")
+    gens = ring.gens()
+    to_ring = gens[len(model.joints):]
+    args = [*gens[:len(model.joints)], *(p.compose(*to_ring, ctx=ring) for p in phi)]
+    det_a = model.det_A.compose(*args, ctx=ring)
+    legs = [(leg.joint, leg.constraint.compose(*args, ctx=ring)) for leg in model.legs]
+    return reduce_trig(restrict(norm_chain(det_a, legs), TRIG))
+
+
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
     """The model along one piece (a multi-piece path: one per ``trajectory.pieces``)."""
     if trajectory.segments:
@@ -145,8 +168,11 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
             "the trajectory uses square roots (sqrt, or sin/cos of t plus a multiple of pi): "
             "this version certifies trajectories with rational coefficients only",
             path=trajectory.path, line=trajectory.lines.get("pose"), key="pose")
-    _refuse_costly(projection.singularity_surface, phi, model.pose, trajectory)
-    mu = compose_pose(projection.singularity_surface, phi, model.pose)
+    if projection.expanded:
+        _refuse_costly(projection.singularity_surface, phi, model.pose, trajectory)
+        mu = compose_pose(projection.singularity_surface, phi, model.pose)
+    else:
+        mu = eliminate_along_path(model, phi)
     legs = []
     for leg in model.legs:
         coeffs = tuple(compose_pose(c, phi, model.pose) for c in leg_coefficients(leg))

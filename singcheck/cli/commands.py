@@ -125,8 +125,11 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     with progress.status(f"projecting {spec.name} onto its workspace ({engine.name})"):
         machine = api.robot_from_spec(spec, cache=not no_cache, engine=engine)
     projection = machine.projection
-    degree = projection.singularity_surface.total_degree()
-    progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
+    if projection.expanded:
+        degree = projection.singularity_surface.total_degree()
+        progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
+    else:
+        progress.note(f"singularity surface: not expanded: {projection.not_expanded}")
     results = []
     with progress.bar(len(specs)) as advance:
         for doc in api.check_batch(machine, specs, tolerance=tolerance, jobs=jobs,
@@ -190,7 +193,8 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
                             f"has {len(traj.segments)} segments", path=traj.path)
         engine = api.elimination_engine(backend, cache=False)
         machine = api.robot_from_spec(spec, cache=False, engine=engine)
-        epsilon = None if no_epsilon else joint_space_singularities(machine.model, engine)
+        epsilon = None if no_epsilon or not machine.projection.expanded else \
+            joint_space_singularities(machine.model, engine)
         path = build_path(machine.projection, traj) if traj else None
         click.echo(render(machine.projection, epsilon, path, "json" if fmt == "json" else
                           "latex" if as_latex else "text"), nl=False)

@@ -9,11 +9,17 @@
   μ(X) list), exact because the leg involves no other joint.
 * ``joint_space_singularities`` ε(ρ): the projection of ``{F = 0, det A = 0}`` onto the
   joint space (pose eliminated), computed on demand.
+
+When ξ(X) would be too big to expand (:func:`expansion_bound` over
+``max_surface_terms``: six pose variables and six legs reach that), it is not computed:
+``singularity_surface`` is None, ``not_expanded`` says why, and each trajectory eliminates
+the joints along its own path instead (:func:`singcheck.certify.path.eliminate_along_path`).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from math import comb
 
 from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
@@ -36,12 +42,22 @@ class JointLimitSurface:
 class RobotProjection:
     model: RobotModel
     pose_context: fmpq_mpoly_ctx
-    singularity_surface: fmpq_mpoly  # ξ, squarefree, monic
-    singularity_surface_as_computed: fmpq_mpoly  # what the backend returned
+    singularity_surface: fmpq_mpoly | None  # ξ, squarefree, monic; None: not expanded
+    singularity_surface_as_computed: fmpq_mpoly | None  # what the backend returned
     workspace_boundary: tuple[fmpq_mpoly, ...]  # one discriminant per leg
     joint_limit_surfaces: tuple[JointLimitSurface, ...]
     backend: str
     method: str
+    not_expanded: str = ""  # why ξ(X) was not expanded (then μ is eliminated per path)
+
+    @property
+    def expanded(self) -> bool:
+        return self.singularity_surface is not None
+
+
+#: ξ(X) is expanded when the bound on its number of terms (:func:`expansion_bound`) is at
+#: most this; above it each trajectory eliminates the joints along its own path.
+MAX_SURFACE_TERMS = 10_000_000
 
 
 def singularity_surface_request(model: RobotModel) -> EliminationRequest:
@@ -120,9 +136,47 @@ def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str)
                            "re-check against the in-process norm of det A over the legs")
 
 
-def project_robot(model: RobotModel, backend: EliminationBackend) -> RobotProjection:
-    """Every workspace surface of the robot, with ξ from ``backend`` (re-checked)."""
+def expansion_bound(model: RobotModel) -> tuple[int, int]:
+    """(degree, terms): bounds on the largest factor of ξ(X) as the norm would build it.
+
+    ξ is the product over the irreducible factors g of det A of the chain of resultants
+    of g with the legs whose joints it involves.  ``deg Res_v(g, f) ≤ deg g · deg f``
+    (total degrees), so that factor's norm has degree at most d = deg g · Π deg f_i, and
+    at most C(n + d, n) terms in the n pose variables.  A bound, not a measurement: it
+    decides beforehand, in microseconds, whether expanding ξ can be afforded.
+    """
+    names = model.context.names()
+    n = len(model.pose)
+    worst = (0, 1)
+    for g, _ in model.det_A.factor()[1]:
+        degree = g.total_degree()
+        for leg in model.legs:
+            if g.degrees()[names.index(leg.joint)] > 0:
+                degree *= leg.constraint.total_degree()
+        worst = max(worst, (degree, comb(n + degree, n)), key=lambda b: b[1])
+    return worst
+
+
+def not_expanded_reason(model: RobotModel, max_terms: int = MAX_SURFACE_TERMS) -> str:
+    """Why ξ(X) should not be expanded ("" when it should)."""
+    degree, terms = expansion_bound(model)
+    if terms <= max_terms:
+        return ""
+    return (f"ξ(X) in {len(model.pose)} pose variables could reach degree {degree} "
+            f"({terms:.1e} terms, over the limit of {max_terms:.0e}); each path eliminates "
+            "the joints along itself instead (μ(t) computed directly)")
+
+
+def project_robot(model: RobotModel, backend: EliminationBackend,
+                  max_surface_terms: int = MAX_SURFACE_TERMS) -> RobotProjection:
+    """Every workspace surface of the robot, with ξ from ``backend`` (re-checked), or
+    without ξ when it is too big to expand (:func:`not_expanded_reason`)."""
     pose_ctx = _pose_context(model)
+    reason = not_expanded_reason(model, max_surface_terms)
+    if reason:
+        return RobotProjection(model, pose_ctx, None, None, workspace_boundary(model, pose_ctx),
+                               joint_limit_surfaces(model, pose_ctx), backend.name,
+                               "eliminated along each path", reason)
 
     def check(result) -> None:
         recheck_singularity_surface(model, _single(result, "singularity surface"),

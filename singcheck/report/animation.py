@@ -16,9 +16,8 @@ from flint import arb
 
 from singcheck.certify.classification import TrajectoryReport
 from singcheck.report.postures import (
-    draw_bodies,
+    drawing_at,
     drawing_box,
-    joints_at,
     postures,
     traced_points,
 )
@@ -29,16 +28,16 @@ _COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#
 
 
 def frame_times(report: TrajectoryReport, mode: str, samples: int = SAMPLES):
-    """The frames' times: (float, ball, is_singular), sorted; the singular times are the
-    certified enclosures of the mode's proven singular times."""
-    rng = report.path.trajectory.range
+    """The frames' times: (float, ball, is_singular, segment or None), sorted; the
+    singular times are the certified enclosures of the mode's proven singular times."""
+    rng = report.trajectory.global_range
     lo, hi = float(rng.start), float(rng.end)
-    times = [(float(x), arb(float(x)), False) for x in np.linspace(lo, hi, samples)]
-    times[0] = (lo, rng.start.ball(), False)
-    times[-1] = (hi, rng.end.ball(), False)
+    times = [(float(x), arb(float(x)), False, None) for x in np.linspace(lo, hi, samples)]
+    times[0] = (lo, rng.start.ball(), False, 1)
+    times[-1] = (hi, rng.end.ball(), False, len(report.trajectory.pieces))
     for m in report.modes:
         if m.label == mode:
-            times += [(float(c.t.mid()), c.t, True) for c in m.singular_times]
+            times += [(float(c.t.mid()), c.t, True, c.segment) for c in m.singular_times]
     return sorted(times, key=lambda x: x[0])
 
 
@@ -87,13 +86,9 @@ def animation_figure(report: TrajectoryReport, d, title: str, samples: int = SAM
                         subplot_titles=(f"the robot, mode {mode}", "μ(t) / max|μ|",
                                         f"det A, mode {mode}"))
     times = frame_times(report, mode, samples)
-    frames_bodies = []
-    for _, ball, _ in times:
-        joints = joints_at(report, mode, ball)
-        if joints is None:  # not proven real on this ball (only off a feasible mode)
-            frames_bodies.append(None)
-            continue
-        frames_bodies.append(draw_bodies(spec, joints, report.path.pose_at(ball)))
+    # None where a joint is not proven real on the ball (only off a feasible mode)
+    frames_bodies = [drawing_at(report, mode, ball, segment)
+                     for _, ball, _, segment in times]
     first = next(b for b in frames_bodies if b is not None)
     # static traces: the traced path, μ, det A, the singular times
     cls = go.Scatter3d if dim == 3 else go.Scatter
@@ -108,7 +103,7 @@ def animation_figure(report: TrajectoryReport, d, title: str, samples: int = SAM
     if det is not None:
         fig.add_trace(go.Scatter(x=d.t, y=det, mode="lines", name="det A",
                                  line={"color": "#1f77b4"}, showlegend=False), row=2, col=2)
-    sing = [t for t, _, s in times if s]
+    sing = [t for t, _, s, _ in times if s]
     if sing:
         fig.add_trace(go.Scatter(x=sing, y=[0] * len(sing), mode="markers",
                                  name="proven singular times",
@@ -132,7 +127,7 @@ def animation_figure(report: TrajectoryReport, d, title: str, samples: int = SAM
     moving_from = len(fig.data)
     for trace in _body_traces(go, first, dim, False):
         fig.add_trace(trace, row=1, col=1)
-    ts = np.array([t for t, _, _ in times])
+    ts = np.array([t for t, *_ in times])
     mu_at = np.interp(ts, d.t, d.mu)
     det_at = np.interp(ts, d.t, det) if det is not None else np.zeros_like(ts)
     fig.add_trace(go.Scatter(x=[ts[0]], y=[mu_at[0]], mode="markers", name="now",
@@ -141,7 +136,8 @@ def animation_figure(report: TrajectoryReport, d, title: str, samples: int = SAM
                              marker={"color": "#ff7f0e", "size": 12}), row=2, col=2)
     indices = list(range(moving_from, len(fig.data)))
     frames, steps = [], []
-    for k, ((t, _, singular), bodies) in enumerate(zip(times, frames_bodies, strict=True)):
+    for k, ((t, _, singular, _), bodies) in enumerate(zip(times, frames_bodies,
+                                                                  strict=True)):
         bodies = bodies or first
         name = f"{k}"
         data = _body_traces(go, bodies, dim, singular) + [
@@ -165,9 +161,9 @@ def animation_figure(report: TrajectoryReport, d, title: str, samples: int = SAM
                                    "args": [[None], {"mode": "immediate",
                                                      "frame": {"duration": 0}}]}]}],
         sliders=[{"active": 0, "steps": steps, "x": 0.14, "len": 0.86, "y": -0.04,
-                  "currentvalue": {"prefix": f"{report.path.trajectory.parameter} = "}}],
+                  "currentvalue": {"prefix": f"{report.trajectory.parameter} = "}}],
         legend={"orientation": "h", "y": 1.2, "x": 0.0, "yanchor": "bottom"})
-    fig.update_xaxes(title_text=report.path.trajectory.parameter, row=2, col=2)
+    fig.update_xaxes(title_text=report.trajectory.parameter, row=2, col=2)
     box = drawing_box([b for b in frames_bodies if b], path_traces)
     names = report.path.projection.model.pose
     titles = list(names) if len(names) == dim else ["", "", ""]

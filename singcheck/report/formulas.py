@@ -114,7 +114,8 @@ def latex(p: fmpq_mpoly) -> str:
 def robot_formulas(projection, epsilon: fmpq_mpoly | None) -> dict:
     """Every robot-level formula as plain text, keyed for JSON and display."""
     model = projection.model
-    factors = [(f, int(m)) for f, m in projection.singularity_surface_as_computed.factor()[1]]
+    factors = [(f, int(m)) for f, m in projection.singularity_surface_as_computed.factor()[1]] \
+        if projection.expanded else []
     return {
         "det_A": model.det_A,
         "det_B": model.det_B,
@@ -139,8 +140,11 @@ def render(projection, epsilon, path: PathModel | None, style: str) -> str:
         doc = {
             "robot": model.name, "joints": list(model.joints), "pose": list(model.pose),
             "det_A": str(f["det_A"]), "det_B": str(f["det_B"]),
-            "singularity_surface": str(f["singularity_surface"]),
-            "singularity_surface_degree": int(f["singularity_surface"].total_degree()),
+            "singularity_surface": str(f["singularity_surface"]) if projection.expanded
+            else None,
+            "singularity_surface_degree": int(f["singularity_surface"].total_degree())
+            if projection.expanded else None,
+            "singularity_surface_not_expanded": projection.not_expanded or None,
             "singularity_surface_factors": [{"factor": str(p), "multiplicity": m}
                                             for p, m in f["singularity_surface_factors"]],
             "joint_space_singularities": None if epsilon is None else str(epsilon),
@@ -161,7 +165,8 @@ def render(projection, epsilon, path: PathModel | None, style: str) -> str:
     eq = " &= " if style == "latex" else " = "
     nl = " \\\\\n" if style == "latex" else "\n"
     lines = [f"det A{eq}{show(f['det_A'])}", f"det B{eq}{show(f['det_B'])}",
-             f"xi(X){eq}{show(f['singularity_surface'])}"]
+             f"xi(X){eq}{show(f['singularity_surface'])}" if projection.expanded else
+             f"xi(X) not expanded: {projection.not_expanded}"]
     if epsilon is not None:
         lines.append(f"epsilon(rho){eq}{show(epsilon)}")
     lines += [f"workspace boundary ({j}){eq}{show(d)}"
@@ -176,10 +181,13 @@ def render(projection, epsilon, path: PathModel | None, style: str) -> str:
         return ("% s = sin t, c = cos t\n\\begin{align*}\n" + body + "\n\\end{align*}\n")
     degrees = ", ".join(f"degree {int(p.total_degree())}" + (f" (power {m})" if m > 1 else "")
                         for p, m in f["singularity_surface_factors"])
-    header = (f"robot {model.name}: joints {', '.join(model.joints)}; pose "
-              f"{', '.join(model.pose)}\nξ as computed by {projection.backend}: factors of "
-              f"{degrees}; singcheck uses their squarefree product (degree "
-              f"{int(f['singularity_surface'].total_degree())})\n")
+    header = f"robot {model.name}: joints {', '.join(model.joints)}; pose {', '.join(model.pose)}\n"
+    if projection.expanded:
+        header += (f"ξ as computed by {projection.backend}: factors of {degrees}; singcheck "
+                   "uses their squarefree product (degree "
+                   f"{int(f['singularity_surface'].total_degree())})\n")
+    else:
+        header += f"ξ(X) was not expanded: {projection.not_expanded}\n"
     if path:
         header += f"trajectory {path.trajectory.name}: s = sin t, c = cos t\n"
     return header + "\n".join(lines) + "\n"

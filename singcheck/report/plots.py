@@ -141,13 +141,16 @@ def _det_figure(plt, d: FigureData, title: str):
 
 
 def _workspace_figure(plt, d: FigureData, xi, title: str):
+    if xi is None:  # not expanded (too big): the path alone
+        title = title.replace("ξ(X) = 0", "ξ(X) not expanded")
     pose = d.names["pose"]
-    f = numpy_polynomial(xi)
+    f = numpy_polynomial(xi) if xi is not None else None
     if len(pose) == 2:
         fig, ax = plt.subplots(figsize=(6, 5))
         (x0, x1), (y0, y1) = _box(d.pose[0]), _box(d.pose[1])
         gx, gy = np.meshgrid(np.linspace(x0, x1, 300), np.linspace(y0, y1, 300))
-        ax.contour(gx, gy, f([gx, gy]), levels=[0], colors="orange")
+        if f is not None:
+            ax.contour(gx, gy, f([gx, gy]), levels=[0], colors="orange")
         ax.plot(d.pose[0], d.pose[1], color="black", lw=1)
         _mark_points(ax, d, 2)
         ax.set_xlabel(pose[0])
@@ -161,7 +164,8 @@ def _workspace_figure(plt, d: FigureData, xi, title: str):
         n = 48
         axes = [np.linspace(a, b, n) for a, b in boxes]
         grid = list(np.meshgrid(*axes, indexing="ij"))
-        values = f(grid + [np.zeros_like(grid[0])] * (len(pose) - 3))
+        values = f(grid + [np.zeros_like(grid[0])] * (len(pose) - 3)) if f is not None \
+            else np.ones_like(grid[0])
         if values.min() < 0 < values.max():
             verts, faces, _, _ = marching_cubes(values, 0.0)
             verts = np.array([b[0] for b in boxes]) + verts * np.array(

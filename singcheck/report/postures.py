@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from flint import acb, arb
+from flint import acb, arb, fmpq
 
 from singcheck.algebra.intervals import evaluate
 from singcheck.algebra.trig import evaluate_trig
@@ -67,43 +67,72 @@ def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:
             for body in spec.drawing]
 
 
-def joints_at(report: TrajectoryReport, label: str, t: arb) -> list | None:
-    path = report.path
-    per_leg = [leg.branches(t) for leg in path.legs]
+def _on_piece(report: TrajectoryReport, index: int, t: arb):
+    """The model of the path's piece ``index`` (0-based) and the ball ``t`` of the user's
+    time in that piece's own time (τ = g·π·t on a rescaled piece)."""
+    if not report.pieces:
+        return report.path, t
+    spec = report.trajectory.pieces[index]
+    path = report.pieces[index].path
+    if spec.time_scale is None:
+        return path, t
+    g = spec.time_scale
+    return path, t * arb.pi() * arb(fmpq(g.numerator, g.denominator))
+
+
+def piece_index(report: TrajectoryReport, t: float) -> int:
+    """The (first) piece whose range holds the time t, 0-based (for drawing only)."""
+    pieces = report.trajectory.pieces
+    for i, spec in enumerate(pieces):
+        if t <= float(spec.global_range.end):
+            return i
+    return len(pieces) - 1
+
+
+def drawing_at(report: TrajectoryReport, label: str, t: arb,
+               segment: int | None = None) -> list[DrawnBody] | None:
+    """The robot's drawing at the user's time ``t`` (a ball) in working mode ``label``, on
+    the given piece (1-based; default: the one holding t's midpoint); None where a joint
+    of the mode is not proven real on the ball."""
+    index = piece_index(report, _mid(t)) if segment is None else segment - 1
+    path, local = _on_piece(report, index, t)
+    per_leg = [leg.branches(local) for leg in path.legs]
     joints = [per_leg[i][ch] for i, ch in enumerate(label)]
-    return None if any(j is None or isinstance(j, acb) for j in joints) else joints
+    if any(j is None or isinstance(j, acb) for j in joints):
+        return None
+    return draw_bodies(path.projection.model.spec, joints, path.pose_at(local))
 
 
 def postures(report: TrajectoryReport) -> list[Posture]:
     """The start posture and one per proven singular time, for each feasible mode (for
     a path with no feasible mode: the start posture of the first mode real there)."""
-    spec = report.path.projection.model.spec
-    if not spec.drawing:
+    if not report.path.projection.model.spec.drawing:
         return []
-    start = report.path.trajectory.range.start.ball()
+    start = report.trajectory.global_range.start.ball()
     feasible = [m for m in report.modes if m.feasible]
     if not feasible:
-        feasible = [m for m in report.modes if joints_at(report, m.label, start)][:1]
+        feasible = [m for m in report.modes if drawing_at(report, m.label, start, 1)][:1]
     out = []
     for mode in feasible:
-        times = [("start", start)] + [("singular", c.t) for c in mode.singular_times]
-        for kind, t in times:
-            joints = joints_at(report, mode.label, t)
-            if joints is None:  # the branch's reality is not proven on this ball
+        times = [("start", start, 1)] + [("singular", c.t, c.segment)
+                                         for c in mode.singular_times]
+        for kind, t, segment in times:
+            bodies = drawing_at(report, mode.label, t, segment)
+            if bodies is None:  # the branch's reality is not proven on this ball
                 continue
-            bodies = draw_bodies(spec, joints, report.path.pose_at(t))
             out.append(Posture(_mid(t), (float(t.lower()), float(t.upper())), mode.label,
                                kind, mode.feasible, bodies))
     return out
 
 
 def traced_points(report: TrajectoryReport, t: np.ndarray) -> list[np.ndarray]:
-    """Each distinct drawn point that moves with the pose alone, sampled along the path:
-    arrays of shape (len(t), dim)."""
-    spec = report.path.projection.model.spec
+    """Each distinct drawn point that moves with the pose alone, sampled along the path
+    at the user's times ``t``: arrays of shape (len(t), dim)."""
     model = report.path.projection.model
+    spec = model.spec
     joint_index = [spec.context.names().index(j) for j in model.joints]
-    times = [arb(float(x)) for x in t]
+    located = [(piece_index(report, float(x)), float(x)) for x in t]
+    located = [(i, _on_piece(report, i, arb(x))) for i, x in located]
     seen, out = set(), []
     for body in spec.drawing:
         for p in (*body.points, *(q for chain in body.chains for q in chain)):
@@ -111,8 +140,13 @@ def traced_points(report: TrajectoryReport, t: np.ndarray) -> list[np.ndarray]:
                     all(c.is_constant() for c in p) or tuple(map(str, p)) in seen:
                 continue
             seen.add(tuple(map(str, p)))
-            along = [compose_pose(c, report.path.phi, model.pose) for c in p]
-            out.append(np.array([[_mid(evaluate_trig(c, x)) for c in along] for x in times]))
+            along: dict[int, list] = {}
+            rows = []
+            for i, (path, local) in located:
+                if i not in along:
+                    along[i] = [compose_pose(c, path.phi, model.pose) for c in p]
+                rows.append([_mid(evaluate_trig(c, local)) for c in along[i]])
+            out.append(np.array(rows))
     return out
 
 
@@ -137,7 +171,8 @@ def posture_figure(plt, report: TrajectoryReport, title: str, samples: int = 600
     spec = report.path.projection.model.spec
     dim = spec.drawing_dimension
     axes = report.path.projection.model.pose  # named when they are the drawing's axes
-    lo, hi = float(report.path.trajectory.range.start), float(report.path.trajectory.range.end)
+    rng = report.trajectory.global_range
+    lo, hi = float(rng.start), float(rng.end)
     traces = traced_points(report, np.linspace(lo, hi, samples))
     box = drawing_box([p.bodies for p in posts], traces)
     n = len(posts)

@@ -30,23 +30,28 @@ from singcheck.roots.enclosures import (
 from singcheck.roots.half_angle import _half_angle
 from singcheck.roots.rational import (
     exact_tolerance,
+    no_root_between,
+    nonzero_on,
     real_roots_exact,
     to_fraction,
 )
 
 
 def _as_univariate_t(p: fmpq_mpoly) -> fmpq_poly:
-    coeffs: dict[int, fmpq] = {}
-    for (i, _j, _k), c in p.terms():
-        coeffs[i] = coeffs.get(i, fmpq(0)) + c
-    return fmpq_poly([coeffs.get(i, fmpq(0)) for i in range(max(coeffs) + 1)])
+    coeffs = [fmpq(0)] * (p.degrees()[0] + 1)
+    for (i, _j, _k), c in p.terms():  # free of s and c here: one term per power of t
+        coeffs[i] += c
+    return fmpq_poly(coeffs)
 
 
 def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
     roots, undecided = [], []
     ends = [fmpq(e.rational.numerator, e.rational.denominator)
             for e in (interval.start, interval.end) if not e.pi_coefficient]
-    for rr, mult in real_roots_exact(_as_univariate_t(p)):
+    poly = _as_univariate_t(p)
+    if len(ends) == 2 and (nonzero_on(poly, *ends) or no_root_between(poly, *ends)):
+        return RootIsolation((), (), EXACT)  # quick proofs: ball arithmetic, Descartes on [a, b]
+    for rr, mult in real_roots_exact(poly):
         for q in ends:
             rr.pin(q)
 

@@ -197,6 +197,34 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     return intervals
 
 
+def nonzero_on(p: fmpq_poly, a: fmpq, b: fmpq, pieces: int = 8) -> bool:
+    """True when ball evaluations of ``p`` on ``pieces`` balls covering [a, b] all exclude
+    0 (then p has no root there: a proof by ball arithmetic).  False: not proven."""
+    with working_precision(64):
+        balls = arb_poly(p)  # each coefficient's ball, converted in FLINT
+        lo, width = arb(a), arb(b - a)
+        for k in range(pieces):
+            piece = (lo + width * k / pieces).union(lo + width * (k + 1) / pieces)
+            if balls(piece).contains(0):
+                return False
+    return True
+
+
+def no_root_between(p: fmpq_poly, a: fmpq, b: fmpq) -> bool:
+    """True when ``p`` provably has no root in the closed interval [a, b] (a < b): p(a)
+    and p(b) are non-zero exactly, and the Möbius transform (1 + v)ⁿ·p(a + (b − a)/(1 + v)),
+    whose positive roots are p's roots in (a, b), has no sign variation in its
+    coefficients (Descartes' rule of signs).  False means "not proven" (maybe roots)."""
+    if p(a) == 0 or p(b) == 0:
+        return False
+    n = p.degree()
+    q = p(fmpq_poly([a, b - a]))  # roots in (0, 1)
+    coeffs = q.coeffs() + [fmpq(0)] * (n + 1 - len(q.coeffs()))
+    moved = fmpq_poly(coeffs[::-1])(fmpq_poly([1, 1]))  # x^n q(1/x) at x = 1 + v
+    signs = [c > 0 for c in moved.coeffs() if c != 0]
+    return all(x == signs[0] for x in signs)
+
+
 def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
                      ) -> list[tuple[RationalRoot, int]]:
     """Isolating rational intervals of the real roots of ``p``, with multiplicities

@@ -96,7 +96,7 @@ def workspace_variety(projection: RobotProjection,
         if not disc.is_constant():
             out.append(VarietyComponent(SERIAL, f"leg {leg.joint}: its two branches meet",
                                         disc))
-    if parallel:
+    if parallel and projection.expanded:  # a ξ too big to expand is left out
         out.append(VarietyComponent(PARALLEL, "ξ(X): some working mode is singular",
                                     projection.singularity_surface))
     for s in projection.joint_limit_surfaces:

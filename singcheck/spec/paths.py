@@ -234,15 +234,16 @@ def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec
 
 def interpolated_pieces(path: str, name: str, parameter: str, times: list[Fraction],
                         values: dict[str, list[Fraction]], kind: str, lines: list[int]):
-    """One polynomial piece per interval between waypoints (in the global t)."""
+    """One polynomial piece per interval [tᵢ, tᵢ₊₁] between waypoints, written in the
+    local time u = t − tᵢ ∈ [0, tᵢ₊₁ − tᵢ]."""
     per_coord = {v: (linear_pieces if kind == "linear" else natural_cubic_spline)(times, ys)
                  for v, ys in values.items()}
     pieces = []
     for i in range(len(times) - 1):
-        rng = TimeRange(LinearInPi(times[i]), LinearInPi(times[i + 1]))
+        rng = TimeRange(LinearInPi(Fraction(0)), LinearInPi(times[i + 1] - times[i]))
         pieces.append(TrajectorySpec(path, f"{name}[{i + 1}]", parameter, rng,
                                      {v: polys[i] for v, polys in per_coord.items()},
-                                     {"segment": lines[i]}))
+                                     {"segment": lines[i]}, time_offset=times[i]))
     check_joins(pieces, path, [*lines])
     return pieces
 
@@ -252,18 +253,17 @@ def _q(x: Fraction) -> fmpq:
 
 
 def linear_pieces(ts: list[Fraction], ys: list[Fraction]) -> list[fmpq_mpoly]:
-    """The straight line from each waypoint to the next, as polynomials in t."""
+    """The straight line from each waypoint to the next, in u = t − tᵢ."""
     one = TRIG.from_dict({(0, 0, 0): 1})
-    return [one * _q(y0) + (T - _q(t0)) * _q((y1 - y0) / (t1 - t0))
+    return [one * _q(y0) + T * _q((y1 - y0) / (t1 - t0))
             for t0, t1, y0, y1 in zip(ts, ts[1:], ys, ys[1:], strict=False)]
 
 
 def natural_cubic_spline(ts: list[Fraction], ys: list[Fraction]) -> list[fmpq_mpoly]:
-    """The natural cubic spline through the points, exactly: its second derivatives Mᵢ
-    solve hᵢ₋₁Mᵢ₋₁ + 2(hᵢ₋₁ + hᵢ)Mᵢ + hᵢMᵢ₊₁ = 6(Δᵢ − Δᵢ₋₁), M₀ = Mₙ = 0 (Thomas'
-    algorithm over Q), and on [tᵢ, tᵢ₊₁]
-    S = Mᵢ(tᵢ₊₁ − t)³/6h + Mᵢ₊₁(t − tᵢ)³/6h + (yᵢ/h − Mᵢh/6)(tᵢ₊₁ − t)
-    + (yᵢ₊₁/h − Mᵢ₊₁h/6)(t − tᵢ)."""
+    """The natural cubic spline through the points, exactly, each piece in u = t − tᵢ: its
+    second derivatives Mᵢ solve hᵢ₋₁Mᵢ₋₁ + 2(hᵢ₋₁ + hᵢ)Mᵢ + hᵢMᵢ₊₁ = 6(Δᵢ − Δᵢ₋₁),
+    M₀ = Mₙ = 0 (Thomas' algorithm over Q), and on [tᵢ, tᵢ₊₁], with h = tᵢ₊₁ − tᵢ,
+    S = Mᵢ(h − u)³/6h + Mᵢ₊₁u³/6h + (yᵢ/h − Mᵢh/6)(h − u) + (yᵢ₊₁/h − Mᵢ₊₁h/6)u."""
     n = len(ts) - 1
     t = [_q(x) for x in ts]
     y = [_q(v) for v in ys]
@@ -283,12 +283,11 @@ def natural_cubic_spline(ts: list[Fraction], ys: list[Fraction]) -> list[fmpq_mp
             diag.append(d)
             rhs.append(r)
         for i in range(n - 1, 0, -1):
-            nxt = m[i + 1] if i + 1 < n else fmpq(0)
-            m[i] = (rhs[i - 1] - h[i] * nxt) / diag[i - 1]
+            m[i] = (rhs[i - 1] - h[i] * m[i + 1]) / diag[i - 1]
     one = TRIG.from_dict({(0, 0, 0): 1})
     out = []
     for i in range(n):
-        a, b = one * t[i + 1] - T, T - one * t[i]
+        a, b = one * h[i] - T, T
         out.append(a ** 3 * (m[i] / (6 * h[i])) + b ** 3 * (m[i + 1] / (6 * h[i]))
                    + a * (y[i] / h[i] - m[i] * h[i] / 6)
                    + b * (y[i + 1] / h[i] - m[i + 1] * h[i] / 6))

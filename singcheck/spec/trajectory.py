@@ -46,6 +46,9 @@ class TrajectorySpec:
     #: the pieces of a multi-piece path (segments, waypoints, CSV), each a one-piece spec
     #: over its own global sub-range; ``range`` is then the whole path's and ``pose`` empty.
     segments: tuple[TrajectorySpec, ...] = ()
+    #: t₀ when the pose is written in the local time u = t − t₀ (interpolated pieces: small
+    #: u keeps ball evaluations tight and coefficients small); ``range`` is then in u.
+    time_offset: Fraction = Fraction(0)
 
     @property
     def pieces(self) -> tuple[TrajectorySpec, ...]:
@@ -54,28 +57,34 @@ class TrajectorySpec:
 
     @property
     def global_range(self) -> TimeRange:
-        """The range in the user's parameter t (``range`` is in τ on a rescaled piece)."""
-        if self.time_scale is None:
-            return self.range
-        g = self.time_scale
-        return TimeRange(LinearInPi(self.range.start.pi_coefficient / g),
-                         LinearInPi(self.range.end.pi_coefficient / g))
+        """The range in the user's parameter t (``range`` is in the piece's own time)."""
+        if self.time_scale is not None:
+            g = self.time_scale
+            return TimeRange(LinearInPi(self.range.start.pi_coefficient / g),
+                             LinearInPi(self.range.end.pi_coefficient / g))
+        d = self.time_offset
+        return TimeRange(*(LinearInPi(e.rational + d, e.pi_coefficient)
+                           for e in (self.range.start, self.range.end)))
 
     def local_time(self, t: LinearInPi) -> LinearInPi:
-        """The exact time τ at which this piece is at the user's time t (rational t on a
-        rescaled piece)."""
-        if self.time_scale is None:
-            return t
-        return LinearInPi(Fraction(0), self.time_scale * t.rational)
+        """The exact time of this piece at the user's time t (rational t on a rescaled
+        piece)."""
+        if self.time_scale is not None:
+            return LinearInPi(Fraction(0), self.time_scale * t.rational)
+        return LinearInPi(t.rational - self.time_offset, t.pi_coefficient)
 
     def to_global(self, t):
-        """A ball in this piece's time mapped to a ball in t (t = τ/(gπ), rigorous)."""
-        if self.time_scale is None:
-            return t
+        """A ball in this piece's time mapped to a ball in t (t = τ/(gπ) or u + t₀,
+        rigorous)."""
         from flint import arb, fmpq
 
-        g = self.time_scale
-        return t / (arb.pi() * arb(fmpq(g.numerator, g.denominator)))
+        if self.time_scale is not None:
+            g = self.time_scale
+            return t / (arb.pi() * arb(fmpq(g.numerator, g.denominator)))
+        if self.time_offset:
+            d = self.time_offset
+            return t + arb(fmpq(d.numerator, d.denominator))
+        return t
 
 
 def exactly_less(a: LinearInPi, b: LinearInPi) -> bool:

@@ -1,0 +1,56 @@
+"""ξ(X) too big to expand: μ(t) eliminated along each path instead (issue 12, 6-DOF).
+
+The path-wise elimination is forced on small robots (``max_surface_terms=0``) so that its
+answers can be checked against the paper's figures and against ξ(φ(t)) itself."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from singcheck import api
+from singcheck.algebra.polynomials import squarefree_part
+from singcheck.certify.path import compose_pose, eliminate_along_path
+from tests.conftest import ROBOTS, TRAJECTORIES
+
+
+@pytest.fixture(scope="module")
+def pathwise_orthoglide():
+    return api.load_robot(ROBOTS / "orthoglide.yaml", backend="flint", cache=False,
+                          max_surface_terms=0)
+
+
+def test_the_projection_says_why_xi_was_not_expanded(pathwise_orthoglide):
+    projection = pathwise_orthoglide.projection
+    assert not projection.expanded and projection.singularity_surface is None
+    assert "could reach degree 24" in projection.not_expanded  # 3·2·2·2 (Bézout bound)
+    from singcheck.report.formulas import render
+
+    text = render(projection, None, None, "text")
+    assert "ξ(X) was not expanded" in text and "xi(X) not expanded" in text
+
+
+def test_pathwise_heart1_gives_the_papers_singular_times(pathwise_orthoglide):
+    traj = api.load_trajectory(TRAJECTORIES / "heart1.yaml", pathwise_orthoglide)
+    report = api.check(pathwise_orthoglide, traj, regions=False)
+    # the paper, Eq. (sol): t = [-1.51, -0.97, 0.97, 1.51], two decimals (truncated)
+    ts = [math.copysign(math.floor(abs(float(c.t.mid())) * 100) / 100, float(c.t.mid()))
+          for c in report.candidates]
+    assert ts == pytest.approx([-1.51, -0.97, 0.97, 1.51], abs=1e-9)
+    assert [c.status for c in report.candidates] == ["spurious", "spurious", "real", "real"]
+    assert report.verdict == "singular"
+
+
+@pytest.mark.parametrize("robot, name", [("orthoglide", "helix"), ("orthoglide", "heart2"),
+                                         ("skew-biglide", "skew-biglide-ellipse"),
+                                         ("stacked-orthoglide", "stacked-heart")])
+def test_pathwise_mu_has_the_zeros_of_xi_along_the_path(robot, name):
+    """Substituting first commutes with the resultants (constant leading coefficients):
+    the squarefree parts agree exactly, as polynomials in t, sin t, cos t."""
+    machine = api.load_robot(ROBOTS / f"{robot}.yaml", backend="flint", cache=False)
+    traj = api.load_trajectory(TRAJECTORIES / f"{name}.yaml", machine)
+    phi = tuple(traj.pose[v] for v in machine.model.pose)
+    mu = eliminate_along_path(machine.model, phi)
+    expected = compose_pose(machine.singularity_surface, phi, machine.model.pose)
+    assert squarefree_part(mu) == squarefree_part(expected)

@@ -189,7 +189,9 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
             certificate = certify_trajectory(robot.projection, trajectory, tolerance)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions or not _one_piece(trajectory):
+        if not regions or not _one_piece(trajectory) or not robot.model.polynomial:
+            # the workspace decomposition (CAD) needs rational polynomials in the pose:
+            # robots with angles or square roots get the certificate without it
             return Report(trajectory, certificate)
         path = certificate.path
         from singcheck.spaces.path_regions import path_in_workspace
@@ -233,7 +235,7 @@ def check_batch(robot: Robot, trajectories: list[TrajectorySpec], *,
         if jobs > 1 and n > 4:
             import multiprocessing
 
-            if regions:
+            if regions and robot.model.polynomial:
                 from singcheck.spaces.path_regions import prepare_region_maps
 
                 prepare_region_maps(robot.projection,

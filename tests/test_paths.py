@@ -339,3 +339,59 @@ def test_json_gains_segments_and_keeps_schema_1(tmp_path):
     assert [c["segment"] for c in t["candidates"]] == [1, 2]
     for key in ("candidates", "working_modes", "verdict", "root_isolation", "undecided"):
         assert key in t
+
+
+def test_plot_marks_the_joins_of_a_multi_piece_path(orthoglide_projection, robot_spec,
+                                                    tmp_path):
+    from singcheck.report.plots import figure_data, write_figures
+
+    report = _certify(orthoglide_projection, LINEAR_YAML.format(kind="linear"), robot_spec)
+    d = figure_data(report, samples=400)
+    assert float(d.t[0]) == 0 and float(d.t[-1]) == 2
+    assert [j["t"] for j in d.joins] == [1.0]
+    assert d.joins[0]["pose"] == pytest.approx([0.9, 1.1, 1.0])  # the middle waypoint
+    written = write_figures(report, tmp_path)
+    assert {p.name for p in written} >= {"through-waypoints-mu.png",
+                                         "through-waypoints-workspace.svg"}
+
+
+def test_quick_root_exclusion_on_a_rational_range():
+    from flint import fmpq, fmpq_poly
+
+    from singcheck.roots.rational import no_root_between, nonzero_on
+
+    p = fmpq_poly([2, -7, 3])  # 3t² − 7t + 2 = (3t − 1)(t − 2): roots 1/3 and 2
+    for a, b, free in [(0, fmpq(1, 4), True), (fmpq(1, 2), fmpq(3, 2), True),
+                       (0, 1, False), (fmpq(1, 3), 1, False), (1, 3, False)]:
+        assert no_root_between(p, fmpq(a), fmpq(b)) is free
+        assert not (nonzero_on(p, fmpq(a), fmpq(b)) and not free)  # never a false "free"
+
+
+def test_run_reads_a_csv_with_the_interpolation_asked(tmp_path):
+    csv = tmp_path / "path.csv"
+    csv.write_text(CSV)
+    expected = {"linear": singular_times(_linear_pieces()),
+                "cubic": singular_times(_cubic_pieces())}
+    for kind, roots in expected.items():
+        out = singcheck("run", str(ROBOTS / "orthoglide.yaml"), str(csv), "--format", "json",
+                        "--backend", "sympy", "--interpolation", kind)
+        assert out.returncode == 1, out.stderr
+        found = [c["t_interval"] for c in json.loads(out.stdout)["trajectories"][0]
+                 ["candidates"] if c["status"] == "real"]
+        assert len(found) == len(roots)
+        for (lo, hi), root in zip(found, roots, strict=True):
+            assert lo - 1e-12 <= float(root) <= hi + 1e-12, kind
+
+
+def test_a_serial_singularity_at_a_join_breaks_every_mode():
+    from singcheck import api
+
+    robot = api.robot_from_spec(parse_robot(RAIL, "rail.yaml"), "sympy", cache=False)
+    text = ("name: touch\nparameter: t\ninterpolation: linear\nwaypoints:\n"
+            "  - {t: 0, x: 1, y: 1}\n  - {t: 1, x: 1, y: 2}\n  - {t: 2, x: 3/2, y: 1}\n")
+    # independently: leg p's discriminant 4 − y² vanishes exactly at the join (y = 2)
+    assert 4 - Fraction(2) ** 2 == 0
+    report = api.check(robot, parse_trajectory(text, "p.yaml", robot.spec), regions=False)
+    assert report.verdict == "infeasible"
+    assert not [m for m in report.working_modes if m.feasible]
+    assert all("meet at t ≈ 1" in m.reason for m in report.working_modes)

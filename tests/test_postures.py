@@ -151,3 +151,26 @@ def test_a_path_in_two_rescaled_pieces_is_drawn_at_its_own_times(tmp_path):
     for post in posts:
         expected = _independent("orthoglide", "heart1", post.mode, post.t * math.pi)
         _assert_drawn(post, expected)
+
+
+def test_an_interpolated_path_is_traced_through_its_waypoints(tmp_path):
+    """A CSV of poses (a spline whose pieces run in local time u = t - t_i): the traced
+    end effector and the drawn platform pass through every row at its time."""
+    import numpy as np
+    from flint import arb
+
+    from singcheck.report.postures import drawing_at, traced_points
+
+    rows = [(0, 0.25, 0.6, 1), (1, 0.9, 1.1, 1), (2, 1.2, 0.3, 1), (3, 0.5, 0.2, 1)]
+    path = tmp_path / "pick.csv"
+    path.write_text("t,x,y,z\n" + "".join(",".join(map(str, r)) + "\n" for r in rows))
+    robot = api.load_robot(ROBOTS / "orthoglide.yaml", backend="flint", cache=False)
+    report = api.check(robot, api.load_trajectory(path, robot), regions=False).certificate
+    assert len(report.pieces) == 3
+    (trace,) = traced_points(report, np.array([r[0] for r in rows], dtype=float))
+    assert trace.ravel().tolist() == pytest.approx([v for r in rows for v in r[1:]], abs=1e-12)
+    mode = next(m.label for m in report.modes if m.feasible)
+    for t, *pose in rows:
+        bodies = drawing_at(report, mode, arb(t))
+        platform = next(b for b in bodies if b.name == "platform")
+        assert platform.points.ravel().tolist() == pytest.approx(pose, abs=1e-12)

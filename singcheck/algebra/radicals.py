@@ -33,6 +33,8 @@ from fractions import Fraction
 
 from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
 
+from singcheck.algebra.trig import TRIG, evaluate_trig
+
 MAX_RADICAND_BITS = 64
 _RADICAL = re.compile(r"sqrt\((\d+)\)\Z")
 
@@ -255,9 +257,10 @@ def radical_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
 
 
 def angle_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
-    """[(cos index, sin index)] for every angle pair ``cos(v)``, ``sin(v)`` of ``ctx``."""
+    """[(cos index, sin index)] for every angle pair ``cos(v)``, ``sin(v)`` of ``ctx``
+    (and (c, s) of a path ring whose first variables are t, s = sin t, c = cos t)."""
     names = ctx.names()
-    out = []
+    out = [(2, 1)] if names[:3] == ("t", "s", "c") else []
     for i, name in enumerate(names):
         if name.startswith("cos(") and name.endswith(")"):
             partner = "sin(" + name[4:]
@@ -340,3 +343,70 @@ def expand_trig(coefficients: dict[str, int], pi_part: Fraction,
             k >>= 1
         re_, im = re_ * pr - im * pi_, re_ * pi_ + im * pr
     return reduce_relations(re_), reduce_relations(im)
+
+
+def path_ring(primes) -> fmpq_mpoly_ctx:
+    """Q[t, s, c] with a ``sqrt(p)`` variable per prime (``TRIG`` itself for none)."""
+    primes = sorted(set(primes))
+    if not primes:
+        return TRIG
+    return fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
+
+
+def into_ring(p: fmpq_mpoly, ring: fmpq_mpoly_ctx) -> fmpq_mpoly:
+    """``p`` in a ring that has all of its variables (matched by name)."""
+    if p.context() is ring:
+        return p
+    names = ring.names()
+    where = [names.index(v) for v in p.context().names()]
+    out = {}
+    for exps, coeff in p.terms():
+        e = [0] * ring.nvars()
+        for i, k in zip(where, exps, strict=True):
+            e[i] = k
+        out[tuple(e)] = coeff
+    return ring.from_dict(out)
+
+
+_PARTS: dict[int, tuple[fmpq_mpoly, list]] = {}
+
+
+def _parts(p: fmpq_mpoly) -> list[tuple[tuple[int, ...], fmpq_mpoly]]:
+    """[(radical exponents, TRIG polynomial)] with p = Σ √…^e · P_e(t, s, c), memoised
+    (each P_e is kept alive with p, so ``evaluate_trig``'s own memo stays valid)."""
+    hit = _PARTS.get(id(p))
+    if hit is not None and hit[0] is p:
+        return hit[1]
+    groups: dict[tuple[int, ...], dict] = {}
+    for exps, coeff in p.terms():
+        groups.setdefault(tuple(exps[3:]), {})[tuple(exps[:3])] = coeff
+    parts = [(k, TRIG.from_dict(v)) for k, v in groups.items()]
+    if len(_PARTS) > 512:
+        _PARTS.clear()
+    _PARTS[id(p)] = (p, parts)
+    return parts
+
+
+def evaluate_path(p: fmpq_mpoly, t: arb, signs: dict[int, int] | None = None) -> arb:
+    """Rigorous enclosure of a path polynomial (in a :func:`path_ring`) for every t in
+    the ball ``t``, each ``sqrt(q)`` at its value √q (or -√q where ``signs[q] = -1``)."""
+    if p.context() is TRIG:
+        return evaluate_trig(p, t)
+    values = [b for _, b in sorted(radical_balls(p.context(), signs).items())]
+    total = arb(0)
+    for exps, part in _parts(p):
+        term = evaluate_trig(part, t)
+        for v, e in zip(values, exps, strict=True):
+            if e:
+                term *= v ** e
+        total += term
+    return total
+
+
+def conjugates(p: fmpq_mpoly) -> list[dict[int, int]]:
+    """Every sign choice on the square roots ``p`` involves, except all-positive."""
+    from itertools import product
+
+    primes = [q for i, q in radical_variables(p.context()) if p.degrees()[i] > 0]
+    return [dict(zip(primes, signs, strict=True))
+            for signs in product((1, -1), repeat=len(primes)) if -1 in signs]

@@ -11,7 +11,13 @@ What is proven, and how:
   det A(ρ_mode(T), φ(T)) over the candidate's ball T excludes 0.
 * **Singular, by elimination.**  For a leg-decoupled robot the working modes list every
   complex solution of the inverse kinematics, so μ(τ) = 0 means some mode's det A
-  vanishes at τ.  When every other mode is proven non-zero on T, it is this one.
+  vanishes at τ.  When every other mode is proven non-zero on T, it is this one.  With
+  square roots among the parameters, "every mode" includes the conjugate robots' modes
+  (√p ↦ -√p, evaluated but never feasible), since ξ is normed over them; with revolute
+  legs it needs W = a² + b² ≠ 0 on T for each (the joint integral over the pose there).
+* **Singular, det A free of the joints.**  When det A involves no joint, ξ is det A
+  (normed over the square roots): at a root of μ where every conjugate det A is proven
+  non-zero, det A vanishes, in every mode at once.
 * **Singular, exactly.**  At a root known exactly (a point ball, e.g. t = 0) where every
   enclosure is exact, det A evaluating to an exact 0 is a proof.
 * **Singular, by sign change.**  When det A along a real mode has proven opposite signs
@@ -27,7 +33,8 @@ from dataclasses import dataclass, field
 from flint import acb, arb
 
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
-from singcheck.certify.path import PathModel
+from singcheck.algebra.radicals import evaluate_path
+from singcheck.certify.path import PathModel, joint_float
 from singcheck.certify.working_modes import (
     FEASIBLE,
     INFEASIBLE,
@@ -44,6 +51,7 @@ BY_ELIMINATION = "elimination"
 BY_SIGN_CHANGE = "sign change"
 BY_EXCLUSION = "det A ≠ 0 (ball arithmetic)"
 BY_EXACT_ZERO = "det A = 0 exactly"
+BY_JOINT_FREE = "det A free of the joints (ξ = det A)"
 
 VERDICT_FREE = "singularity-free"
 VERDICT_SINGULAR = "singular"
@@ -101,14 +109,44 @@ class TrajectoryReport:
 
 def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
     pose = path.pose_at(t)
+    variables = path.pose_variables_at(t)
     per_leg = [leg.branches(t) for leg in path.legs]
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}
     for mode in modes:
         js = [per_leg[i][b.label] for i, b in enumerate(mode.branches)]
         joints[mode.label] = js
-        values[mode.label] = None if any(j is None for j in js) else path.det_A(js, pose)
+        values[mode.label] = None if any(j is None for j in js) else \
+            path.det_A(js, variables)
     return pose, joints, values
+
+
+def _conjugate_values(path: PathModel, modes: list[WorkingMode], t: arb) -> list:
+    """det A of every mode of every conjugate robot (square roots' signs flipped)."""
+    from itertools import product
+
+    from singcheck.algebra.radicals import radical_variables
+
+    primes = [q for _, q in radical_variables(path.projection.model.context)]
+    if not primes:
+        return []
+    variables = path.pose_variables_at(t)
+    out = []
+    for signs in product((1, -1), repeat=len(primes)):
+        if -1 not in signs:
+            continue
+        sigma = dict(zip(primes, signs, strict=True))
+        per_leg = path.conjugate_branches(t, variables, sigma)
+        for mode in modes:
+            js = [per_leg[i][b.label] for i, b in enumerate(mode.branches)]
+            out.append(None if any(j is None for j in js) else
+                       path.det_A(js, variables, sigma))
+    return out
+
+
+def _integral(path: PathModel, t: arb) -> bool:
+    """W ≠ 0 on the ball for every revolute leg (its joint integral over the pose)."""
+    return all(excludes_zero(evaluate_path(w, t)) for w in path.degenerate)
 
 
 def _sign_at(path: PathModel, mode: WorkingMode, point: arb) -> int | None:
@@ -121,9 +159,7 @@ def _branches_continuous(path: PathModel, t: arb) -> bool:
     """True when every quadratic leg's discriminant is proven > 0 on the whole ball:
     then each branch is real and continuous there, as the intermediate value
     theorem needs."""
-    from singcheck.algebra.trig import evaluate_trig
-
-    return all(leg.discriminant is None or evaluate_trig(leg.discriminant, t) > 0
+    return all(leg.discriminant is None or evaluate_path(leg.discriminant, t) > 0
                for leg in path.legs)
 
 
@@ -132,6 +168,12 @@ def _decide(path, modes, root: RealRoot):
     pose, joints, values = _mode_values(path, modes, root.t)
     decided: dict[str, ModeAtCandidate] = {}
     open_modes = []
+    conjugate = _conjugate_values(path, modes, root.t) if not path.projection.model.polynomial \
+        else []
+    conjugates_regular = all(v is not None and excludes_zero(v) for v in conjugate)
+    if path.projection.model.joint_free_det_A and conjugates_regular:
+        return pose, joints, {m.label: ModeAtCandidate(m.label, SINGULAR, BY_JOINT_FREE)
+                              for m in modes}
     for mode in modes:
         v = values[mode.label]
         if v is not None and excludes_zero(v):
@@ -141,7 +183,7 @@ def _decide(path, modes, root: RealRoot):
             decided[mode.label] = ModeAtCandidate(mode.label, SINGULAR, BY_EXACT_ZERO)
         else:
             open_modes.append(mode)
-    if len(open_modes) == 1:
+    if len(open_modes) == 1 and conjugates_regular and _integral(path, root.t):
         m = open_modes[0]
         decided[m.label] = ModeAtCandidate(m.label, SINGULAR, BY_ELIMINATION)
         open_modes = []
@@ -177,14 +219,10 @@ def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot
     feasible = {m.label for m in modes if m.status == FEASIBLE}
     states = {pm.status for pm in per_mode if pm.mode in feasible}
     status = "real" if SINGULAR in states else "unknown" if UNKNOWN in states else "spurious"
-    shown = {m.label: {leg.leg.joint: _mid(v) for leg, v in zip(path.legs, joints[m.label],
-                                                                 strict=True)}
+    shown = {m.label: {leg.leg.joint: joint_float(v)
+                       for leg, v in zip(path.legs, joints[m.label], strict=True)}
              for m in modes if m.status == FEASIBLE}
     return Candidate(root, pose, shown, per_mode, status)
-
-
-def _mid(v) -> float | None:
-    return float(v.mid()) if isinstance(v, arb) else None
 
 
 def _clear_undecided(path, modes, box) -> bool:

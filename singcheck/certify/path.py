@@ -7,36 +7,87 @@ Composing with φ is exact (``fmpq_mpoly.compose`` into ``Q[t, s, c]`` then
   big to expand, μ is computed directly: :func:`eliminate_along_path`),
 * per leg, the coefficients of its constraint in its joint, its discriminant D(t) and
   its joint-limit polynomials, from which the IK branches ρ = (-b ± √D)/(2a) along the
-  path and their limit crossings are certified.
+  path (for a revolute leg, cos θ and sin θ of its two branches) and their limit
+  crossings are certified.
+
+**Angles along the path.**  A pose angle φ(t) = k·t + qπ (k an integer, 12q an integer)
+has ``cos φ(t) = cos(kt)·cos(qπ) - sin(kt)·sin(qπ)`` (and likewise sin), exact
+polynomials in s, c with surd coefficients.  Square roots (of the robot's parameters, of
+such offsets, of an angle joint's limits) stay variables ``sqrt(p)`` of the path ring
+(:func:`~singcheck.algebra.radicals.path_ring`), evaluated as balls and isolated through
+their norm (:mod:`singcheck.roots.isolation`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.intervals import evaluate, fraction_ball
 from singcheck.algebra.polynomials import restrict
-from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig
-from singcheck.elimination.projection import RobotProjection
+from singcheck.algebra.radicals import (
+    cos_pi,
+    evaluate_path,
+    into_ring,
+    path_ring,
+    radical_balls,
+    radical_prime,
+    reduce_relations,
+    sin_pi,
+    surd_polynomial,
+)
+from singcheck.algebra.trig import TRIG, cos_multiple, reduce_trig, sin_multiple
+from singcheck.elimination.projection import (
+    RobotProjection,
+    angle_limit_values,
+    degenerate_set,
+    limit_constraint,
+    norm_legs,
+)
 from singcheck.elimination.requests import norm_chain
-from singcheck.model.robot import Leg, RobotModel, leg_coefficients
+from singcheck.errors import UnsupportedRobotError
+from singcheck.model.robot import (
+    REVOLUTE,
+    Leg,
+    RobotModel,
+    leg_coefficients,
+    leg_discriminant,
+)
 from singcheck.spec.files import TrajectorySpec
 
 
+def _reduce(p: fmpq_mpoly) -> fmpq_mpoly:
+    return reduce_trig(p) if p.context() is TRIG else reduce_relations(p)
+
+
 def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ...]) -> fmpq_mpoly:
-    """``p(…, X = φ(t))`` for a polynomial in any context whose non-pose variables are absent."""
+    """``p(…, X = φ(t))`` for a polynomial in any context whose non-pose variables are absent
+    (square roots ``sqrt(q)`` become the path ring's, which ``phi`` lives in)."""
     names = p.context().names()
+    ring = phi[0].context() if phi else TRIG
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
     args = []
     for v in names:
         if v in pose:
             args.append(phi[pose.index(v)])
+        elif radical_prime(v) is not None and v in gens:
+            args.append(gens[v])
         elif p.degrees()[names.index(v)] > 0:
             raise ValueError(f"{v} is not a pose variable")
         else:
-            args.append(TRIG.from_dict({}))
-    return reduce_trig(p.compose(*args, ctx=TRIG))
+            args.append(ring.from_dict({}))
+    return _reduce(p.compose(*args, ctx=ring))
+
+
+def joint_float(value) -> float | None:
+    """A joint value for display: a real ball's midpoint, or the angle atan2(s, c) of a
+    revolute branch (radians, in (-π, π]); None when not real."""
+    if isinstance(value, arb):
+        return float(value.mid())
+    if isinstance(value, tuple) and all(isinstance(v, arb) for v in value):
+        return float(arb.atan2(value[1], value[0]).mid())
+    return None
 
 
 #: The most terms μ(t) = ξ(φ(t)) may have by the a-priori bound of :func:`mu_size_bound`
@@ -79,11 +130,17 @@ def _refuse_costly(xi, phi, pose, trajectory) -> None:
 
 @dataclass(frozen=True)
 class LegAlongPath:
-    """One leg's constraint along the path: ``a ρ² + b(t) ρ + c(t)`` (or ``b ρ + c``)."""
+    """One leg's constraint along the path: ``a ρ² + b(t) ρ + c(t)`` (or ``b ρ + c``), or
+    ``a(t) cos θ + b(t) sin θ + d(t)`` for a revolute leg."""
 
     leg: Leg
-    coefficients: tuple[fmpq_mpoly, ...]  # TRIG polys, highest degree first
-    discriminant: fmpq_mpoly | None  # b² - 4ac for a quadratic leg
+    coefficients: tuple[fmpq_mpoly, ...]  # path polys, highest degree first / (a, b, d)
+    discriminant: fmpq_mpoly | None  # b² - 4ac for a quadratic leg, Δ for a revolute one
+    limits: dict = field(default_factory=dict)  # limit value -> its polynomial along the path
+
+    @property
+    def revolute(self) -> bool:
+        return self.leg.kind == REVOLUTE
 
     @property
     def labels(self) -> tuple[str, ...]:
@@ -92,66 +149,193 @@ class LegAlongPath:
 
     def limit_polynomial(self, value) -> fmpq_mpoly:
         """The constraint with the joint set to ``value``: it vanishes when a branch is there."""
-        out = TRIG.from_dict({})
+        if value in self.limits:
+            return self.limits[value]
+        out = self.coefficients[0].context().from_dict({})
         q = fmpq(value.numerator, value.denominator)
         for c in self.coefficients:
             out = out * q + c
         return out
 
-    def branches(self, t: arb) -> dict[str, arb | acb | None]:
+    def branches(self, t: arb) -> dict[str, arb | acb | tuple | None]:
         """Enclosures of each branch's joint value for every t in the ball ``t``.
 
         A quadratic leg's branches are real where D > 0 (proven) and complex
-        conjugate where D < 0; where the sign of D is not proven both are None.
-        """
-        values = [evaluate_trig(c, t) for c in self.coefficients]
-        if self.leg.degree == 1:
-            b, c = values
-            return {"o": -c / b}
-        a, b, _ = values
-        d = evaluate_trig(self.discriminant, t)
+        conjugate where D < 0; where the sign of D is not proven both are None.  A
+        revolute branch is the pair (cos θ, sin θ)."""
+        values = [evaluate_path(c, t) for c in self.coefficients]
+        d = evaluate_path(self.discriminant, t) if self.discriminant is not None else None
+        return branch_values(self.leg, values, d)
+
+    def inside(self, value, limits) -> bool | None:
+        """Whether a branch value is strictly inside the limits (True), outside them
+        (False), or not decided (None, also on the limits themselves)."""
+        return inside_limits(self.leg, value, limits)
+
+
+def branch_values(leg: Leg, values: list, d) -> dict:
+    """Each branch from the leg's coefficient balls (and its discriminant's)."""
+    if leg.kind == REVOLUTE:
+        a, b, dd = values
+        w = a * a + b * b
         if d > 0:
             root = d.sqrt()
-            return {"+": (-b + root) / (2 * a), "-": (-b - root) / (2 * a)}
-        if d < 0:
+        elif d < 0:
             root = acb(0, (-d).sqrt())
-            return {"+": (-acb(b) + root) / (2 * a), "-": (-acb(b) - root) / (2 * a)}
-        return {"+": None, "-": None}
+            a, b, dd, w = acb(a), acb(b), acb(dd), acb(w)
+        else:
+            return {"+": None, "-": None}
+        return {label: ((-a * dd + sigma * b * root) / w, (-b * dd - sigma * a * root) / w)
+                for label, sigma in (("+", 1), ("-", -1))}
+    if leg.degree == 1:
+        b, c = values
+        return {"o": -c / b}
+    a, b, _ = values
+    if d > 0:
+        root = d.sqrt()
+        return {"+": (-b + root) / (2 * a), "-": (-b - root) / (2 * a)}
+    if d < 0:
+        root = acb(0, (-d).sqrt())
+        return {"+": (-acb(b) + root) / (2 * a), "-": (-acb(b) - root) / (2 * a)}
+    return {"+": None, "-": None}
+
+
+def inside_limits(leg: Leg, value, limits) -> bool | None:
+    """Strictly inside (True), outside (False) or undecided (None).  For an angle θ and
+    limits [lo, hi] of width w < 2π with middle m: θ is inside (mod 2π) exactly when
+    cos(θ - m) = cos θ·cos m + sin θ·sin m ≥ cos(w/2) (no branch cut to straddle)."""
+    if value is None:
+        return None
+    if leg.kind == REVOLUTE:
+        if not isinstance(value, tuple) or not all(isinstance(v, arb) for v in value):
+            return None
+        lo, hi = (v.ball() for v in limits)
+        width = hi - lo
+        if width >= 2 * arb.pi():
+            return True
+        mid = (lo + hi) / 2
+        margin = value[0] * mid.cos() + value[1] * mid.sin() - (width / 2).cos()
+        return True if margin > 0 else False if margin < 0 else None
+    lo, hi = (fraction_ball(v) for v in limits)
+    if value > lo and value < hi:
+        return True
+    if value < lo or value > hi:
+        return False
+    return None
 
 
 @dataclass(frozen=True)
 class PathModel:
     projection: RobotProjection
     trajectory: TrajectorySpec
-    phi: tuple[fmpq_mpoly, ...]  # pose coordinates in the robot's pose order
+    phi: tuple[fmpq_mpoly, ...]  # pose coordinates in the robot's pose order (display)
     mu: fmpq_mpoly  # ξ(φ(t))
     legs: tuple[LegAlongPath, ...]
+    coordinates: tuple[fmpq_mpoly, ...] = ()  # the pose variables' (cos φ, sin φ for angles)
+    degenerate: tuple[fmpq_mpoly, ...] = ()  # W of each revolute leg along the path
 
     def pose_at(self, t: arb) -> list[arb]:
-        return [evaluate_trig(x, t) for x in self.phi]
+        """The pose coordinates (an angle in radians, its π offset included)."""
+        out = []
+        offsets = self.trajectory.angle_offsets
+        for v, x in zip(self.projection.model.pose, self.phi, strict=True):
+            value = evaluate_path(x, t)
+            if v in offsets:
+                value += arb.pi() * fraction_ball(offsets[v])
+            out.append(value)
+        return out
 
-    def det_A(self, joints: list[arb | acb], pose: list[arb]) -> arb | acb:
-        """Enclosure of det A at the given joint and pose enclosures."""
-        return evaluate(self.projection.model.det_A, [*joints, *pose])
+    def pose_variables_at(self, t: arb) -> list[arb]:
+        """Balls of the model's pose variables (cos φ, sin φ for an angle)."""
+        return [evaluate_path(x, t) for x in self.coordinates]
+
+    def det_A(self, joints: list, pose: list[arb], signs: dict[int, int] | None = None):
+        """Enclosure of det A at the given joint values (a revolute joint's as a (cos,
+        sin) pair) and pose-variable balls; ``signs`` picks conjugate square roots."""
+        model = self.projection.model
+        point: list = []
+        for j in joints:
+            point += list(j) if isinstance(j, tuple) else [j]
+        point += list(pose)
+        point += [b for _, b in sorted(radical_balls(model.context, signs).items())]
+        return evaluate(model.det_A, point)
+
+    def conjugate_branches(self, t: arb, pose: list[arb], signs: dict[int, int]):
+        """Per leg, the branches of the conjugate robot (its square roots' signs flipped
+        as ``signs`` says), by ball evaluation of the leg's coefficients at the pose."""
+        model = self.projection.model
+        n_joint = len(model.joint_variables)
+        radicals = [b for _, b in sorted(radical_balls(model.context, signs).items())]
+        out = []
+        for leg in self.legs:
+            coefficients = leg_coefficients(leg.leg)
+            point = [arb(0)] * n_joint + list(pose) + radicals
+            values = [evaluate(c, point) for c in coefficients]
+            disc = leg_discriminant(leg.leg, coefficients)
+            out.append(branch_values(leg.leg, values,
+                                     evaluate(disc, point) if disc is not None else None))
+        return out
 
 
-def eliminate_along_path(model: RobotModel, phi: tuple[fmpq_mpoly, ...]) -> fmpq_mpoly:
+def _angle_coordinates(v: str, p: fmpq_mpoly, q, ring, where) -> tuple[fmpq_mpoly, fmpq_mpoly]:
+    """(cos, sin) of the angle k·t + qπ along the path, exactly."""
+    terms = dict(p.terms())
+    k = None
+    if not terms:
+        k = 0
+    elif len(terms) == 1:
+        (exps, coeff), = terms.items()
+        if exps[0] == 1 and not any(exps[1:]) and coeff.q == 1:
+            k = int(coeff.p)
+    if k is None or cos_pi(q) is None:
+        raise UnsupportedRobotError(
+            f"the angle {v} must follow k*t + a multiple of pi/12 along the path (k an "
+            "integer, e.g. 2*t - pi/6) for an exact certificate; other angle paths are not "
+            "supported yet", **where)
+    ck, sk = into_ring(cos_multiple(k), ring), into_ring(sin_multiple(k), ring)
+    cq, sq = surd_polynomial(cos_pi(q), ring), surd_polynomial(sin_pi(q), ring)
+    return _reduce(ck * cq - sk * sq), _reduce(sk * cq + ck * sq)
+
+
+def _primes_of(*polys) -> set[int]:
+    out = set()
+    for p in polys:
+        for i, name in enumerate(p.context().names()):
+            prime = radical_prime(name)
+            if prime is not None and p.degrees()[i] > 0:
+                out.add(prime)
+    return out
+
+
+def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
+                         where: dict | None = None) -> fmpq_mpoly:
     """μ(t) without ξ(X): substitute X = φ(t) first, then eliminate the joints.
 
-    det A and every leg constraint are composed with φ into Q[ρ, t, s, c], and the joints
-    are eliminated by the same norm as ξ (:func:`~singcheck.elimination.requests.norm_chain`,
-    a chain of resultants, one factor of det A at a time).  Each leg's leading
-    coefficient in its joint is a non-zero constant, so the resultants commute with the
-    substitution: the result is ξ(φ(t)) up to a constant factor and multiplicities, and
-    has exactly its zeros.  Only polynomials in one parameter (and s, c) are formed, never
-    ξ(X) in every pose variable.
+    det A and every leg constraint are composed with φ (the pose variables' coordinates:
+    cos φ, sin φ for an angle) into Q[ρ, √…, t, s, c], and the joints (and the robot's
+    square roots) are eliminated by the same norm as ξ
+    (:func:`~singcheck.elimination.requests.norm_chain`, a chain of resultants and
+    revolute norms, one factor of det A at a time).  Each leg's leading coefficient in
+    its joint is a non-zero constant (a revolute leg's norm is a polynomial identity), so
+    the elimination commutes with the substitution: the result is ξ(φ(t)) up to a
+    constant factor and multiplicities, and has exactly its zeros.  Only polynomials in
+    one parameter (and s, c) are formed, never ξ(X) in every pose variable.  A path with
+    square roots of its own is refused (they would be conjugated with the robot's).
     """
-    ring = fmpq_mpoly_ctx.get((*model.joints, "t", "s", "c"), "lex")
-    gens = ring.gens()
-    to_ring = gens[len(model.joints):]
-    args = [*gens[:len(model.joints)], *(p.compose(*to_ring, ctx=ring) for p in phi)]
+    if any(x.context() is not TRIG for x in coordinates):
+        raise UnsupportedRobotError(
+            "ξ(X) was not expanded and this path has square roots of its own (sqrt, or an "
+            "angle offset like pi/6): eliminating along it is not supported yet",
+            **(where or {}))
+    eliminated = model.eliminated
+    ring = fmpq_mpoly_ctx.get((*eliminated, "t", "s", "c"), "lex")
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    tsc = [gens["t"], gens["s"], gens["c"]]
+    pose = model.pose_variables
+    args = [gens[v] if v in gens else coordinates[pose.index(v)].compose(*tsc, ctx=ring)
+            for v in model.context.names()]
     det_a = model.det_A.compose(*args, ctx=ring)
-    legs = [(leg.joint, leg.constraint.compose(*args, ctx=ring)) for leg in model.legs]
+    legs = [(v, f.compose(*args, ctx=ring)) for v, f in norm_legs(model)]
     return reduce_trig(restrict(norm_chain(det_a, legs), TRIG))
 
 
@@ -160,28 +344,52 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
     if trajectory.segments:
         raise ValueError("build_path takes one piece: use trajectory.pieces")
     model = projection.model
+    spec = model.spec
+    where = dict(path=trajectory.path, line=trajectory.lines.get("pose"), key="pose")
     phi = tuple(trajectory.pose[v] for v in model.pose)
-    if any(p.context() is not TRIG for p in phi):
-        from singcheck.errors import UnsupportedRobotError
-
-        raise UnsupportedRobotError(
-            "the trajectory uses square roots (sqrt, or sin/cos of t plus a multiple of pi): "
-            "this version certifies trajectories with rational coefficients only",
-            path=trajectory.path, line=trajectory.lines.get("pose"), key="pose")
+    primes = set(spec.radicals) | _primes_of(*phi)
+    offsets = trajectory.angle_offsets
+    for v in model.pose:
+        if v in offsets and cos_pi(offsets[v]) is not None:
+            primes |= cos_pi(offsets[v]).primes() | sin_pi(offsets[v]).primes()
+    for leg in model.legs:
+        if leg.kind == REVOLUTE and leg.joint in spec.joint_limits:
+            for value in spec.joint_limits[leg.joint]:
+                try:
+                    cos_l, sin_l = angle_limit_values(leg.joint, value)
+                except UnsupportedRobotError as e:
+                    raise UnsupportedRobotError(
+                        e.message, path=spec.path, line=spec.lines.get("joint_limits"),
+                        key=f"joint_limits.{leg.joint}") from None
+                primes |= cos_l.primes() | sin_l.primes()
+    ring = path_ring(primes)
+    phi = tuple(into_ring(x, ring) for x in phi)
+    coordinates = []
+    for v, x in zip(model.pose, phi, strict=True):
+        if v in model.angles:
+            coordinates += _angle_coordinates(v, x, offsets.get(v, 0), ring, where)
+        else:
+            coordinates.append(x)
+    coordinates = tuple(coordinates)
+    pose_vars = model.pose_variables
     if projection.expanded:
-        _refuse_costly(projection.singularity_surface, phi, model.pose, trajectory)
-        mu = compose_pose(projection.singularity_surface, phi, model.pose)
+        _refuse_costly(projection.singularity_surface, coordinates, pose_vars, trajectory)
+        mu = compose_pose(projection.singularity_surface, coordinates, pose_vars)
     else:
-        mu = eliminate_along_path(model, phi)
+        mu = eliminate_along_path(model, coordinates, where)
     legs = []
     for leg in model.legs:
-        coeffs = tuple(compose_pose(c, phi, model.pose) for c in leg_coefficients(leg))
-        disc = None
-        if leg.degree == 2:
-            a, b, c = coeffs
-            disc = reduce_trig(b * b - 4 * a * c)
-        legs.append(LegAlongPath(leg, coeffs, disc))
-    return PathModel(projection, trajectory, phi, mu, tuple(legs))
+        coeffs = tuple(compose_pose(c, coordinates, pose_vars) for c in leg_coefficients(leg))
+        disc = leg_discriminant(leg, coeffs)
+        limits = {}
+        if leg.kind == REVOLUTE and leg.joint in spec.joint_limits:
+            for value in spec.joint_limits[leg.joint]:
+                limits[value] = compose_pose(limit_constraint(model, leg, value), coordinates,
+                                             pose_vars)
+        legs.append(LegAlongPath(leg, coeffs, _reduce(disc) if disc is not None else None,
+                                 limits))
+    degenerate = tuple(compose_pose(w, coordinates, pose_vars) for w in degenerate_set(model))
+    return PathModel(projection, trajectory, phi, mu, tuple(legs), coordinates, degenerate)
 
 
 def exact_point(q) -> arb:

@@ -29,10 +29,11 @@ from itertools import product
 
 from flint import arb
 
-from singcheck.algebra.intervals import fraction_ball, working_precision
-from singcheck.algebra.trig import TimeRange, evaluate_trig
+from singcheck.algebra.intervals import working_precision
+from singcheck.algebra.radicals import evaluate_path
+from singcheck.algebra.trig import TimeRange
 from singcheck.budget import checkpoint
-from singcheck.certify.path import LegAlongPath, PathModel
+from singcheck.certify.path import LegAlongPath, PathModel, joint_float
 from singcheck.roots.enclosures import IdenticallyZeroError, RootIsolation
 from singcheck.roots.isolation import isolate_real_roots
 
@@ -129,7 +130,7 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when)
     """Status of both branches of a quadratic leg with respect to step 1 (``when``
     writes a time ball in the user's parameter)."""
     joint = leg.leg.joint
-    if _everywhere(lambda t: evaluate_trig(leg.discriminant, t) > 0, interval):
+    if _everywhere(lambda t: evaluate_path(leg.discriminant, t) > 0, interval):
         return FEASIBLE, "", None
     iso = _isolate(leg.discriminant, interval, tolerance)
     if iso is None:
@@ -140,28 +141,18 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when)
         return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {when(t)} " \
             "(serial singularity: the path reaches the workspace boundary)", t
     for box in iso.undecided:
-        if not evaluate_trig(leg.discriminant, box.t) > 0:
+        if not evaluate_path(leg.discriminant, box.t) > 0:
             return UNKNOWN, f"could not prove that the branches of {joint} stay apart: " \
                 f"{box.reason}", box.t
     for prec in _PRECISIONS:
         with working_precision(prec):
-            d = evaluate_trig(leg.discriminant, interval.start.ball())
+            d = evaluate_path(leg.discriminant, interval.start.ball())
         if d > 0:
             return FEASIBLE, "", None
         if d < 0:
             return INFEASIBLE, f"{joint} has no real solution along the path " \
                 "(outside the workspace)", None
     return UNKNOWN, f"the sign of the discriminant of {joint} could not be decided", None
-
-
-def _inside(value, lo, hi) -> bool | None:
-    if value is None:
-        return None
-    if value > lo and value < hi:
-        return True
-    if value < lo or value > hi:
-        return False
-    return None
 
 
 def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
@@ -171,12 +162,11 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
     ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
     the leg equals it (one polynomial serves both branches)."""
     joint = leg.leg.joint
-    lo, hi = (fraction_ball(v) for v in limits)
     bounds = f"[{limits[0]}, {limits[1]}]"
-    if _inside(leg.branches(interval.start.ball())[label], lo, hi) is False:
+    if leg.inside(leg.branches(interval.start.ball())[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
                                  f"{joint} is outside {bounds} from the start")
-    if _everywhere(lambda t: _inside(leg.branches(t)[label], lo, hi) is True, interval):
+    if _everywhere(lambda t: leg.inside(leg.branches(t)[label], limits) is True, interval):
         return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
     undecided = []
@@ -190,7 +180,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
     for box in undecided:
-        if _inside(leg.branches(box.t)[label], lo, hi) is not True:
+        if leg.inside(leg.branches(box.t)[label], limits) is not True:
             return BranchFeasibility(joint, label, UNKNOWN,
                                      f"limit crossing of {joint} not decided: {box.reason}")
     events += [box.t for box in undecided]
@@ -198,7 +188,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         verdict = None
         for prec in _PRECISIONS:
             with working_precision(prec):
-                verdict = _inside(leg.branches(point)[label], lo, hi)
+                verdict = leg.inside(leg.branches(point)[label], limits)
             if verdict is not None:
                 break
         if verdict is None:
@@ -225,7 +215,7 @@ def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibili
     out = []
     for leg in path.legs:
         joint = leg.leg.joint
-        if leg.leg.degree == 2:
+        if leg.discriminant is not None:
             status, reason, event = _leg_reality(leg, interval, tolerance, when)
         else:
             status, reason, event = FEASIBLE, "", None
@@ -248,8 +238,7 @@ def _start_values(path: PathModel) -> list[dict[str, float | None]]:
     out = []
     for leg in path.legs:
         values = leg.branches(start)
-        out.append({label: (float(v.mid()) if isinstance(v, arb) else None)
-                    for label, v in values.items()})
+        out.append({label: joint_float(v) for label, v in values.items()})
     return out
 
 

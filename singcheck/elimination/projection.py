@@ -24,10 +24,24 @@ from math import comb
 from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import restrict, squarefree_part
+from singcheck.algebra.radicals import (
+    angle_names,
+    cos_pi,
+    norm_radicals,
+    radical_name,
+    sin_pi,
+    surd_polynomial,
+)
 from singcheck.elimination.cache import CachedBackend
 from singcheck.elimination.requests import EliminationBackend, EliminationRequest, norm_chain
-from singcheck.errors import BackendError
-from singcheck.model.robot import RobotModel, leg_coefficients
+from singcheck.errors import BackendError, UnsupportedRobotError
+from singcheck.model.robot import (
+    REVOLUTE,
+    RobotModel,
+    leg_coefficients,
+    leg_discriminant,
+    revolute_discriminant,
+)
 
 
 @dataclass(frozen=True)
@@ -60,20 +74,40 @@ class RobotProjection:
 MAX_SURFACE_TERMS = 10_000_000
 
 
+def _circles(model: RobotModel, names) -> tuple[fmpq_mpoly, ...]:
+    """cos(v)² + sin(v)² - 1 for each angle among ``names`` (user variables)."""
+    gens = dict(zip(model.context.names(), model.context.gens(), strict=True))
+    return tuple(gens[c] ** 2 + gens[s] ** 2 - 1
+                 for c, s in (angle_names(v) for v in names if v in model.angles))
+
+
 def singularity_surface_request(model: RobotModel) -> EliminationRequest:
-    """Eliminate the joints from ``{F, det A}`` (the paper's ξ(X))."""
-    return EliminationRequest("singularity_surface", model.context,
-                              (*model.constraints, model.det_A), model.joints)
+    """Eliminate the joints from ``{F, det A}`` (the paper's ξ(X)); an angle joint brings
+    its circle cos² + sin² = 1, a square root its pseudo-leg sqrt(p)² = p (eliminated
+    too, so ξ has rational coefficients)."""
+    return EliminationRequest(
+        "singularity_surface", model.context,
+        (*model.constraints, model.det_A, *_circles(model, model.joints),
+         *(leg.constraint for leg in model.radical_legs)), model.eliminated)
 
 
 def joint_space_request(model: RobotModel) -> EliminationRequest:
     """Eliminate the pose from ``{F, det A}`` (the paper's ε(ρ))."""
-    return EliminationRequest("joint_space_singularities", model.context,
-                              (*model.constraints, model.det_A), model.pose)
+    return EliminationRequest(
+        "joint_space_singularities", model.context,
+        (*model.constraints, model.det_A, *_circles(model, model.pose),
+         *(leg.constraint for leg in model.radical_legs)),
+        (*model.pose_variables, *model.spec.radical_variables))
 
 
 def _pose_context(model: RobotModel) -> fmpq_mpoly_ctx:
-    return fmpq_mpoly_ctx.get(model.pose, "lex")
+    return fmpq_mpoly_ctx.get(model.pose_variables, "lex")
+
+
+def to_pose(model: RobotModel, p: fmpq_mpoly, pose_ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
+    """A polynomial in the pose (and square roots) as one over Q in the pose context:
+    its norm over the square roots (every conjugate's zero set together)."""
+    return restrict(norm_radicals(p), pose_ctx)
 
 
 def _single(result, label: str) -> fmpq_mpoly:
@@ -92,15 +126,45 @@ def _single(result, label: str) -> fmpq_mpoly:
 
 
 def workspace_boundary(model: RobotModel, pose_ctx: fmpq_mpoly_ctx) -> tuple[fmpq_mpoly, ...]:
+    """Per leg, where its two branches meet: b² - 4ac, or Δ = a² + b² - d² for a
+    revolute leg (1 for a linear leg); normed over the square roots."""
     out = []
     for leg in model.legs:
-        coeffs = [restrict(c, pose_ctx) for c in leg_coefficients(leg)]
-        if leg.degree == 2:
-            a, b, c = coeffs
-            out.append(b * b - 4 * a * c)
-        else:
-            out.append(pose_ctx.from_dict({(0,) * pose_ctx.nvars(): 1}))
+        disc = leg_discriminant(leg, leg_coefficients(leg))
+        out.append(pose_ctx.from_dict({(0,) * pose_ctx.nvars(): 1}) if disc is None
+                   else to_pose(model, disc, pose_ctx))
     return tuple(out)
+
+
+def angle_limit_values(joint: str, value) -> tuple:
+    """``(cos L, sin L)`` as exact surds for an angle joint's limit L = qπ, 12q an
+    integer (the limits whose crossings are algebraic)."""
+    if value.rational or cos_pi(value.pi_coefficient) is None:
+        raise UnsupportedRobotError(
+            f"the limit {value} of angle joint {joint} must be a multiple of pi/12 (e.g. "
+            "-pi/2, 2*pi/3) so that its sine and cosine are exact")
+    return cos_pi(value.pi_coefficient), sin_pi(value.pi_coefficient)
+
+
+def limit_constraint(model: RobotModel, leg, value) -> fmpq_mpoly:
+    """The leg's constraint with its joint at the limit ``value``, in a context with
+    every square root it needs (the robot's context, plus sqrt(2), sqrt(3) for an angle
+    limit)."""
+    coeffs = leg_coefficients(leg)
+    if leg.kind != REVOLUTE:
+        poly = coeffs[0].context().from_dict({})
+        q = fmpq(value.numerator, value.denominator)
+        for c in coeffs:  # Horner in the joint value
+            poly = poly * q + c
+        return poly
+    cos_l, sin_l = angle_limit_values(leg.joint, value)
+    names = model.context.names()
+    extra = tuple(radical_name(p) for p in sorted(cos_l.primes() | sin_l.primes())
+                  if radical_name(p) not in names)
+    ctx = fmpq_mpoly_ctx.get((*names, *extra), "lex")
+    a, b, d = (ctx.from_dict({(*e, *(0,) * len(extra)): k for e, k in c.terms()})
+               for c in coeffs)
+    return a * surd_polynomial(cos_l, ctx) + b * surd_polynomial(sin_l, ctx) + d
 
 
 def joint_limit_surfaces(model: RobotModel, pose_ctx) -> tuple[JointLimitSurface, ...]:
@@ -109,29 +173,61 @@ def joint_limit_surfaces(model: RobotModel, pose_ctx) -> tuple[JointLimitSurface
         limits = model.spec.joint_limits.get(leg.joint)
         if limits is None:
             continue
-        coeffs = [restrict(c, pose_ctx) for c in leg_coefficients(leg)]
         for bound, value in zip(("min", "max"), limits, strict=True):
-            poly = pose_ctx.from_dict({})
-            q = fmpq(value.numerator, value.denominator)
-            for c in coeffs:  # Horner in the joint value
-                poly = poly * q + c
-            out.append(JointLimitSurface(leg.joint, bound, value, poly))
+            poly = norm_radicals(limit_constraint(model, leg, value))
+            out.append(JointLimitSurface(leg.joint, bound, value, restrict(poly, pose_ctx)))
     return tuple(out)
 
 
+def norm_legs(model: RobotModel) -> list:
+    """The legs as :func:`~singcheck.elimination.requests.norm_chain` takes them: a
+    revolute leg's (cos, sin) pair, then each square root's pseudo-leg."""
+    legs = [(leg.variables if leg.kind == REVOLUTE else leg.joint, leg.constraint)
+            for leg in model.legs]
+    return legs + [(leg.joint, leg.constraint) for leg in model.radical_legs]
+
+
 def norm_over_legs(model: RobotModel) -> fmpq_mpoly:
-    """The norm of det A over the legs (squarefree, FLINT): exactly ξ's zero set."""
-    legs = [(leg.joint, leg.constraint) for leg in model.legs]
-    return restrict(norm_chain(model.det_A, legs), _pose_context(model))
+    """The norm of det A over the legs (squarefree, FLINT): exactly ξ's zero set (outside
+    the degenerate set of revolute legs, :func:`degenerate_set`)."""
+    return restrict(norm_chain(model.det_A, norm_legs(model)), _pose_context(model))
+
+
+def degenerate_set(model: RobotModel) -> tuple[fmpq_mpoly, ...]:
+    """W = a² + b² of each revolute leg, normed over the square roots (pose context):
+    where W ≠ 0 the leg's joint is integral over the pose and ξ vanishes exactly on the
+    singular modes; a real pose has W = 0 only if the leg does not depend on its angle."""
+    pose_ctx = _pose_context(model)
+    out = []
+    for leg in model.legs:
+        if leg.kind == REVOLUTE:
+            a, b, d = leg_coefficients(leg)
+            out.append(to_pose(model, revolute_discriminant(a, b, d) + d * d, pose_ctx))
+    return tuple(out)
+
+
+def _without_degenerate_factors(p: fmpq_mpoly, degenerate) -> fmpq_mpoly:
+    if not degenerate:
+        return squarefree_part(p)
+    _, factors = squarefree_part(p).factor()
+    out = p.context().from_dict({(0,) * p.context().nvars(): 1})
+    for f, _ in factors:
+        if not any(divmod(w, f)[1].is_zero() for w in degenerate):
+            out *= f
+    return squarefree_part(out)
 
 
 def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str) -> None:
     """Refuse a ξ whose zero set differs from the independently computed norm's.
 
-    Both are reduced to monic squarefree parts and compared exactly; a CAS result that
-    parsed but is wrong (or belongs to another request) fails here, loudly.
+    Both are reduced to monic squarefree parts and compared exactly (for revolute legs,
+    without the factors of the degenerate set W = 0, where a CAS's closure of the
+    projection and the norm may differ); a CAS result that parsed but is wrong (or
+    belongs to another request) fails here, loudly.
     """
-    if squarefree_part(xi) != squarefree_part(norm_over_legs(model)):
+    degenerate = degenerate_set(model)
+    if _without_degenerate_factors(xi, degenerate) != \
+            _without_degenerate_factors(norm_over_legs(model), degenerate):
         raise BackendError(f"{backend}: the singularity surface it returned fails the "
                            "re-check against the in-process norm of det A over the legs")
 
@@ -142,17 +238,19 @@ def expansion_bound(model: RobotModel) -> tuple[int, int]:
     ξ is the product over the irreducible factors g of det A of the chain of resultants
     of g with the legs whose joints it involves.  ``deg Res_v(g, f) ≤ deg g · deg f``
     (total degrees), so that factor's norm has degree at most d = deg g · Π deg f_i, and
-    at most C(n + d, n) terms in the n pose variables.  A bound, not a measurement: it
-    decides beforehand, in microseconds, whether expanding ξ can be afforded.
+    at most C(n + d, n) terms in the n pose variables (a revolute leg's norm, a square
+    root's pseudo-leg: the same bound with their constraint's degree, doubled for the
+    revolute norm's square).  A bound, not a measurement: it decides beforehand, in
+    microseconds, whether expanding ξ can be afforded.
     """
     names = model.context.names()
-    n = len(model.pose)
+    n = len(model.pose_variables)
     worst = (0, 1)
     for g, _ in model.det_A.factor()[1]:
         degree = g.total_degree()
-        for leg in model.legs:
-            if g.degrees()[names.index(leg.joint)] > 0:
-                degree *= leg.constraint.total_degree()
+        for leg in (*model.legs, *model.radical_legs):
+            if any(g.degrees()[names.index(v)] > 0 for v in leg.variables):
+                degree *= leg.constraint.total_degree() * (2 if leg.kind == REVOLUTE else 1)
         worst = max(worst, (degree, comb(n + degree, n)), key=lambda b: b[1])
     return worst
 
@@ -167,31 +265,46 @@ def not_expanded_reason(model: RobotModel, max_terms: int = MAX_SURFACE_TERMS) -
             "the joints along itself instead (μ(t) computed directly)")
 
 
+JOINT_FREE = "det A is free of the joints: ξ = det A (no elimination)"
+
+
 def project_robot(model: RobotModel, backend: EliminationBackend,
                   max_surface_terms: int = MAX_SURFACE_TERMS) -> RobotProjection:
     """Every workspace surface of the robot, with ξ from ``backend`` (re-checked), or
-    without ξ when it is too big to expand (:func:`not_expanded_reason`)."""
+    without ξ when it is too big to expand (:func:`not_expanded_reason`).
+
+    When det A involves no joint (squared-distance legs), ξ is det A itself, normed over
+    the square roots: no backend runs.  Factors of the degenerate set W = 0 of revolute
+    legs are dropped from ξ (each backend's closure may keep them or not): a real pose
+    there has no real, separated branches of that leg (Δ = W - d² ≤ 0), so no feasible
+    mode passes through it."""
     pose_ctx = _pose_context(model)
-    reason = not_expanded_reason(model, max_surface_terms)
-    if reason:
-        return RobotProjection(model, pose_ctx, None, None, workspace_boundary(model, pose_ctx),
-                               joint_limit_surfaces(model, pose_ctx), backend.name,
-                               "eliminated along each path", reason)
-
-    def check(result) -> None:
-        recheck_singularity_surface(model, _single(result, "singularity surface"),
-                                    result.backend)
-
-    request = singularity_surface_request(model)
-    if isinstance(backend, CachedBackend):  # cache only what passes the re-check
-        result = backend.eliminate(request, check=check)
+    if model.joint_free_det_A:
+        raw = to_pose(model, model.det_A, pose_ctx)
+        name, method = "none", JOINT_FREE
     else:
-        result = backend.eliminate(request)
-        check(result)
-    raw = _single(result, "singularity surface")
-    xi = squarefree_part(raw)
+        reason = not_expanded_reason(model, max_surface_terms)
+        if reason:
+            return RobotProjection(model, pose_ctx, None, None,
+                                   workspace_boundary(model, pose_ctx),
+                                   joint_limit_surfaces(model, pose_ctx), backend.name,
+                                   "eliminated along each path", reason)
+
+        def check(result) -> None:
+            recheck_singularity_surface(model, _single(result, "singularity surface"),
+                                        result.backend)
+
+        request = singularity_surface_request(model)
+        if isinstance(backend, CachedBackend):  # cache only what passes the re-check
+            result = backend.eliminate(request, check=check)
+        else:
+            result = backend.eliminate(request)
+            check(result)
+        raw = _single(result, "singularity surface")
+        name, method = result.backend, result.method
+    xi = _without_degenerate_factors(raw, degenerate_set(model))
     return RobotProjection(model, pose_ctx, xi, raw, workspace_boundary(model, pose_ctx),
-                           joint_limit_surfaces(model, pose_ctx), result.backend, result.method)
+                           joint_limit_surfaces(model, pose_ctx), name, method)
 
 
 def joint_space_singularities(model: RobotModel, backend: EliminationBackend) -> fmpq_mpoly:

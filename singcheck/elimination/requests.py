@@ -14,7 +14,7 @@ from typing import Protocol
 
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
-from singcheck.algebra.polynomials import squarefree_part
+from singcheck.algebra.polynomials import coefficient_in, squarefree_part
 
 
 @dataclass(frozen=True)
@@ -48,23 +48,56 @@ class EliminationBackend(Protocol):
     def version(self) -> str: ...
 
 
+def _circle_pairs(request: EliminationRequest) -> dict[str, str]:
+    """cos(v) → sin(v) for every angle whose two variables are both eliminated."""
+    elim = set(request.eliminate)
+    return {v: "sin(" + v[4:] for v in request.eliminate
+            if v.startswith("cos(") and "sin(" + v[4:] in elim}
+
+
+def _is_circle(f: fmpq_mpoly, c: int, s: int) -> bool:
+    ctx = f.context()
+    gens = ctx.gens()
+    return f == gens[c] ** 2 + gens[s] ** 2 - 1
+
+
 def leg_structure(request: EliminationRequest):
-    """``(g, [(v, f_v), …])`` when every eliminated variable v has a generator f_v that
-    involves v and no other eliminated variable, with a constant leading coefficient in
-    v, and exactly one generator g is left; else None."""
+    """``(g, [(v, f_v), …])`` when every eliminated variable is covered by one *leg* and
+    exactly one generator g is left, else None.  A leg is either a single variable v
+    with a generator f_v that involves no other eliminated variable and has a constant
+    leading coefficient in v, or an angle's pair ``(cos(v), sin(v))`` (then ``v`` in the
+    list is that pair) with the circle ``cos² + sin² - 1`` among the generators and one
+    generator ``a·cos + b·sin + d`` involving no other eliminated variable."""
     names = request.context.names()
-    legs: dict[str, fmpq_mpoly] = {}
+    pairs = _circle_pairs(request)
+    partners = set(pairs.values())
+    circles = {c for c, s in pairs.items()
+               if any(_is_circle(f, names.index(c), names.index(s)) for f in request.generators)}
+    legs: dict[object, fmpq_mpoly] = {}
     rest = []
     for f in request.generators:
         involved = [v for v in request.eliminate if f.degrees()[names.index(v)] > 0]
-        if len(involved) == 1 and involved[0] not in legs and _constant_lead(f, names,
-                                                                            involved[0]):
+        pair = [c for c in pairs if set(involved) <= {c, pairs[c]}] if involved else []
+        if pair and len(involved) == 2 and _is_circle(f, *(names.index(v) for v in involved)):
+            continue  # the circle of that angle
+        if len(involved) == 1 and involved[0] not in legs and involved[0] not in pairs \
+                and involved[0] not in partners and _constant_lead(f, names, involved[0]):
             legs[involved[0]] = f
+        elif pair and pair[0] in circles and (pair[0], pairs[pair[0]]) not in legs and \
+                _linear_in(f, names.index(pair[0]), names.index(pairs[pair[0]])):
+            legs[(pair[0], pairs[pair[0]])] = f
         else:
             rest.append(f)
-    if len(rest) != 1 or set(legs) != set(request.eliminate):
+    covered = {v for key in legs for v in (key if isinstance(key, tuple) else (key,))}
+    if len(rest) != 1 or covered != set(request.eliminate):
         return None
-    return rest[0], [(v, legs[v]) for v in request.eliminate]
+    order = {v: i for i, v in enumerate(request.eliminate)}
+    keys = sorted(legs, key=lambda k: order[k[0] if isinstance(k, tuple) else k])
+    return rest[0], [(k, legs[k]) for k in keys]
+
+
+def _linear_in(f: fmpq_mpoly, c: int, s: int) -> bool:
+    return all(e[c] + e[s] <= 1 for e, _ in f.terms())
 
 
 def _constant_lead(f: fmpq_mpoly, names, v: str) -> bool:
@@ -73,15 +106,61 @@ def _constant_lead(f: fmpq_mpoly, names, v: str) -> bool:
     return all(sum(e) == d for e, _ in f.terms() if e[i] == d)
 
 
-def norm_chain(g: fmpq_mpoly, legs: list[tuple[str, fmpq_mpoly]]) -> fmpq_mpoly:
+def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
+    """The norm of ``g`` over the two points of ``f = a·c + b·s + d = 0`` on the circle
+    ``c² + s² = 1``, free of c and s.
+
+    On branch σ = ±1, ``c = (P + σb·R)/W`` and ``s = (Q - σa·R)/W`` with ``P = -a·d``,
+    ``Q = -b·d``, ``W = a² + b²`` and ``R = √Δ``, ``Δ = W - d²``.  With k the total degree
+    of g in (c, s), ``W^k·g`` at branch σ is ``G₀ + σR·G₁`` (polynomials over Q[X]), and
+    the product over both branches is ``G₀² - Δ·G₁²``.  Where W ≠ 0 it vanishes exactly
+    when g vanishes at one of the two (complex) points; on W = 0 (the leg does not
+    depend on its angle) it may vanish too: the degenerate set, handled by the caller.
+    """
+    ctx = g.context()
+    names = ctx.names()
+    ci, si = names.index(c), names.index(s)
+    one = ctx.from_dict({(0,) * ctx.nvars(): 1})
+    zero = ctx.from_dict({})
+    a, b = coefficient_in(f, ci, 1), coefficient_in(f, si, 1)
+    d = coefficient_in(coefficient_in(f, ci, 0), si, 0)
+    w = a * a + b * b
+    delta = w - d * d
+
+    def mul(x, y):
+        return x[0] * y[0] + delta * x[1] * y[1], x[0] * y[1] + x[1] * y[0]
+
+    groups: dict[tuple[int, int], dict] = {}
+    for exps, coeff in g.terms():
+        e = list(exps)
+        key = (e[ci], e[si])
+        e[ci] = e[si] = 0
+        groups.setdefault(key, {})[tuple(e)] = coeff
+    k = max(i + j for i, j in groups)
+    cpow, spow, wpow = [(one, zero)], [(one, zero)], [one]
+    for _ in range(k):
+        cpow.append(mul(cpow[-1], (-a * d, b)))
+        spow.append(mul(spow[-1], (-b * d, -a)))
+        wpow.append(wpow[-1] * w)
+    g0, g1 = zero, zero
+    for (i, j), terms in groups.items():
+        coefficient = ctx.from_dict(terms) * wpow[k - i - j]
+        x = mul(cpow[i], spow[j])
+        g0 += coefficient * x[0]
+        g1 += coefficient * x[1]
+    return g0 * g0 - delta * g1 * g1
+
+
+def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]]) -> fmpq_mpoly:
     """A polynomial with the zero set of ``Res_vn(… Res_v1(g, f_1) …, f_n)`` (FLINT).
 
     When each f_i is monic-like in its v_i (constant leading coefficient), that chain is
     the norm of g over the legs: g multiplied over every common complex root, so it
-    vanishes exactly on the projection.  Computed one irreducible factor of g at a time,
-    reduced to its squarefree part after each step (the next resultant vanishes exactly
-    where the previous one has a root of the next leg, so the zero set is kept), which
-    keeps factored inputs (stacked stages) small.
+    vanishes exactly on the projection.  A revolute leg (``v`` a pair cos, sin) takes
+    :func:`revolute_norm` instead of a resultant.  Computed one irreducible factor of g
+    at a time, reduced to its squarefree part after each step (the next resultant
+    vanishes exactly where the previous one has a root of the next leg, so the zero set
+    is kept), which keeps factored inputs (stacked stages) small.
     """
     names = g.context().names()
     _, factors = g.factor()
@@ -89,8 +168,12 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[str, fmpq_mpoly]]) -> fmpq_mpoly:
     for factor, _mult in factors:
         acc = factor
         for v, f in legs:
-            if acc.degrees()[names.index(v)] == 0:
+            variables = v if isinstance(v, tuple) else (v,)
+            if all(acc.degrees()[names.index(x)] <= 0 for x in variables):
                 continue  # a leg that does not touch this factor only raises its power
-            acc = squarefree_part(acc.resultant(f, v))
+            if isinstance(v, tuple):
+                acc = squarefree_part(revolute_norm(acc, v[0], v[1], f))
+            else:
+                acc = squarefree_part(acc.resultant(f, v))
         total *= acc
     return squarefree_part(total)

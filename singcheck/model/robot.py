@@ -3,17 +3,43 @@
 Following the paper, ``A = ∂F/∂X`` (pose) and ``B = ∂F/∂ρ`` (joints); ``det A = 0`` is a
 parallel singularity and ``det B = 0`` a serial one.  Everything is exact (``fmpq_mpoly``).
 
-singcheck certifies robots whose inverse kinematics is *leg-decoupled*: each
-constraint involves exactly one actuated joint (a leg), is of degree 1 or 2 in it, and
-its leading coefficient in that joint is a non-zero constant.  That covers robots with
-prismatic actuators and distance legs (Orthoglide, biglides, linear Deltas, Gough-Stewart
-legs).  Two facts follow and the rest of the pipeline relies on them:
+**Angles.**  A joint or pose variable v used inside sin/cos enters the algebra as the
+pair ``(cos(v), sin(v))`` with cos² + sin² = 1 (every polynomial is kept reduced modulo
+that relation, :func:`~singcheck.algebra.radicals.reduce_relations`).  The derivative in
+an angle is the derivative along the circle, ``∂/∂v = -sin(v)·∂/∂cos(v) +
+cos(v)·∂/∂sin(v)``: A and B keep one column per joint or pose variable, and det A, det B
+are the determinants of the true Jacobians, as polynomials in the cos/sin variables.
 
-* the inverse kinematics has finitely many branches, ``ρ_i = (-b ± √D)/(2a)`` per leg,
-  so the working modes are the sign choices, and
-* the map ``V(F) → pose space`` is finite (every ρ_i is integral over Q[X]), so the
-  projection of ``{F = 0, det A = 0}`` is closed: ξ(X) vanishes exactly where some
-  (possibly complex) working mode is singular.
+**Square roots.**  A parameter like √3 is a variable ``sqrt(3)`` with the *pseudo-leg*
+``sqrt(3)² - 3 = 0`` (:attr:`RobotModel.radical_legs`): it is eliminated with the joints,
+so ξ(X) has rational coefficients and vanishes where some working mode of the robot *or
+of a conjugate robot* (√3 ↦ -√3) is singular.  Conjugate modes are never feasible; the
+certification evaluates them only to complete the elimination argument.
+
+singcheck certifies robots whose inverse kinematics is *leg-decoupled*: each
+constraint involves exactly one actuated joint (a leg), and that leg is
+
+* **prismatic**: of degree 1 or 2 in its joint ρ with a non-zero constant leading
+  coefficient; its branches are ``ρ = (-b ± √D)/(2a)``, D = b² - 4ac; or
+* **revolute**: an angle joint θ entering as ``a(X)·cos θ + b(X)·sin θ + d(X)`` (degree
+  ≤ 2 in the half-angle tangent); its branches are
+  ``cos θ = (-a·d + σ·b·√Δ)/W``, ``sin θ = (-b·d - σ·a·√Δ)/W`` for σ = ±1, with
+  ``W = a² + b²`` and ``Δ = W - d²`` (no half-angle tangent: θ = π is an ordinary point,
+  and only W = 0, i.e. a = b = 0, the leg not depending on θ at all, is degenerate).
+  ``∂F/∂θ = σ·√Δ`` on branch σ: the branches meet (serial singularity) where Δ = 0.
+
+Two facts follow and the rest of the pipeline relies on them:
+
+* the inverse kinematics has finitely many branches per leg, so the working modes are
+  the sign choices, and
+* every prismatic joint is integral over Q[X], and a revolute joint's (cos θ, sin θ) is
+  integral where W ≠ 0, so the projection of ``{F = 0, det A = 0}`` is closed outside the
+  degenerate set W = 0: there, ξ(X) vanishes exactly where some (possibly complex)
+  working mode is singular.
+
+When det A does not involve the joints at all (legs in which the joint appears only
+squared, ρᵢ² = |…|²: 3-RPR, Gough–Stewart), every mode has the same det A(X) and
+ξ(X) = det A(X) with no elimination (:attr:`RobotModel.joint_free_det_A`).
 """
 
 from __future__ import annotations
@@ -24,44 +50,99 @@ from typing import TYPE_CHECKING
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import coefficient_in
+from singcheck.algebra.radicals import angle_names, radical_name, reduce_relations
 from singcheck.errors import UnsupportedRobotError
 
 if TYPE_CHECKING:
     from singcheck.spec.files import RobotSpec
 
 
+PRISMATIC, REVOLUTE, RADICAL = "prismatic", "revolute", "radical"
+
+
 @dataclass(frozen=True)
 class Leg:
-    """One constraint and the single actuated joint it involves."""
+    """One constraint and the single actuated joint it involves (or a square root's
+    pseudo-leg ``sqrt(p)² - p``, kind ``radical``)."""
 
     joint: str
-    joint_index: int
+    joint_index: int  # in the context: the joint, or cos(joint) for a revolute leg
     constraint: fmpq_mpoly
-    constraint_index: int
-    degree: int  # 1 or 2 in the joint
+    constraint_index: int  # -1 for a radical pseudo-leg
+    degree: int  # in the joint (prismatic); 2 for a revolute leg (in tan(θ/2))
+    kind: str = PRISMATIC
+
+    @property
+    def variables(self) -> tuple[str, ...]:
+        """The context variables of the joint: ``(ρ,)`` or ``(cos(θ), sin(θ))``."""
+        return angle_names(self.joint) if self.kind == REVOLUTE else (self.joint,)
 
 
 @dataclass(frozen=True)
 class RobotModel:
     spec: RobotSpec
-    context: fmpq_mpoly_ctx  # joints then pose
+    context: fmpq_mpoly_ctx  # joint variables, pose variables, radicals (spec.context)
     joints: tuple[str, ...]
     pose: tuple[str, ...]
     constraints: tuple[fmpq_mpoly, ...]
-    A: tuple[tuple[fmpq_mpoly, ...], ...]  # ∂F/∂X
-    B: tuple[tuple[fmpq_mpoly, ...], ...]  # ∂F/∂ρ
+    A: tuple[tuple[fmpq_mpoly, ...], ...]  # ∂F/∂X, one column per pose variable
+    B: tuple[tuple[fmpq_mpoly, ...], ...]  # ∂F/∂ρ, one column per joint
     det_A: fmpq_mpoly
     det_B: fmpq_mpoly
     legs: tuple[Leg, ...]  # in joint order
+    radical_legs: tuple[Leg, ...] = ()  # sqrt(p)² - p, one per square root
 
     @property
     def name(self) -> str:
         return self.spec.name
 
+    @property
+    def angles(self) -> frozenset[str]:
+        return self.spec.angles
 
-def jacobian(polys: tuple[fmpq_mpoly, ...], variables: tuple[str, ...]):
-    """The matrix ``∂polys/∂variables`` (rows: polys, columns: variables)."""
-    return tuple(tuple(p.derivative(v) for v in variables) for p in polys)
+    @property
+    def joint_variables(self) -> tuple[str, ...]:
+        return self.spec.joint_variables
+
+    @property
+    def pose_variables(self) -> tuple[str, ...]:
+        return self.spec.pose_variables
+
+    @property
+    def eliminated(self) -> tuple[str, ...]:
+        """The variables a projection onto the pose eliminates: joints and radicals."""
+        return (*self.joint_variables, *self.spec.radical_variables)
+
+    @property
+    def joint_free_det_A(self) -> bool:
+        """det A involves no joint variable: ξ(X) is det A itself (no elimination)."""
+        names = self.context.names()
+        return all(self.det_A.degrees()[names.index(v)] <= 0 for v in self.joint_variables)
+
+    @property
+    def polynomial(self) -> bool:
+        """No angle and no square root: the original, purely polynomial class."""
+        return not self.spec.angles and not self.spec.radicals
+
+
+def jacobian(polys: tuple[fmpq_mpoly, ...], variables: tuple[str, ...],
+             angles: frozenset[str] = frozenset()):
+    """The matrix ``∂polys/∂variables`` (rows: polys, columns: variables); for an angle
+    v the column is the derivative along the circle, -sin(v)·∂/∂cos(v) + cos(v)·∂/∂sin(v)
+    (reduced modulo cos² + sin² = 1)."""
+    rows = []
+    for p in polys:
+        row = []
+        for v in variables:
+            if v in angles:
+                c, s = angle_names(v)
+                gens = dict(zip(p.context().names(), p.context().gens(), strict=True))
+                row.append(reduce_relations(gens[c] * p.derivative(s)
+                                            - gens[s] * p.derivative(c)))
+            else:
+                row.append(p.derivative(v))
+        rows.append(tuple(row))
+    return tuple(rows)
 
 
 def determinant(matrix) -> fmpq_mpoly:
@@ -95,26 +176,36 @@ def determinant(matrix) -> fmpq_mpoly:
     return minor(tuple(range(n)))
 
 
+_RESHAPE = ("; reformulate it so that each constraint drives one actuated joint, e.g. "
+            "a leg's squared length ρ² = |B - A(X)|², or a revolute joint's distal link "
+            "as |B(X) - A(θ)|² = l²")
+
+
 def _legs(spec: RobotSpec) -> tuple[Leg, ...]:
     joints = spec.joints
+    names = spec.context.names()
     found: dict[str, Leg] = {}
     for index, f in enumerate(spec.constraints):
-        involved = [j for j in joints if f.degrees()[joints.index(j)] > 0]
+        involved = [j for j in joints
+                    if any(f.degrees()[names.index(v)] > 0 for v in spec.variables(j))]
         line = spec.constraint_lines[index]
         key = f"constraints[{index}]"
         if len(involved) != 1:
             what = "no actuated joint" if not involved else "joints " + ", ".join(involved)
             raise UnsupportedRobotError(
                 f"involves {what}; singcheck certifies leg-decoupled robots, where each "
-                "constraint involves exactly one actuated joint",
-                path=spec.path, line=line, key=key)
+                "constraint involves exactly one actuated joint (passive joints must be "
+                "eliminated first)" + _RESHAPE, path=spec.path, line=line, key=key)
         joint = involved[0]
         if joint in found:
             raise UnsupportedRobotError(
                 f"joint {joint} already appears in constraints[{found[joint].constraint_index}];"
                 " each actuated joint must drive exactly one leg constraint",
                 path=spec.path, line=line, key=key)
-        j = joints.index(joint)
+        if joint in spec.angles:
+            found[joint] = _revolute_leg(spec, joint, f, index, line, key)
+            continue
+        j = names.index(joint)
         degree = f.degrees()[j]
         if degree > 2:
             raise UnsupportedRobotError(
@@ -129,13 +220,59 @@ def _legs(spec: RobotSpec) -> tuple[Leg, ...]:
     return tuple(found[j] for j in joints)
 
 
+def _revolute_leg(spec: RobotSpec, joint: str, f: fmpq_mpoly, index: int, line: int,
+                  key: str) -> Leg:
+    names = spec.context.names()
+    c, s = (names.index(v) for v in angle_names(joint))
+    for exps, _ in f.terms():
+        if exps[c] + exps[s] > 1:
+            raise UnsupportedRobotError(
+                f"is not of the form a·cos({joint}) + b·sin({joint}) + d (it has degree > 2 "
+                f"in tan({joint}/2)); singcheck supports revolute legs with two inverse "
+                "kinematics branches" + _RESHAPE, path=spec.path, line=line, key=key)
+    return Leg(joint, c, f, index, 2, REVOLUTE)
+
+
 def leg_coefficients(leg: Leg) -> tuple[fmpq_mpoly, ...]:
-    """``(a, b, c)`` with ``constraint = a·ρ² + b·ρ + c`` (``(b, c)`` for a linear leg).
+    """``(a, b, c)`` with ``constraint = a·ρ² + b·ρ + c`` (``(b, c)`` for a linear leg);
+    for a revolute leg ``(a, b, d)`` with ``constraint = a·cos θ + b·sin θ + d``.
 
     Each coefficient is a polynomial in the pose variables (still in the robot's context).
     """
+    if leg.kind == REVOLUTE:
+        f = leg.constraint
+        c = leg.joint_index
+        return (coefficient_in(f, c, 1), coefficient_in(f, c + 1, 1),
+                coefficient_in(coefficient_in(f, c, 0), c + 1, 0))
     return tuple(coefficient_in(leg.constraint, leg.joint_index, d)
                  for d in range(leg.degree, -1, -1))
+
+
+def revolute_discriminant(a: fmpq_mpoly, b: fmpq_mpoly, d: fmpq_mpoly) -> fmpq_mpoly:
+    """Δ = a² + b² - d²: the branches of a·cos θ + b·sin θ + d = 0 are real and apart
+    where Δ > 0, meet where Δ = 0 (serial singularity)."""
+    return a * a + b * b - d * d
+
+
+def leg_discriminant(leg: Leg, coefficients) -> fmpq_mpoly | None:
+    """The polynomial whose sign says whether the leg's two branches are real and apart
+    (b² - 4ac, or Δ for a revolute leg); None for a linear leg."""
+    if leg.kind == REVOLUTE:
+        return revolute_discriminant(*coefficients)
+    if leg.degree == 2:
+        a, b, c = coefficients
+        return b * b - 4 * a * c
+    return None
+
+
+def _radical_legs(spec: RobotSpec) -> tuple[Leg, ...]:
+    names = spec.context.names()
+    gens = spec.context.gens()
+    out = []
+    for p in spec.radicals:
+        i = names.index(radical_name(p))
+        out.append(Leg(radical_name(p), i, gens[i] ** 2 - p, -1, 2, RADICAL))
+    return tuple(out)
 
 
 def build_model(spec: RobotSpec) -> RobotModel:
@@ -144,21 +281,15 @@ def build_model(spec: RobotSpec) -> RobotModel:
     Raises :class:`UnsupportedRobotError` (with the constraint's file and line) for a
     robot outside the leg-decoupled class, and when det A is identically zero.
     """
-    if spec.angles or spec.radicals:
-        what = "angles (sin/cos)" if spec.angles else "square roots"
-        raise UnsupportedRobotError(
-            f"the constraints use {what}: the spec language accepts them, but this version "
-            "certifies only polynomial constraints with rational coefficients",
-            path=spec.path, line=spec.lines.get("constraints"), key="constraints")
     constraints = tuple(spec.constraints)
-    A = jacobian(constraints, spec.pose)
-    B = jacobian(constraints, spec.joints)
-    det_A = determinant(A)
-    det_B = determinant(B)
+    A = jacobian(constraints, spec.pose, spec.angles)
+    B = jacobian(constraints, spec.joints, spec.angles)
+    det_A = reduce_relations(determinant(A))
+    det_B = reduce_relations(determinant(B))
     legs = _legs(spec)
     if det_A.is_zero():
         raise UnsupportedRobotError(
             "det A = det(∂F/∂pose) is identically zero: the robot is singular everywhere",
             path=spec.path, line=spec.lines.get("constraints"), key="constraints")
     return RobotModel(spec, spec.context, spec.joints, spec.pose, constraints, A, B, det_A,
-                      det_B, legs)
+                      det_B, legs, _radical_legs(spec))

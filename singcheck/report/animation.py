@@ -152,7 +152,7 @@ def animation_figure(report: TrajectoryReport, d, title: str, samples: int = SAM
     play = {"frame": {"duration": 60, "redraw": True}, "fromcurrent": True,
             "transition": {"duration": 0}}
     fig.update_layout(
-        title=title, height=660, margin={"t": 120},
+        title={"text": title, "y": 0.985, "yanchor": "top"}, height=660, margin={"t": 120},
         updatemenus=[{"type": "buttons", "showactive": False, "x": 0.0, "y": -0.08,
                       "xanchor": "left", "yanchor": "top", "direction": "left",
                       "buttons": [{"label": "▶ play", "method": "animate",
@@ -162,7 +162,7 @@ def animation_figure(report: TrajectoryReport, d, title: str, samples: int = SAM
                                                      "frame": {"duration": 0}}]}]}],
         sliders=[{"active": 0, "steps": steps, "x": 0.14, "len": 0.86, "y": -0.04,
                   "currentvalue": {"prefix": f"{report.trajectory.parameter} = "}}],
-        legend={"orientation": "h", "y": 1.2, "x": 0.0, "yanchor": "bottom"})
+        legend={"orientation": "h", "y": 1.1, "x": 0.0, "yanchor": "bottom"})
     fig.update_xaxes(title_text=report.trajectory.parameter, row=2, col=2)
     box = drawing_box([b for b in frames_bodies if b], path_traces)
     names = report.path.projection.model.pose

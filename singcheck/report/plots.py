@@ -66,18 +66,16 @@ class FigureData:
     feasible: list[str]
     limits: dict[str, tuple[float, float]]
     names: dict[str, list[str]] = field(default_factory=dict)
+    joins: list[dict] = field(default_factory=list)  # t and pose where pieces meet
 
 
-def figure_data(report: TrajectoryReport, samples: int = 2000) -> FigureData:
-    """Everything the figures draw, as arrays and certified marks."""
-    path = report.path
-    model = path.projection.model
+def _sample_piece(path, n: int):
+    """Samples of one piece in its own time: (own t, pose, μ, joints per leg branch)."""
     lo, hi = float(path.trajectory.range.start), float(path.trajectory.range.end)
-    t = np.linspace(lo, hi, samples)
+    t = np.linspace(lo, hi, n)
     tsc = [t, np.sin(t), np.cos(t)]
     pose = [numpy_polynomial(p)(tsc) for p in path.phi]
     mu = numpy_polynomial(path.mu)(tsc)
-    mu = mu / (np.max(np.abs(mu)) or 1.0)
     legs = []
     for leg in path.legs:
         values = [numpy_polynomial(c)(tsc) for c in leg.coefficients]
@@ -88,6 +86,31 @@ def figure_data(report: TrajectoryReport, samples: int = 2000) -> FigureData:
             with np.errstate(invalid="ignore"):
                 root = np.sqrt(b * b - 4 * a * c)
             legs.append({"+": (-b + root) / (2 * a), "-": (-b - root) / (2 * a)})
+    return t, pose, mu, legs
+
+
+def _to_user_time(spec, t: np.ndarray) -> np.ndarray:
+    """A piece's own time samples in the user's parameter (drawing only)."""
+    if spec.time_scale is not None:
+        return t / (float(spec.time_scale) * np.pi)
+    return t + float(spec.time_offset)
+
+
+def figure_data(report: TrajectoryReport, samples: int = 2000) -> FigureData:
+    """Everything the figures draw, as arrays and certified marks (a path of several
+    pieces is sampled piece by piece, in the user's parameter, its joins recorded)."""
+    model = report.path.projection.model
+    pieces = report.pieces or [report]
+    specs = report.trajectory.pieces
+    per = max(50, samples // len(pieces))
+    parts = [_sample_piece(r.path, per) for r in pieces]
+    t = np.concatenate([_to_user_time(spec, part[0]) for spec, part in zip(specs, parts,
+                                                                            strict=True)])
+    pose = [np.concatenate([part[1][i] for part in parts]) for i in range(len(model.pose))]
+    mu = np.concatenate([part[2] for part in parts])
+    mu = mu / (np.max(np.abs(mu)) or 1.0)
+    legs = [{label: np.concatenate([part[3][i][label] for part in parts])
+             for label in parts[0][3][i]} for i in range(len(model.legs))]
     joints = {m.label: [legs[i][ch] for i, ch in enumerate(m.label)] for m in report.modes}
     det = numpy_polynomial(model.det_A)
     feasible = [m.label for m in report.modes if m.feasible]
@@ -100,9 +123,18 @@ def figure_data(report: TrajectoryReport, samples: int = 2000) -> FigureData:
                            "interval": (float(c.t.lower()), float(c.t.upper())),
                            "pose": [float(b.mid()) for b in c.pose]})
     limits = {j: (float(a), float(b)) for j, (a, b) in model.spec.joint_limits.items()}
+    ends = np.cumsum([len(part[0]) for part in parts])[:-1]
+    joins = [{"t": float(t[k]), "pose": [float(p[k]) for p in pose]} for k in ends]
     return FigureData(t, mu, candidates, pose, joints, det_a, singular, feasible, limits,
                       {"pose": list(model.pose), "joints": list(model.joints),
-                       "parameter": [path.trajectory.parameter]})
+                       "parameter": [report.trajectory.parameter]}, joins)
+
+
+def _mark_joins(ax, d: FigureData) -> None:
+    """The joins of a path of several pieces: dotted vertical lines at their times."""
+    for k, j in enumerate(d.joins):
+        ax.axvline(j["t"], color="tab:blue", lw=0.8, ls=":",
+                   label="segment joins" if k == 0 else None)
 
 
 _STATUS_STYLE = {"real": ("red", "o"), "spurious": ("green", "x"), "unknown": ("magenta", "s")}
@@ -118,6 +150,9 @@ def _mu_figure(plt, d: FigureData, title: str):
         ax.annotate(f"{c['label']} ({c['status']})\nt={c['t']:.6f}", (c["t"], 0),
                     textcoords="offset points", xytext=(0, 14 if i % 2 else -30),
                     ha="center", fontsize=7)
+    _mark_joins(ax, d)
+    if d.joins:
+        ax.legend(fontsize=7)
     ax.set_xlabel(d.names["parameter"][0])
     ax.set_ylabel("μ(t) / max|μ|")
     ax.set_title(title)
@@ -132,6 +167,7 @@ def _det_figure(plt, d: FigureData, title: str):
         if ts:
             ax.plot(ts, [0] * len(ts), "o", color="red", ms=7, label=f"proven zeros ({label})")
     ax.axhline(0, color="grey", lw=0.5)
+    _mark_joins(ax, d)
     ax.set_xlabel(d.names["parameter"][0])
     ax.set_ylabel("det A")
     ax.set_title(title)
@@ -188,6 +224,9 @@ def _box(values: np.ndarray, margin: float = 0.25) -> tuple[float, float]:
 
 
 def _mark_points(ax, d: FigureData, dims: int) -> None:
+    for k, j in enumerate(d.joins):  # the joins of a path of several pieces
+        ax.plot(*[[v] for v in j["pose"][:dims]], marker="D", color="tab:blue", ms=5,
+                ls="none", label="segment joins" if k == 0 else None)
     for c in d.candidates:
         color, marker = _STATUS_STYLE.get(c["status"], ("magenta", "s"))
         ax.plot(*[[v] for v in c["pose"][:dims]], marker=marker, color=color, ms=8, ls="none")
@@ -248,7 +287,10 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
     from singcheck.report.postures import posture_figure
 
     makers["postures"] = lambda: posture_figure(
-        plt, report, f"{robot} · {name}: the robot at the start and its singular postures")
+        plt, report, f"{robot} · {name}: the robot at the start" + (
+            " and at its singular times" if any(m.singular_times for m in report.modes
+                                                if m.feasible) else
+            " (no singular time on a feasible mode)"))
     written = []
     for key in makers:
         fig = makers[key]()

@@ -69,15 +69,17 @@ def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:
 
 def _on_piece(report: TrajectoryReport, index: int, t: arb):
     """The model of the path's piece ``index`` (0-based) and the ball ``t`` of the user's
-    time in that piece's own time (τ = g·π·t on a rescaled piece)."""
+    time in that piece's own time (the inverse of ``TrajectorySpec.to_global``: τ = g·π·t
+    on a rescaled piece, u = t − t₀ on an interpolated one)."""
     if not report.pieces:
         return report.path, t
     spec = report.trajectory.pieces[index]
     path = report.pieces[index].path
-    if spec.time_scale is None:
-        return path, t
-    g = spec.time_scale
-    return path, t * arb.pi() * arb(fmpq(g.numerator, g.denominator))
+    if spec.time_scale is not None:
+        g = spec.time_scale
+        return path, t * arb.pi() * arb(fmpq(g.numerator, g.denominator))
+    d = spec.time_offset
+    return path, t - arb(fmpq(d.numerator, d.denominator)) if d else t
 
 
 def piece_index(report: TrajectoryReport, t: float) -> int:
@@ -126,19 +128,25 @@ def postures(report: TrajectoryReport) -> list[Posture]:
 
 
 def traced_points(report: TrajectoryReport, t: np.ndarray) -> list[np.ndarray]:
-    """Each distinct drawn point that moves with the pose alone, sampled along the path
-    at the user's times ``t``: arrays of shape (len(t), dim)."""
+    """Each distinct drawn point that moves with the pose alone (preferring the drawing's
+    single points), sampled along the path at the user's times ``t``: arrays of shape
+    (len(t), dim)."""
     model = report.path.projection.model
     spec = model.spec
     joint_index = [spec.context.names().index(j) for j in model.joints]
     located = [(piece_index(report, float(x)), float(x)) for x in t]
     located = [(i, _on_piece(report, i, arb(x))) for i, x in located]
+    def pose_only(p) -> bool:
+        return not any(c.degrees()[i] for c in p for i in joint_index) and \
+            not all(c.is_constant() for c in p)
+
+    # the drawing's single points (a platform) when some move with the pose alone, else
+    # every end point of a segment that does
+    traced = [p for body in spec.drawing for p in body.points if pose_only(p)] or \
+        [q for body in spec.drawing for chain in body.chains for q in chain if pose_only(q)]
     seen, out = set(), []
-    for body in spec.drawing:
-        for p in (*body.points, *(q for chain in body.chains for q in chain)):
-            if any(c.degrees()[i] for c in p for i in joint_index) or \
-                    all(c.is_constant() for c in p) or tuple(map(str, p)) in seen:
-                continue
+    for p in traced:
+        if tuple(map(str, p)) not in seen:
             seen.add(tuple(map(str, p)))
             along: dict[int, list] = {}
             rows = []

@@ -17,7 +17,10 @@ from __future__ import annotations
 
 from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
 
-from singcheck.algebra.trig import LinearInPi, TimeRange, reduce_trig, uses_t, uses_trig
+from singcheck.algebra.intervals import excludes_zero, working_precision
+from singcheck.algebra.polynomials import restrict
+from singcheck.algebra.radicals import conjugates, evaluate_path, norm_radicals
+from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig, uses_t, uses_trig
 from singcheck.roots.branch_bound import branch_and_bound
 from singcheck.roots.enclosures import (
     EXACT,
@@ -72,7 +75,12 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
 
 def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
                        tolerance: float = 1e-9) -> RootIsolation:
-    """Every real root of ``poly(t, sin t, cos t)`` on the closed range, certified."""
+    """Every real root of ``poly(t, sin t, cos t)`` on the closed range, certified.
+
+    A polynomial with square roots among its coefficients (a :func:`path_ring`
+    element) goes through :func:`_with_radicals`."""
+    if poly.context() is not TRIG:
+        return _with_radicals(poly, interval, tolerance)
     p = reduce_trig(poly)
     if p.is_zero():
         raise IdenticallyZeroError("the function is identically zero along the path")
@@ -81,3 +89,36 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
     if uses_trig(p):
         return _half_angle(p, interval, tolerance)
     return _exact_univariate(p, interval, tolerance)
+
+
+def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
+    """Roots of a polynomial over Q(√2, √3, …): those of its norm N = ∏ p^σ (over Q,
+    isolated as above), kept only where proven to be roots of p itself.
+
+    Each ball T of N holds exactly one root τ of N.  If p excludes 0 on T, τ is a root of
+    a conjugate only: dropped.  If every conjugate p^σ (σ ≠ id) excludes 0 on T, then
+    p(τ) = 0: kept.  Otherwise T is refined (and the precision raised) a few times;
+    what stays ambiguous is reported undecided, never guessed."""
+    norm = restrict(norm_radicals(p), TRIG)
+    iso = isolate_real_roots(norm, interval, tolerance)
+    sigmas = conjugates(p)
+    roots, undecided = [], list(iso.undecided)
+    for root in iso.roots:
+        r, verdict = root, None
+        for step, bits in enumerate((53, 128, 256, 512)):
+            if step:
+                r = r.refined(tolerance * 10.0 ** (-4 * step))
+            with working_precision(bits):
+                if excludes_zero(evaluate_path(p, r.t)):
+                    verdict = False
+                elif all(excludes_zero(evaluate_path(p, r.t, s)) for s in sigmas):
+                    verdict = True
+            if verdict is not None:
+                break
+        if verdict:
+            roots.append(r)
+        elif verdict is None:
+            undecided.append(Undecided(r.t, "a root of the norm over the square roots could "
+                                       "not be told apart from a root of a conjugate near "
+                                       f"t ≈ {float(r.t.mid()):.6g}"))
+    return RootIsolation(tuple(roots), tuple(undecided), iso.method)

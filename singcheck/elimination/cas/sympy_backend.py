@@ -19,6 +19,7 @@ from flint import fmpq, fmpq_mpoly
 
 from singcheck.algebra.polynomials import restrict
 from singcheck.elimination.requests import EliminationRequest, EliminationResult, leg_structure
+from singcheck.errors import BackendError
 
 
 def _to_sympy(p: fmpq_mpoly, gens):
@@ -52,6 +53,12 @@ class SympyBackend:
         by_name = dict(zip(request.context.names(), gens, strict=True))
         kept = request.kept_context()
         structure = leg_structure(request)
+        pairs = [v for v in request.eliminate if v.startswith("cos(")]
+        if pairs:
+            raise BackendError(
+                f"sympy cannot eliminate the angle {pairs[0][4:-1]} (a revolute joint's cos, "
+                "sin pair: its Gröbner basis does not finish); use --backend flint, singular "
+                "or macaulay2")
         if structure is not None:
             g, legs = structure
             acc = _to_sympy(g, gens)

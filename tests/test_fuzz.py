@@ -14,7 +14,10 @@ The cases run in-process through the API and the command line's own exit-code ma
 ``singcheck`` process and checks there is no traceback on stderr.
 
 ``SINGCHECK_FUZZ_EXAMPLES=N`` scales the number of cases (the CI default keeps the run
-near a minute); ``SINGCHECK_FUZZ_REPORT=FILE`` writes the counts of exit statuses.
+near a minute); ``SINGCHECK_FUZZ_REPORT=FILE`` writes the counts of exit statuses as it
+goes, and with ``SINGCHECK_FUZZ_KEEP_GOING=1`` (a long campaign) a failing case is
+appended to ``FILE.failures`` (JSON lines: the two specs and the error) instead of
+stopping the run.
 """
 
 from __future__ import annotations
@@ -98,7 +101,25 @@ def _robot(text: str, path: str):
 
 def outcome(robot_text: str, trajectory_text: str) -> int:
     """The exit status ``singcheck run`` gives for this robot and trajectory, computed
-    in-process: any exception the CLI would report as an internal error propagates."""
+    in-process: any exception the CLI would report as an internal error propagates (or,
+    in a campaign, is recorded)."""
+    try:
+        return _outcome(robot_text, trajectory_text)
+    except Exception as e:
+        if not os.environ.get("SINGCHECK_FUZZ_KEEP_GOING"):
+            raise
+        import traceback
+
+        COUNTS["failures"] += 1
+        where = traceback.extract_tb(e.__traceback__)[-1]
+        with open(os.environ["SINGCHECK_FUZZ_REPORT"] + ".failures", "a") as f:
+            f.write(json.dumps({"error": f"{type(e).__name__}: {str(e)[:500]}",
+                                "at": f"{where.filename}:{where.lineno}",
+                                "robot": robot_text, "trajectory": trajectory_text}) + "\n")
+        return -1
+
+
+def _outcome(robot_text: str, trajectory_text: str) -> int:
     from singcheck import api
     from singcheck.cli.commands import _exit_code
     from singcheck.cli.exitcodes import exit_codes
@@ -121,6 +142,8 @@ def outcome(robot_text: str, trajectory_text: str) -> int:
     end = time.monotonic()
     COUNTS[f"exit {code}"] += 1
     COUNTS["cases"] += 1
+    if COUNTS["cases"] % 25 == 0:
+        _report()
     assert code in (0, 1, 2, 3), code
     loaded = loaded or end
     assert loaded - start < ROBOT_BUDGET, f"robot: {loaded - start:.1f} s"

@@ -44,7 +44,7 @@ $(VENV)/.installed: pyproject.toml
 	  $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq python3-venv && \
 	  $(PYTHON) -m venv $(VENV); }
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e '.[test,bench,plot,html]'
+	$(BIN)/python -m pip install -q -e '.[test,bench,plot,html,dask]'
 	@touch $@
 
 test: setup

@@ -1,11 +1,16 @@
-"""make bench: singcheck against the sampling check, same inputs, one process.
+"""make bench: singcheck against its two contenders, same inputs, one process.
 
-Prints tables (contender, median, min, max, ratio to singcheck, found the true
-singularities?) and writes bench/results.json.  On each path singcheck and the sampling
-scans run round-robin, so a noisy spell of the machine falls on all of them alike.  The
-sampling contender is what people use today: evaluate det A along the working mode at N
-points of the path (vectorised NumPy) and look for sign changes.  It is fast, and it can
-miss singularities.
+Prints tables (contender, median, min, max, times relative to singcheck, right answer?),
+says which speed targets the printed run meets, and writes bench/results.json.  On each
+path every contender runs round-robin with singcheck (one run of each per round), so a
+noisy spell of the machine falls on all of them alike.  The contenders:
+
+* the **certified alternative without elimination** (bench/contender.py): interval
+  branch-and-bound over t on det A along each feasible working mode, Merlet's approach,
+  with Arb balls; its answers are checked against singcheck's;
+* the **sampling check** people use today: det A along the working mode at N points of
+  the path (vectorised NumPy), looking for sign changes.  Fast, and it can miss
+  singularities.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 
+from contender import contender  # noqa: E402
 from generate import waypoints_yaml, write  # noqa: E402
 
 from singcheck.certify.classification import certify_path  # noqa: E402
@@ -103,10 +109,27 @@ def found_all(found: list[float], truth: list[float], spacing: float) -> bool:
 
 # -- the runs -------------------------------------------------------------------------
 
+# (robot, trajectory file relative to the repository, label); the long paths are the
+# paper's over [-10π, 10π], bench/paths/
+PATHS = (("orthoglide", "trajectories/heart1.yaml", "heart 1"),
+         ("orthoglide", "trajectories/heart2.yaml", "heart 2"),
+         ("orthoglide", "trajectories/helix.yaml", "helix"),
+         ("orthoglide", "bench/paths/heart-8h.yaml", "8-harmonic heart"),
+         ("orthoglide", "bench/paths/heart1-long.yaml", "heart 1, [-10π, 10π]"),
+         ("orthoglide", "bench/paths/heart2-long.yaml", "heart 2, [-10π, 10π]"),
+         ("orthoglide", "bench/paths/helix-long.yaml", "helix, [-10π, 10π]"),
+         ("biglide", "trajectories/biglide-double-cross.yaml", "biglide, crosses twice"),
+         ("biglide", "trajectories/biglide-graze.yaml", "biglide, grazes"))
+SHORT = ("heart 1", "heart 2", "helix", "8-harmonic heart")
+LONG = ("heart 1, [-10π, 10π]", "heart 2, [-10π, 10π]", "helix, [-10π, 10π]")
+
+
 def load(robot: str, trajectory: str, backend: str = "flint"):
     model = build_model(load_robot(ROOT / "robots" / f"{robot}.yaml"))
     projection = project_robot(model, get_backend(backend))
-    spec = load_trajectory(ROOT / "trajectories" / f"{trajectory}.yaml", model.spec)
+    path = ROOT / trajectory if "/" in trajectory else \
+        ROOT / "trajectories" / f"{trajectory}.yaml"
+    spec = load_trajectory(path, model.spec)
     return projection, spec
 
 
@@ -114,30 +137,54 @@ def truth_of(report, mode: str) -> list[float]:
     return [float(c.t.mid()) for c in report.candidates if mode in c.singular_modes]
 
 
-def compare(robot: str, trajectory: str) -> list[dict]:
-    """singcheck and the sampling scans on one path: rows of the main table."""
+def agrees(answer, report, tolerance: float = 1e-9) -> bool:
+    """The contender's answer is singcheck's: same verdict, same feasible modes, and in
+    each of them the same singular times (balls within a few tolerances)."""
+    feasible = [m.label for m in report.modes if m.feasible]
+    if answer.verdict != report.verdict or sorted(answer.feasible) != sorted(feasible):
+        return False
+    for mode in feasible:
+        ours = sorted(answer.singular_times.get(mode, []), key=lambda b: b.mid())
+        theirs = truth_of(report, mode)
+        if len(ours) != len(theirs) or any(abs(float(a.mid()) - b) > 4 * tolerance
+                                           for a, b in zip(ours, theirs, strict=True)):
+            return False
+    return True
+
+
+def compare(robot: str, trajectory: str, label: str) -> list[dict]:
+    """singcheck, the branch-and-bound contender and the sampling scans on one path."""
     projection, spec = load(robot, trajectory)
+    model = projection.model
     report = certify_path(build_path(projection, spec))
+    answer = contender(model, spec)
     mode = next(m.label for m in report.modes if m.feasible)
     truth = truth_of(report, mode)
     scan = SamplingScan(build_path(projection, spec), mode)
     width = scan.range[1] - scan.range[0]
     sizes = (10**3, 10**4, 10**5)
     timings = interleaved([lambda: certify_path(build_path(projection, spec)),
+                           lambda: contender(model, spec),
                            *[lambda n=n: scan(n) for n in sizes]])
-    rows = [{"case": f"{robot}/{trajectory}", "contender": "singcheck (certified)",
-             **stats(timings[0]), "found": True, "verdict": report.verdict,
-             "singular_times": truth}]
-    for n, ts in zip(sizes, timings[1:], strict=True):
+    right = agrees(answer, report)
+    case = {"case": label, "path": f"{robot}/{Path(trajectory).stem}"}
+    rows = [{**case, "contender": "singcheck (certified)", **stats(timings[0]),
+             "found": report.verdict != "unknown", "verdict": report.verdict,
+             "singular_times": truth},
+            {**case, "contender": "branch-and-bound (certified)", **stats(timings[1]),
+             "found": right, "verdict": answer.verdict, "boxes": answer.boxes,
+             "agrees_with_singcheck": right}]
+    for n, ts in zip(sizes, timings[2:], strict=True):
         found = scan(n)
-        rows.append({"case": f"{robot}/{trajectory}", "contender": f"NumPy sampling, {n:.0e}",
-                     **stats(ts), "found": found_all(found, truth, 2 * width / (n - 1)),
+        rows.append({**case, "contender": f"NumPy sampling, {n:.0e}", **stats(ts),
+                     "found": found_all(found, truth, 2 * width / (n - 1)),
                      "sign_changes": len(found)})
-    if (robot, trajectory) == ("orthoglide", "heart1"):
-        rows += backend_rows(projection.model, spec, truth)
+    if (robot, Path(trajectory).stem) == ("orthoglide", "heart1"):
+        rows += [{**case, **r} for r in backend_rows(projection.model, spec, truth)]
     base = rows[0]["median_s"]
     for row in rows:
         row["ratio_to_singcheck"] = row["median_s"] / base
+        row["singcheck_over_it"] = base / row["median_s"]
     return rows
 
 
@@ -155,7 +202,7 @@ def backend_rows(model, spec, truth) -> list[dict]:
 
         report = once()
         mode = next(m.label for m in report.modes if m.feasible)
-        rows.append({"case": "orthoglide/heart1", "contender": f"singcheck + {name} projection",
+        rows.append({"contender": f"singcheck + {name} projection",
                      **stats(times(once, 3 if name == "sympy" else REPEAT)),
                      "found": truth_of(report, mode) == truth, "verdict": report.verdict})
     return rows
@@ -219,11 +266,19 @@ def space_rows() -> list[dict]:
 
 def cli_rows() -> list[dict]:
     exe = [sys.executable, "-m", "singcheck"]
+    # warm: the elimination cache filled and Python's bytecode cache written, as after any
+    # first run of an installed singcheck (so PYTHONDONTWRITEBYTECODE is not passed on)
+    base_env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     with tempfile.TemporaryDirectory() as cache:
-        env = {**os.environ, "SINGCHECK_CACHE_DIR": cache}
-        args = [*exe, "run", "robots/orthoglide.yaml", "trajectories/heart1.yaml", "-q"]
-        subprocess.run(args, cwd=ROOT, env=env, capture_output=True)  # warm the cache
-        warm = times(lambda: subprocess.run(args, cwd=ROOT, env=env, capture_output=True), 7)
+        env = {**base_env, "SINGCHECK_CACHE_DIR": cache}
+        args = [*exe, "run", "robots/orthoglide.yaml", "trajectories/heart1.yaml",
+                "--format", "json"]
+        flint_only = [sys.executable, "-c", "import flint"]
+        for cmd in (args, flint_only):
+            subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True)  # warm
+        warm, bare = interleaved([
+            lambda: subprocess.run(args, cwd=ROOT, env=env, capture_output=True),
+            lambda: subprocess.run(flint_only, cwd=ROOT, env=env, capture_output=True)])
         with tempfile.TemporaryDirectory() as out:
             paths = write(Path(out), 1000)
             cmd = [*exe, "run", "robots/orthoglide.yaml", *map(str, paths), "-q",
@@ -234,14 +289,17 @@ def cli_rows() -> list[dict]:
     verdicts: dict[str, int] = {}
     for t in json.loads(batch.stdout)["trajectories"]:
         verdicts[t["verdict"]] = verdicts.get(t["verdict"], 0) + 1
-    return [{"what": "singcheck run orthoglide heart1, warm cache, whole process",
+    return [{"what": "singcheck run orthoglide heart1 --format json, warm, whole process",
              **stats(warm)},
+            {"what": "python -c 'import flint', same rounds", **stats(bare)},
             {"what": f"1000 heart-like trajectories, --jobs {os.cpu_count()}",
              "median_s": batch_s, "min_s": batch_s, "max_s": batch_s, "runs": 1,
              "verdicts": verdicts}]
 
 
 def growth_rows() -> list[dict]:
+    """Certification time per trajectory, singcheck and the branch-and-bound contender
+    round-robin, as the path gains harmonics; then robots of growing size."""
     rows = []
     model = build_model(load_robot(ROOT / "robots" / "orthoglide.yaml"))
     projection = project_robot(model, get_backend("flint"))
@@ -249,11 +307,17 @@ def growth_rows() -> list[dict]:
         for k in range(1, 9):
             paths = write(Path(out) / str(k), 3, harmonics=k, seed=k)
             specs = [load_trajectory(p, model.spec) for p in paths]
-            paths_ = [build_path(projection, s) for s in specs]
-            ts = times(lambda ps=paths_: [certify_path(p) for p in ps], 3)
+            ours, theirs = interleaved(
+                [lambda ss=specs: [certify_path(build_path(projection, s)) for s in ss],
+                 lambda ss=specs: [contender(model, s) for s in ss]], 5)
+            reports = [certify_path(build_path(projection, s)) for s in specs]
+            right = sum(agrees(contender(model, s), r) for s, r in zip(specs, reports,
+                                                                       strict=True))
             rows.append({"axis": "harmonics", "size": k,
-                         "mu_degree": max(int(p.mu.total_degree()) for p in paths_),
-                         "median_s": statistics.median(ts) / 3})
+                         "mu_degree": max(int(r.path.mu.total_degree()) for r in reports),
+                         "median_s": statistics.median(ours) / 3,
+                         "contender_median_s": statistics.median(theirs) / 3,
+                         "contender_agrees": f"{right}/3"})
     for robot, trajectory in (("skew-biglide", "skew-biglide-ellipse"),
                               ("orthoglide", "heart1"),
                               ("stacked-orthoglide", "stacked-heart")):
@@ -269,6 +333,29 @@ def growth_rows() -> list[dict]:
                      "projection_s": statistics.median(proj_t),
                      "median_s": statistics.median(cert_t)})
     return rows
+
+
+def targets(paths: list[dict], cli: list[dict]) -> list[dict]:
+    """Issue 17's speed targets, checked on the figures of this run."""
+    def median(label: str, contender: str) -> float:
+        return next(r["median_s"] for r in paths
+                    if r["case"] == label and r["contender"] == contender)
+
+    out = []
+    for label in SHORT + LONG:
+        limit = 1.0 if label in SHORT else 0.5
+        ratio = median(label, "singcheck (certified)") / median(
+            label, "branch-and-bound (certified)")
+        out.append({"target": f"{label}: singcheck <= {limit}x the branch-and-bound",
+                    "value": ratio, "limit": limit, "met": ratio <= limit})
+    ratio = median("heart 1", "singcheck (certified)") / median("heart 1",
+                                                                "NumPy sampling, 1e+04")
+    out.append({"target": "heart 1: singcheck <= 2x the 10^4-point NumPy scan",
+                "value": ratio, "limit": 2.0, "met": ratio <= 2.0})
+    ratio = cli[0]["median_s"] / cli[1]["median_s"]
+    out.append({"target": "warm CLI run <= 2.5x python -c 'import flint'",
+                "value": ratio, "limit": 2.5, "met": ratio <= 2.5})
+    return out
 
 
 def spline_rows() -> list[dict]:
@@ -309,18 +396,24 @@ def ms(x: float) -> str:
 def main() -> None:
     results = {"machine": machine(), "repeat": REPEAT}
     print(f"machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, "
-          f"Python {results['machine']['python']}\n")
+          f"Python {results['machine']['python']}, load average {os.getloadavg()[0]:.1f} "
+          f"at the start; medians of {REPEAT} round-robin runs\n")
     results["paths"] = rows = []
-    for robot, trajectory in (("orthoglide", "heart1"), ("orthoglide", "heart2"),
-                              ("orthoglide", "helix"), ("biglide", "biglide-double-cross"),
-                              ("biglide", "biglide-graze")):
-        rows += compare(robot, trajectory)
-    print(f"{'case':38} {'contender':32} {'median ms':>9} {'min ms':>9} {'max ms':>9} "
-          f"{'ratio':>7}  found the true singularities")
+    for robot, trajectory, label in PATHS:
+        rows += compare(robot, trajectory, label)
+    print(f"{'path':24} {'contender':32} {'median ms':>9} {'min ms':>9} {'max ms':>9} "
+          f"{'vs singcheck':>12}  right answer?")
     for r in rows:
-        print(f"{r['case']:38} {r['contender']:32} {ms(r['median_s'])} {ms(r['min_s'])} "
-              f"{ms(r['max_s'])} {r['ratio_to_singcheck']:7.2f}  "
-              f"{'yes' if r['found'] else 'NO'}")
+        right = "yes" if r["found"] else "NO"
+        if "verdict" in r and r["contender"] != "singcheck (certified)":
+            right += f" ({r['verdict']})"
+        elif "verdict" in r:
+            right += f" ({r['verdict']}, {len(r['singular_times'])} singular times)"
+        print(f"{r['case']:24} {r['contender']:32} {ms(r['median_s'])} {ms(r['min_s'])} "
+              f"{ms(r['max_s'])} {r['ratio_to_singcheck']:11.2f}x  {right}")
+    print("(vs singcheck: its median time / singcheck's; right answer: singcheck decided; "
+          "branch-and-bound: same verdict and singular times as singcheck; sampling: "
+          "sign changes at exactly singcheck's singular times)")
     results["spline"] = spline = spline_rows()
     print("\nwaypoints: read and certify, whole path (spline built exactly)")
     for r in spline:
@@ -345,17 +438,32 @@ def main() -> None:
     results["command_line"] = cli = cli_rows()
     print("\ncommand line")
     for r in cli:
-        print(f"  {r['what']:62} median {ms(r['median_s'])} ms" +
+        print(f"  {r['what']:66} median {ms(r['median_s'])} ms" +
               (f"  {r['verdicts']}" if "verdicts" in r else ""))
     results["growth"] = growth = growth_rows()
-    print("\ngrowth: certification time per trajectory (projection cached)")
+    print("\ngrowth: certification time per trajectory (projection cached), singcheck and "
+          "the branch-and-bound round-robin")
     for r in growth:
         if r["axis"] == "harmonics":
-            print(f"  harmonics {r['size']}: μ degree {r['mu_degree']:4}  "
-                  f"{ms(r['median_s'])} ms")
+            print(f"  harmonics {r['size']}: μ degree {r['mu_degree']:4}  singcheck "
+                  f"{ms(r['median_s'])} ms  branch-and-bound {ms(r['contender_median_s'])} ms"
+                  f"  (agrees with singcheck on {r['contender_agrees']})")
         else:
             print(f"  {r['robot']:20} {r['size']} joints, ξ degree {r['xi_degree']:3}: "
                   f"projection {ms(r['projection_s'])} ms, certify {ms(r['median_s'])} ms")
+    print("  path length, [-10π, 10π] over [-π, π] (or the helix's [0, 20]):")
+    for short, long in zip(SHORT, LONG, strict=False):
+        def med(label, who):
+            return next(r["median_s"] for r in rows
+                        if r["case"] == label and r["contender"] == who)
+        print(f"    {short:8} singcheck {med(long, 'singcheck (certified)') / med(short, 'singcheck (certified)'):5.2f}x"  # noqa: E501
+              f"  branch-and-bound {med(long, 'branch-and-bound (certified)') / med(short, 'branch-and-bound (certified)'):5.2f}x")  # noqa: E501
+    results["targets"] = goals = targets(rows, cli)
+    print("\ntargets (issue 17), on this run:")
+    for g in goals:
+        print(f"  {'MET    ' if g['met'] else 'NOT MET'}  {g['target']}: {g['value']:.2f}x")
+    met = sum(g["met"] for g in goals)
+    print(f"  {met} of {len(goals)} targets met")
     out = ROOT / "bench" / "results.json"
     out.write_text(json.dumps(results, indent=2) + "\n")
     print(f"\nwritten: {out.relative_to(ROOT)}")

@@ -19,6 +19,7 @@ same :class:`Robot` runs no CAS and reads no cache entry.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -212,41 +213,160 @@ def _one_piece(trajectory: TrajectorySpec) -> bool:
     return not trajectory.segments and trajectory.time_scale is None
 
 
+#: the default per-trajectory time limit of a batch (seconds): generous, but finite
+DEFAULT_TIME_LIMIT = 300.0
+
+
+def check_safely(robot: Robot, trajectory: TrajectorySpec, **options) -> dict[str, Any]:
+    """:func:`check` as one trajectory of a batch: its JSON trajectory object (with
+    ``time_s``, the seconds it took), whatever happens.  A failure of this trajectory
+    alone (a backend failure, a bug, the time limit) becomes its result — verdict
+    ``unknown`` past the time limit, ``error`` with the reason otherwise — so that the
+    other trajectories of the batch still complete.
+    Ctrl-C (KeyboardInterrupt) still stops the batch."""
+    import time
+
+    from singcheck.errors import BackendError
+    from singcheck.report.trajectory import error_json, time_limited_json
+
+    start = time.perf_counter()
+    try:
+        with hard_time_limit(options.get("time_limit")):
+            doc = check(robot, trajectory, **options).to_dict()
+    except TimeLimitExceeded as e:
+        doc = time_limited_json(trajectory, f"unknown: {e}")
+    except BackendError as e:
+        doc = error_json(trajectory, "backend", str(e))
+    except Exception as e:  # a bug, confined to this trajectory
+        doc = error_json(trajectory, "internal", f"{type(e).__name__}: {e}")
+    doc["time_s"] = round(time.perf_counter() - start, 6)
+    return doc
+
+
+@contextmanager
+def hard_time_limit(seconds: float | None):
+    """A backstop behind the cooperative :func:`~singcheck.budget.checkpoint`: in a
+    process's main thread, a timer raises :class:`TimeLimitExceeded` a little after the
+    limit (10 % and a second), should some loop not reach a checkpoint in time."""
+    import signal
+    import threading
+
+    if (seconds is None or not hasattr(signal, "setitimer")
+            or threading.current_thread() is not threading.main_thread()):
+        yield
+        return
+
+    def expire(signum, frame):
+        raise TimeLimitExceeded(f"time limit ({seconds:g} s) reached")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds * 1.1 + 1)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 # state inherited by forked workers (set just before the pool starts)
 _WORKER: dict = {}
 
 
-def _check_index(i: int) -> dict:
+def _worker_signals() -> None:
+    """In a forked worker: Ctrl-C and a hangup reach the whole process group, but it is
+    the parent that stops the batch (and then terminates the workers); SIGTERM ends a
+    worker silently.  So no worker prints a KeyboardInterrupt traceback."""
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+def _check_indices(indices: list[int]) -> list[tuple[int, dict]]:
     robot, trajectories, options = _WORKER["robot"], _WORKER["trajectories"], _WORKER["options"]
-    return check(robot, trajectories[i], **options).to_dict()
+    return [(i, check_safely(robot, trajectories[i], **options)) for i in indices]
+
+
+def prepare_regions(robot: Robot, trajectories: list[TrajectorySpec], time_limit: float | None,
+                    notify: Notify = _quiet) -> bool:
+    """Compute, once, the region maps that several trajectories share (before workers
+    fork, or before a cluster gets the robot), within ``time_limit``.  False when that
+    ran out of time: the batch then runs without the region statement."""
+    from singcheck.spaces.path_regions import prepare_region_maps
+
+    try:
+        with deadline(time_limit), hard_time_limit(time_limit):
+            prepare_region_maps(robot.projection, [t for t in trajectories if _one_piece(t)],
+                                robot.region_cache, notify)
+    except TimeLimitExceeded:
+        notify(f"the workspace regions shared by the paths took more than {time_limit:g} s "
+               "(--time-limit): the batch runs without the region statement")
+        return False
+    return True
 
 
 def check_batch(robot: Robot, trajectories: list[TrajectorySpec], *,
                 tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
-                time_limit: float | None = None, jobs: int = 1,
-                notify: Notify = _quiet) -> Iterator[dict]:
+                time_limit: float | None = DEFAULT_TIME_LIMIT, jobs: int = 1,
+                ordered: bool = True, notify: Notify = _quiet) -> Iterator[dict]:
     """Certify many trajectories, in ``jobs`` forked processes when there are more than 4;
-    yields each one's JSON trajectory object, in input order, as soon as it is known."""
+    yields each one's JSON trajectory object as soon as it is known: in input order, or
+    (``ordered=False``) in the order they finish.
+
+    One trajectory's failure is its own result (:func:`check_safely`); a worker process
+    that dies makes the trajectories it held ``error`` results.  ``time_limit`` bounds
+    each trajectory (and the shared region maps, once)."""
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
                    notify=notify)
-    _WORKER.update(robot=robot, trajectories=trajectories, options=options)
     n = len(trajectories)
+    if jobs > 1 and n > 4:
+        if regions and robot.model.polynomial and not prepare_regions(
+                robot, trajectories, time_limit, notify):
+            options["regions"] = False
+        yield from _forked(robot, trajectories, options, jobs, ordered)
+        return
+    for spec in trajectories:
+        yield check_safely(robot, spec, **options)
+
+
+def _forked(robot, trajectories, options, jobs: int, ordered: bool) -> Iterator[dict]:
+    import multiprocessing
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+
+    from singcheck.report.trajectory import error_json
+
+    n = len(trajectories)
+    size = max(1, min(64, n // (jobs * 16)))
+    chunks = [list(range(i, min(n, i + size))) for i in range(0, n, size)]
+    _WORKER.update(robot=robot, trajectories=trajectories, options=options)
+    pool = ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
+                               initializer=_worker_signals)
     try:
-        if jobs > 1 and n > 4:
-            import multiprocessing
-
-            if regions and robot.model.polynomial:
-                from singcheck.spaces.path_regions import prepare_region_maps
-
-                prepare_region_maps(robot.projection,
-                                    [t for t in trajectories if _one_piece(t)],
-                                    robot.region_cache, notify)
-            with multiprocessing.get_context("fork").Pool(jobs) as pool:
-                yield from pool.imap(_check_index, range(n),
-                                     chunksize=max(1, n // (jobs * 16)))
-        else:
-            for i in range(n):
-                yield _check_index(i)
+        futures = {pool.submit(_check_indices, chunk): chunk for chunk in chunks}
+        pending = list(futures)
+        done_early: dict[int, dict] = {}
+        next_out = 0
+        while pending:
+            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+            pending = [f for f in pending if f not in finished]
+            for future in finished:
+                try:
+                    results = future.result()
+                except Exception as e:  # the worker process died (killed, out of memory)
+                    reason = f"the worker process failed: {type(e).__name__}: {e}"
+                    results = [(i, error_json(trajectories[i], "internal", reason))
+                               for i in futures[future]]
+                if not ordered:
+                    for _, doc in results:
+                        yield doc
+                    continue
+                done_early.update(results)
+            while next_out in done_early:
+                yield done_early.pop(next_out)
+                next_out += 1
     finally:
         _WORKER.clear()
-
+        for process in list(getattr(pool, "_processes", {}).values()):
+            process.terminate()
+        pool.shutdown(wait=True, cancel_futures=True)

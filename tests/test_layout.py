@@ -41,10 +41,14 @@ def _graph() -> dict[str, set[str]]:
     return {m: {i for i in _imports(p) if i in files} - {m} for m, p in files.items()}
 
 
+API_LEVEL = {"api", "cluster"}  # modules at the api stage (cluster: the API on Dask)
+
+
 def _stage(module: str) -> str:
     """The stage a module belongs to; the package itself re-exports the API."""
     parts = module.split(".")
-    return parts[1] if len(parts) > 1 else "api"
+    stage = parts[1] if len(parts) > 1 else "api"
+    return "api" if stage in API_LEVEL else stage
 
 
 def upward_imports(graph: dict[str, set[str]]) -> list[str]:

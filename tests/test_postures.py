@@ -174,3 +174,30 @@ def test_an_interpolated_path_is_traced_through_its_waypoints(tmp_path):
         bodies = drawing_at(report, mode, arb(t))
         platform = next(b for b in bodies if b.name == "platform")
         assert platform.points.ravel().tolist() == pytest.approx(pose, abs=1e-12)
+
+
+def test_a_drawing_with_angles_and_square_roots_is_evaluated_by_name():
+    """A revolute joint (an angle: its cos and sin are the spec's variables) and an exact
+    √3 parameter: the drawn points are the trigonometry done here with mpmath."""
+    from singcheck.report.postures import draw_bodies
+    from singcheck.spec.files import parse_robot
+
+    spec = parse_robot("""\
+name: arm
+joints: [th, q]
+pose: [x, y]
+parameters: {l: 2, h: sqrt(3)/2}
+constraints:
+  - (x - l*cos(th))^2 + (y - l*sin(th))^2 - 1
+  - (x - q)^2 + (y - h)^2 - 1
+drawing:
+  crank: [[[0, 0], [l*cos(th), l*sin(th)], [x, y]]]
+  slider: [[q, h]]
+""", "arm.yaml")
+    assert spec.angles == {"th"}
+    th, q, x, y = mpmath.mpf(1) / 3, mpmath.mpf(5) / 4, mpmath.mpf(1) / 2, mpmath.mpf(2)
+    crank, slider = draw_bodies(spec, [float(th), float(q)], [float(x), float(y)])
+    assert crank.chains[0].ravel().tolist() == pytest.approx(
+        [0, 0, float(2 * mpmath.cos(th)), float(2 * mpmath.sin(th)), 0.5, 2], abs=1e-12)
+    assert slider.points.ravel().tolist() == pytest.approx([1.25, float(mpmath.sqrt(3) / 2)],
+                                                           abs=1e-12)

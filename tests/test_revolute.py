@@ -284,3 +284,29 @@ def test_sympy_says_it_cannot_eliminate_a_revolute_joint_and_who_can():
 def test_external_backends_agree_with_flint_on_the_five_bar(backend):
     assert _robot(FIVE_BAR, backend).singularity_surface == \
         _robot(FIVE_BAR).singularity_surface
+
+
+def test_project_writes_the_revolute_branches_the_test_computes():
+    """`project`'s cos θ = (-a·d ± b·√Δ)/W, sin θ = (-b·d ∓ a·√Δ)/W along the circle give
+    the test's own elbow angles."""
+    from flint import arb
+
+    from singcheck.algebra.intervals import working_precision
+    from singcheck.algebra.radicals import evaluate_path
+    from singcheck.certify.path import build_path
+    from singcheck.report.formulas import joint_formula
+
+    robot = _robot(FIVE_BAR)
+    path = build_path(robot.projection, parse_trajectory(CIRCLE, "path.yaml", robot.spec))
+    for t in (mpmath.mpf(1) / 3, mpmath.mpf(2)):
+        for i in range(2):
+            f = joint_formula(path, i)
+            with working_precision(200):
+                a, b, d, delta = (mpmath.mpf(evaluate_path(p, arb(str(t))).mid().str(
+                    50, radius=False)) for p in (f.a, f.b, f.d, f.delta))
+            w = a * a + b * b
+            angles = {mpmath.atan2((-b * d - sigma * a * mpmath.sqrt(delta)) / w,
+                                   (-a * d + sigma * b * mpmath.sqrt(delta)) / w)
+                      for sigma in (1, -1)}
+            for ref in _five_bar_ik(t)[i]:
+                assert any(abs(mpmath.sin((ref - x) / 2)) < 1e-30 for x in angles)

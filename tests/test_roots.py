@@ -216,3 +216,61 @@ def test_trig_evaluation_encloses_the_function():
             value = sum(mpmath.mpf(int(c.p)) / int(c.q) * x**int(i) * mpmath.sin(x)**int(j)
                         * mpmath.cos(x)**int(k) for (i, j, k), c in p.terms())
             assert contains(box, value)
+
+
+def test_tight_trig_evaluation_encloses_and_is_narrower_on_wide_balls():
+    """The Fourier-form enclosure (``tight``) still holds every value (50-digit mpmath
+    at points of the ball) and is much narrower than Horner in cos t for cos 12t."""
+    import random
+
+    from singcheck.algebra.trig import evaluate_trig, reduce_trig
+
+    rng = random.Random(17)
+    high = reduce_trig(3 * cos_multiple(12) - sin_multiple(9) * T + C**10 * S / 7)
+    for p in [high, *(_random_trig(rng, 12, with_t=True) for _ in range(10))]:
+        for centre, radius in [(0.3, 0.5), (-2.0, 0.2), (1.0, 1e-4), (2.5, 0.05)]:
+            ball = arb(centre, radius)
+            loose, tight = evaluate_trig(p, ball), evaluate_trig(p, ball, tight=True)
+            assert tight.rad() <= loose.rad()
+            for x in (centre + radius * i / 8 for i in range(-8, 9)):
+                x = mpmath.mpf(x)
+                value = sum(mpmath.mpf(int(c.p)) / int(c.q) * x**int(i) * mpmath.sin(x)**int(j)
+                            * mpmath.cos(x)**int(k) for (i, j, k), c in p.terms())
+                assert contains(tight, value)
+    wide = arb(0.3, 0.5)
+    assert evaluate_trig(high, wide, tight=True).rad() < evaluate_trig(high, wide).rad() / 100
+
+
+def test_newton_refinement_keeps_the_root_and_reaches_the_width():
+    """Refining an isolating interval (interval Newton, bisection where Newton cannot
+    work) keeps a sign change at exact rational ends and the true root inside."""
+    from singcheck.roots.rational import real_roots_exact
+
+    cases = [(fmpz_poly([-2, 0, 1]), [mpmath.sqrt(2), -mpmath.sqrt(2)]),
+             # x^7 - 3x + 1: three real roots
+             (fmpz_poly([1, -3, 0, 0, 0, 0, 0, 1]),
+              mpmath.polyroots([1, 0, 0, 0, 0, 0, -3, 1], maxsteps=200, extraprec=200)),
+             # a tight pair near 1/3: (3x - 1)^2 - 10^-12, squarefree
+             (fmpz_poly([10**12 - 1, -6 * 10**12, 9 * 10**12]), None)]
+    for f, roots in cases:
+        real = sorted(mpmath.mpf(mpmath.re(r)) for r in (roots or []) if abs(mpmath.im(r)) < 1e-30)
+        if roots is None:
+            real = sorted(mpmath.mpf(1) / 3 + s * mpmath.mpf(10) ** -6 / 3 for s in (-1, 1))
+        isolated = [rr for rr, _ in real_roots_exact(fmpq_poly(f))]
+        assert len(isolated) == len(real)
+        for rr, x in zip(isolated, real, strict=True):
+            for width in (fmpq(1, 10**9), fmpq(1, 10**30)):
+                rr.bisect_to(width)
+                assert rr.hi - rr.lo <= width
+                lo, hi = fmpq_poly(f)(rr.lo), fmpq_poly(f)(rr.hi)
+                assert lo * hi <= 0  # exact: a sign change (or a root) at the ends
+                assert mpmath.mpf(int(rr.lo.p)) / int(rr.lo.q) <= x <= \
+                    mpmath.mpf(int(rr.hi.p)) / int(rr.hi.q)
+
+
+def test_descartes_variation_count_stops_at_two():
+    from singcheck.roots.rational import _variations_up_to_two
+
+    for coeffs, expected in [([1, 2, 3], 0), ([1, 0, -1], 1), ([1, -1, 1], 2),
+                             ([-1, 0, 0, 2, -3, 4], 2), ([0, 0, 5, 0, -5], 1), ([], 0)]:
+        assert _variations_up_to_two(coeffs) == expected

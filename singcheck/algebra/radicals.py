@@ -387,15 +387,17 @@ def _parts(p: fmpq_mpoly) -> list[tuple[tuple[int, ...], fmpq_mpoly]]:
     return parts
 
 
-def evaluate_path(p: fmpq_mpoly, t: arb, signs: dict[int, int] | None = None) -> arb:
+def evaluate_path(p: fmpq_mpoly, t: arb, signs: dict[int, int] | None = None,
+                  tight: bool = False) -> arb:
     """Rigorous enclosure of a path polynomial (in a :func:`path_ring`) for every t in
-    the ball ``t``, each ``sqrt(q)`` at its value √q (or -√q where ``signs[q] = -1``)."""
+    the ball ``t``, each ``sqrt(q)`` at its value √q (or -√q where ``signs[q] = -1``);
+    ``tight`` as for :func:`~singcheck.algebra.trig.evaluate_trig`."""
     if p.context() is TRIG:
-        return evaluate_trig(p, t)
+        return evaluate_trig(p, t, tight)
     values = [b for _, b in sorted(radical_balls(p.context(), signs).items())]
     total = arb(0)
     for exps, part in _parts(p):
-        term = evaluate_trig(part, t)
+        term = evaluate_trig(part, t, tight)
         for v, e in zip(values, exps, strict=True):
             if e:
                 term *= v ** e

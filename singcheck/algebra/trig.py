@@ -135,13 +135,21 @@ def derivative(p: fmpq_mpoly) -> fmpq_mpoly:
     return reduce_trig(p.derivative("t") + C * p.derivative("s") - S * p.derivative("c"))
 
 
-def evaluate_trig(p: fmpq_mpoly, t: arb) -> arb:
+def evaluate_trig(p: fmpq_mpoly, t: arb, tight: bool = False) -> arb:
     """Rigorous enclosure of ``p(t, sin t, cos t)`` for every t in the ball ``t``.
 
     ``p`` (reduced) is read as Σᵢ tⁱ (P₀ᵢ(c) + s·P₁ᵢ(c)) with ball-coefficient
     polynomials in c evaluated by FLINT (Horner, outward rounding), so the result
     encloses every value of p over the ball; the split is built once per polynomial
     and working precision (coefficients rounded at that precision) and memoised.
+
+    On a wide ball Horner's rule in c = cos t overestimates badly when P has a high
+    degree (its power-basis coefficients are large and alternate: cos 8t = T₈(c) has
+    coefficients up to 160).  With ``tight`` (for callers that would otherwise split
+    the ball), p is then also enclosed in its Fourier form
+    Σᵢ tⁱ Σₖ (aᵢₖ cos kt + bᵢₖ sin kt), each sin kt and cos kt enclosed by Arb
+    directly, and the narrowest of the two enclosures and their intersection is
+    returned: each contains every value.
     """
     split = _split(p)
     if isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
@@ -150,7 +158,79 @@ def evaluate_trig(p: fmpq_mpoly, t: arb) -> arb:
     total = arb(0)
     for p0, p1 in reversed(split):
         total = total * t + p0(c) + s * p1(c)
+    if tight and t.rad() > _WIDE:
+        fourier = _fourier_value(p, t)
+        if fourier is not None:  # each of the three balls holds every value: the narrowest
+            return min((total, fourier, total.intersection(fourier)), key=lambda b: b.rad())
     return total
+
+
+#: balls wider than this (radius) are also enclosed through the Fourier form
+_WIDE = 1e-3
+#: ... for polynomials of at least this degree in c (lower ones barely wrap)
+_FOURIER_MIN_DEGREE = 4
+
+
+def _fourier_value(p: fmpq_mpoly, t: arb) -> arb | None:
+    """The Fourier-form enclosure of p over the ball t (None when p's degree in c is low)."""
+    form = _fourier(p)
+    if form is None:
+        return None
+    terms, harmonics, dt = form
+    sc = {k: (k * t).sin_cos() for k in harmonics}
+    powers = [arb(1), t]
+    for _ in range(dt - 1):
+        powers.append(powers[-1] * t)
+    total = arb(0)
+    for i, k, a, b in terms:
+        if k == 0:
+            term = a
+        else:
+            sin_k, cos_k = sc[k]
+            term = a * cos_k if a is not None else b * sin_k
+            if a is not None and b is not None:
+                term += b * sin_k
+        total += term if i == 0 else term * powers[i]
+    return total
+
+
+_FOURIERS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, object]] = OrderedDict()
+
+
+def _fourier(p: fmpq_mpoly):
+    """(terms, harmonics, degree in t) with terms (i, k, a, b) for tⁱ(a cos kt + b sin kt),
+    converted exactly (Chebyshev bases: T_k(c) = cos kt, s·U_(k-1)(c) = sin kt), the
+    coefficients rounded to balls at the current precision; memoised like the split."""
+    key = (id(p), ctx.prec)
+    hit = _FOURIERS.get(key)
+    if hit is not None and hit[0] is p:
+        _FOURIERS.move_to_end(key)
+        return hit[1]
+    q = reduce_trig(p)
+    form = None
+    if not q.is_zero() and q.degrees()[2] + q.degrees()[1] >= _FOURIER_MIN_DEGREE:
+        dt = q.degrees()[0]
+        parts: dict[tuple[int, int], dict[int, fmpq]] = {}
+        for (i, j, k), a in q.terms():
+            parts.setdefault((i, j), {})[k] = a
+        found: dict[tuple[int, int], list[fmpq]] = {}
+        for (i, j), part in parts.items():
+            poly = fmpq_poly([part.get(k, 0) for k in range(max(part) + 1)])
+            while not poly.is_zero():
+                n = poly.degree()
+                basis = fmpq_poly(fmpz_poly.chebyshev_t(n) if j == 0
+                                  else fmpz_poly.chebyshev_u(n))
+                coeff = poly.coeffs()[-1] / basis.coeffs()[-1]
+                poly -= coeff * basis
+                k = n if j == 0 else n + 1
+                found.setdefault((i, k), [fmpq(0), fmpq(0)])[j] += coeff
+        terms = [(i, k, arb(a) if a != 0 else None, arb(b) if b != 0 else None)
+                 for (i, k), (a, b) in sorted(found.items()) if a != 0 or b != 0]
+        form = (terms, sorted({k for _, k, _, _ in terms if k}), dt)
+    _FOURIERS[key] = (p, form)
+    if len(_FOURIERS) > _SPLITS_KEPT:
+        _FOURIERS.popitem(last=False)
+    return form
 
 
 _SPLITS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, list]] = OrderedDict()

@@ -28,7 +28,7 @@ What is proven, and how:
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from flint import acb, arb
 
@@ -225,6 +225,39 @@ def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot
     return Candidate(root, pose, shown, per_mode, status)
 
 
+def _periodic(path: PathModel) -> bool:
+    """Whether everything along the path is 2π-periodic in t: no polynomial of it
+    (pose, pose coordinates, legs, μ) involves the bare t."""
+    from singcheck.algebra.trig import uses_t
+
+    polys = [*path.phi, *path.coordinates, path.mu, *path.degenerate]
+    for leg in path.legs:
+        polys += [*leg.coefficients, leg.discriminant]
+    return not any(uses_t(p) for p in polys if p is not None)
+
+
+def _classify_all(path: PathModel, modes: list[WorkingMode], roots, tolerance: float
+                  ) -> list[Candidate]:
+    """Every root classified.  On a path free of the bare t everything the
+    classification looks at (the pose, each mode's joints, det A) is 2π-periodic, so
+    the root τ + 2kπ has exactly the classification of τ: a root known to be a 2kπ
+    shift of one already classified (``RealRoot.period``) takes its verdicts per mode,
+    with their proofs, and its pose and joints."""
+    periodic = _periodic(path)
+    done: dict[int, Candidate] = {}
+    out = []
+    for r in roots:
+        base = done.get(r.period[0]) if periodic and r.period is not None else None
+        if base is None:
+            candidate = classify_candidate(path, modes, r, tolerance)
+            if periodic and r.period is not None:
+                done[r.period[0]] = candidate
+        else:
+            candidate = replace(base, root=r)
+        out.append(candidate)
+    return out
+
+
 def _clear_undecided(path, modes, box) -> bool:
     """True when there is a feasible mode and every feasible mode's det A provably stays
     away from 0 on the box (with no feasible mode nothing clears it: the box is kept in
@@ -245,7 +278,7 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
         return TrajectoryReport(path, VERDICT_UNKNOWN,
                                 "the trajectory lies on the singularity surface ξ(X) = 0, so "
                                 "μ(t) ≡ 0 gives no candidates", [], modes, "none")
-    candidates = [classify_candidate(path, modes, r, tolerance) for r in isolation.roots]
+    candidates = _classify_all(path, modes, isolation.roots, tolerance)
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
     undecided = [(b.t, b.reason) for b in isolation.undecided

@@ -157,14 +157,16 @@ class LegAlongPath:
             out = out * q + c
         return out
 
-    def branches(self, t: arb) -> dict[str, arb | acb | tuple | None]:
+    def branches(self, t: arb, tight: bool = False) -> dict[str, arb | acb | tuple | None]:
         """Enclosures of each branch's joint value for every t in the ball ``t``.
 
         A quadratic leg's branches are real where D > 0 (proven) and complex
         conjugate where D < 0; where the sign of D is not proven both are None.  A
-        revolute branch is the pair (cos θ, sin θ)."""
-        values = [evaluate_path(c, t) for c in self.coefficients]
-        d = evaluate_path(self.discriminant, t) if self.discriminant is not None else None
+        revolute branch is the pair (cos θ, sin θ).  ``tight`` spends more on a wide
+        ball (:func:`~singcheck.algebra.trig.evaluate_trig`)."""
+        values = [evaluate_path(c, t, tight=tight) for c in self.coefficients]
+        d = evaluate_path(self.discriminant, t, tight=tight) \
+            if self.discriminant is not None else None
         return branch_values(self.leg, values, d)
 
     def inside(self, value, limits) -> bool | None:

@@ -24,6 +24,7 @@ Whatever cannot be proven makes the branch ``unknown``, with the reason.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from itertools import product
 
@@ -31,7 +32,7 @@ from flint import arb
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.radicals import evaluate_path
-from singcheck.algebra.trig import TimeRange
+from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
 from singcheck.budget import checkpoint
 from singcheck.certify.path import LegAlongPath, PathModel, joint_float
 from singcheck.roots.enclosures import IdenticallyZeroError, RootIsolation
@@ -89,7 +90,13 @@ def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | Non
 
 
 _PIECES = 8
-_BUDGET = 64  # ball evaluations spent before falling back to a root isolation
+_BUDGET = 64  # ball evaluations per 2π of range spent before falling back to a root isolation
+
+
+def _budget(interval: TimeRange) -> int:
+    """The evaluation budget grows with the range: a longer path needs more pieces."""
+    periods = (float(interval.end) - float(interval.start)) / (2 * math.pi)
+    return max(_BUDGET, math.ceil(_BUDGET * periods))
 
 
 def _pieces(interval: TimeRange) -> list[arb]:
@@ -101,26 +108,60 @@ def _pieces(interval: TimeRange) -> list[arb]:
     return [a.union(b) for a, b in zip(edges, edges[1:], strict=False)]
 
 
+_TIGHT_ABOVE = 0.05  # radius above which a failed piece is retried with tight enclosures
+_TIGHT_DEGREE = 10  # ... when the leg's polynomials have at least this degree in (s, c)
+
+
+def _high_degree(leg: LegAlongPath) -> bool:
+    """Whether Horner in cos t is likely to overestimate badly on wide pieces."""
+    return max(p.degrees()[1] + p.degrees()[2] for p in _leg_polys(leg)
+               if p is not None) >= _TIGHT_DEGREE
+
+
+def _leg_polys(leg: LegAlongPath):
+    return (*leg.coefficients, leg.discriminant)
+
+
+def one_period(interval: TimeRange, polys) -> TimeRange:
+    """The part of the range a quick proof about ``polys`` needs to cover.
+
+    Trig polynomials free of the bare t are 2π-periodic, so over a range longer than 2π
+    they take no value that they do not take on its first 2π: proving a property of
+    their values on [start, start + 2π] proves it on the whole range.
+    """
+    start, end = interval.start, interval.end
+    if any(uses_t(p) for p in polys if p is not None) or \
+            float(end) - float(start) <= 2 * math.pi + 1e-9:
+        return interval
+    return TimeRange(start, LinearInPi(start.rational, start.pi_coefficient + 2))
+
+
 def _halves(piece: arb) -> tuple[arb, arb]:
     lo, hi = piece.lower(), piece.upper()
     mid = piece.mid()
     return lo.union(mid), mid.union(hi)
 
 
-def _everywhere(predicate, interval: TimeRange) -> bool:
-    """True when ``predicate(ball)`` is proven on balls covering the whole range: a
-    quick proof by ball arithmetic that spares a root isolation (False means "not
-    proven").  A piece where it fails is halved (ball enclosures tighten as pieces
-    shrink) until a budget of evaluations is spent."""
+def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True) -> bool:
+    """True when ``predicate(ball, tight)`` is proven on balls covering the whole range:
+    a quick proof by ball arithmetic that spares a root isolation (False means "not
+    proven").  A wide piece where it fails is tried again with ``tight`` enclosures
+    (when ``retry_tight``); a piece where it still fails is halved (ball enclosures
+    tighten as pieces shrink) until a budget of evaluations is spent."""
     todo = _pieces(interval)
+    budget = _budget(interval)
     spent = 0
     while todo:
         piece = todo.pop()
         checkpoint()
         spent += 1
-        if predicate(piece):
+        if predicate(piece, False):
             continue
-        if spent + len(todo) + 2 > _BUDGET:
+        if retry_tight and piece.rad() > _TIGHT_ABOVE:
+            spent += 1
+            if predicate(piece, True):
+                continue
+        if spent + len(todo) + 2 > budget:
             return False
         todo += _halves(piece)
     return True
@@ -130,7 +171,8 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when)
     """Status of both branches of a quadratic leg with respect to step 1 (``when``
     writes a time ball in the user's parameter)."""
     joint = leg.leg.joint
-    if _everywhere(lambda t: evaluate_path(leg.discriminant, t) > 0, interval):
+    if _everywhere(lambda t, tight: evaluate_path(leg.discriminant, t, tight=tight) > 0,
+                   one_period(interval, _leg_polys(leg)), _high_degree(leg)):
         return FEASIBLE, "", None
     iso = _isolate(leg.discriminant, interval, tolerance)
     if iso is None:
@@ -166,7 +208,8 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
     if leg.inside(leg.branches(interval.start.ball())[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
                                  f"{joint} is outside {bounds} from the start")
-    if _everywhere(lambda t: leg.inside(leg.branches(t)[label], limits) is True, interval):
+    if _everywhere(lambda t, tight: leg.inside(leg.branches(t, tight)[label], limits) is True,
+                   one_period(interval, _leg_polys(leg)), _high_degree(leg)):
         return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
     undecided = []

@@ -21,6 +21,9 @@ RUN_EPILOG = """\b
 Examples:
   singcheck run robots/orthoglide.yaml trajectories/heart1.yaml
   singcheck run robots/orthoglide.yaml trajectories/*.yaml --format json > report.json
+  cat paths/*.yaml | singcheck run robots/orthoglide.yaml - --format jsonl
+  singcheck run robots/orthoglide.yaml paths.yaml --format junit -o report.xml
+  singcheck run robots/orthoglide.yaml paths.yaml --scheduler tcp://10.0.0.5:8786
 
 \b
 Exit status:
@@ -29,7 +32,11 @@ Exit status:
   2  bad command line or bad spec file
   3  some trajectory could not be decided (unknown), none singular
   4  an elimination backend is missing or failed
-  130 interrupted
+  70 internal error
+  130 interrupted (Ctrl-C, SIGTERM, SIGHUP)
+A batch exits with its worst outcome (0 < 3 < 1 < 4 < 70): a trajectory's own failure
+(time limit: unknown; backend or internal error: error) is its result, never the end of
+the batch.
 """
 
 
@@ -51,7 +58,8 @@ def cli() -> None:
 
 @cli.command(epilog=RUN_EPILOG)
 @click.argument("robot", type=click.Path(dir_okay=False))
-@click.argument("trajectories", nargs=-1, required=True, type=click.Path(dir_okay=False))
+@click.argument("trajectories", nargs=-1, required=True, type=click.Path(dir_okay=False,
+                                                                        allow_dash=True))
 @click.option("--backend",
               type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
               default="auto", envvar="SINGCHECK_BACKEND", show_default=True, show_envvar=True,
@@ -64,13 +72,29 @@ def cli() -> None:
                    "maps (see `singcheck cache`).")
 @click.option("--tolerance", type=click.FloatRange(min=0, min_open=True), default=1e-9,
               show_default=True, help="Width of the certified enclosure of each root in t.")
-@click.option("--format", "fmt", type=click.Choice(["table", "json"]), default="table",
-              show_default=True, help="table for people, json for programs (schema in README).")
+@click.option("--format", "fmt", type=click.Choice(["table", "json", "jsonl", "junit"]),
+              default="table", show_default=True,
+              help="table for people; json for programs (schema in README); jsonl: one "
+                   "JSON object per trajectory, written as each one finishes; junit: JUnit "
+                   "XML for CI test reports.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, writable=True),
-              help="Write the result to this file (atomically) instead of stdout.")
+              help="Write the result to this file (atomically: nothing if interrupted) "
+                   "instead of stdout.")
 @click.option("-j", "--jobs", type=click.IntRange(min=1), default=os.cpu_count() or 1,
               show_default="number of cores",
               help="Processes certifying trajectories in parallel (used for more than 4).")
+@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True),
+              default=300, show_default=True,
+              help="Seconds allowed to each trajectory (its certification and its region "
+                   "statement); past it the trajectory is unknown: time limit.")
+@click.option("--no-regions", is_flag=True,
+              help="Skip the workspace-region statement (where the path lies among the "
+                   "regions of the workspace): faster batches.")
+@click.option("--scheduler", metavar="ADDRESS", envvar="SINGCHECK_SCHEDULER",
+              show_envvar=True,
+              help="Run the batch on this dask.distributed scheduler (e.g. "
+                   "tcp://10.0.0.5:8786): one task per trajectory; needs "
+                   "pip install 'singcheck[dask]'.")
 @click.option("--plot", "plot_dir", type=click.Path(file_okay=False),
               help="Also write the figures (see `singcheck plot`) to this directory.")
 @click.option("--interpolation", type=click.Choice(["linear", "cubic"]), default="cubic",
@@ -80,10 +104,11 @@ def cli() -> None:
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
-def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs, plot_dir,
-        interpolation, quiet, verbose) -> None:
-    """Certify each TRAJECTORY of ROBOT (YAML spec files; a trajectory may also be a
-    CSV table of poses).
+def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs,
+        time_limit, no_regions, scheduler, plot_dir, interpolation, quiet, verbose) -> None:
+    """Certify each TRAJECTORY of ROBOT (YAML spec files; - reads standard input; a
+    trajectory may also be a CSV table of poses).  A YAML file may hold several
+    trajectories as documents separated by ---; their names must be unique in a run.
 
     For every trajectory it prints the candidate singular times (certified
     enclosures of the roots of μ(t)), the pose and joints there, which working
@@ -96,31 +121,53 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     inside the limits between them, the region holding the whole path when it stays in
     one (its decomposition is computed once and cached), and the certified time at which
     a path leaves the workspace.
+
+    A batch never stops for one trajectory: a trajectory that runs past --time-limit is
+    unknown, one whose check fails is an error with the reason, and the others
+    complete.  On Ctrl-C, SIGTERM or SIGHUP the jsonl lines already written stay valid
+    and -o writes nothing.
     """
     if plot_dir:
         require_extra("plot")
     progress = Progress(quiet)
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
-                    verbose, progress, jobs, plot_dir, interpolation)
+                    verbose, progress, jobs, plot_dir, interpolation, time_limit=time_limit,
+                    regions=not no_regions, scheduler=scheduler)
     sys.exit(int(code))
 
 
-def _exit_code(verdicts: list[str]) -> ExitCode:
-    if any(v in ("singular", "infeasible") for v in verdicts):
+#: a trajectory's outcome as an exit status, and how bad each is (a batch exits with
+#: the worst of its trajectories)
+_SEVERITY = [ExitCode.SINGULARITY_FREE, ExitCode.UNKNOWN, ExitCode.SINGULAR,
+             ExitCode.BACKEND, ExitCode.INTERNAL]
+
+
+def _outcome(doc: dict) -> ExitCode:
+    verdict = doc["verdict"]
+    if verdict in ("singular", "infeasible"):
         return ExitCode.SINGULAR
-    if any(v == "unknown" for v in verdicts):
-        return ExitCode.UNKNOWN
-    return ExitCode.SINGULARITY_FREE
+    if verdict == "singularity-free":
+        return ExitCode.SINGULARITY_FREE
+    if verdict == "error":
+        return ExitCode.BACKEND if doc["error"]["kind"] == "backend" else ExitCode.INTERNAL
+    return ExitCode.UNKNOWN
+
+
+def _worst(codes) -> ExitCode:
+    return max(codes, key=_SEVERITY.index, default=ExitCode.SINGULARITY_FREE)
 
 
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
-         progress, jobs, plot_dir=None, interpolation="cubic"):
+         progress, jobs, plot_dir=None, interpolation="cubic", *, time_limit=300.0,
+         regions=True, scheduler=None):
+    from contextlib import closing
+
     from singcheck import api
-    from singcheck.spec.files import load_robot, load_trajectory
+    from singcheck.spec.files import load_robot, load_trajectories
 
     spec = load_robot(robot)
-    specs = [load_trajectory(path, spec, interpolation) for path in trajectories]
+    specs = load_trajectories(trajectories, spec, interpolation)
     engine = api.elimination_engine(backend_name, timeout, not no_cache, progress.note)
     with progress.status(f"projecting {spec.name} onto its workspace ({engine.name})"):
         machine = api.robot_from_spec(spec, cache=not no_cache, engine=engine)
@@ -130,23 +177,93 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         progress.note(f"singularity surface ξ(X): degree {degree} ({projection.method})")
     else:
         progress.note(f"singularity surface: not expanded: {projection.not_expanded}")
-    results = []
-    with progress.bar(len(specs)) as advance:
-        for doc in api.check_batch(machine, specs, tolerance=tolerance, jobs=jobs,
-                                   notify=progress.note):
-            results.append(doc)
+    options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
+                   ordered=fmt != "jsonl", notify=progress.note)
+    if scheduler:
+        from singcheck.cluster import check_on_cluster
+
+        batch = check_on_cluster(scheduler, machine, specs, **options)
+    else:
+        batch = api.check_batch(machine, specs, jobs=jobs, **options)
+    code = ExitCode.SINGULARITY_FREE
+    with _sink(fmt, output, projection) as sink, progress.bar(len(specs)) as advance, \
+            closing(batch) as docs:
+        for doc in docs:
+            sink.add(doc)
+            code = _worst([code, _outcome(doc)])
             advance(doc["name"], doc["verdict"])
+        sink.finish(code, tolerance, verbose)
     if plot_dir:
         _plot_all(machine, specs, tolerance, plot_dir, progress)
-    code = _exit_code([r["verdict"] for r in results])
-    text = _render(projection, results, tolerance, fmt, verbose, code, to_file=bool(output))
-    if output:
-        from singcheck.atomic import write_output
-
-        write_output(output, text)
-    else:
-        sys.stdout.write(text)
     return code
+
+
+class _Sink:
+    """Where results go: kept for the end (table, json, junit), or streamed (jsonl)."""
+
+    def __init__(self, fmt: str, out, projection) -> None:
+        from singcheck.report.trajectory import robot_json
+
+        self.fmt, self.out, self.projection = fmt, out, projection
+        self.robot = robot_json(projection)
+        self.results: list[dict] = []
+
+    def add(self, doc: dict) -> None:
+        seconds = doc.pop("time_s", None)  # not in the JSON schema: JUnit's time only
+        if self.fmt == "junit":
+            doc["time_s"] = seconds
+        if self.fmt != "jsonl":
+            self.results.append(doc)
+            return
+        import json
+
+        line = json.dumps({**doc, "robot": self.robot}, ensure_ascii=False) + "\n"
+        with _signals_held():  # a line is written whole, or not at all
+            self.out.write(line)
+            self.out.flush()
+
+    def finish(self, code: ExitCode, tolerance: float, verbose: bool) -> None:
+        if self.fmt != "jsonl":
+            self.out.write(_render(self.projection, self.results, tolerance, self.fmt,
+                                   verbose, code, to_file=self.out is not sys.stdout))
+
+
+def _sink(fmt: str, output, projection):
+    """A :class:`_Sink` on stdout, or on ``output``: a regular file written atomically (it
+    appears when the batch is done, and not at all when it is interrupted), a device or
+    FIFO written in place (:func:`singcheck.atomic.output_file`)."""
+    from contextlib import contextmanager
+
+    @contextmanager
+    def opened():
+        if not output:
+            yield _Sink(fmt, sys.stdout, projection)
+            return
+        from singcheck.atomic import output_file
+
+        with output_file(output) as f:
+            yield _Sink(fmt, f, projection)
+
+    return opened()
+
+
+def _signals_held():
+    """Hold Ctrl-C, SIGTERM and SIGHUP for the duration of the block (they are delivered
+    just after it), so that a streamed line is never cut in half."""
+    import signal
+    from contextlib import contextmanager
+
+    held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+
+    @contextmanager
+    def block():
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+        try:
+            yield
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+    return block()
 
 
 def _render(projection, results, tolerance, fmt, verbose, code, to_file: bool) -> str:
@@ -154,6 +271,12 @@ def _render(projection, results, tolerance, fmt, verbose, code, to_file: bool) -
 
     if fmt == "json":
         return rep.to_json(rep.document(projection, results, tolerance, int(code)))
+    if fmt == "junit":
+        from singcheck.report.junit import junit_xml
+
+        doc = rep.document(projection, [], tolerance, int(code))
+        return junit_xml(doc.pop("robot"), results,
+                         {k: v for k, v in doc.items() if k != "trajectories"})
     from singcheck.report.console import captured
 
     robot = rep.robot_json(projection)
@@ -207,7 +330,9 @@ def _plot_all(machine, specs, tolerance: float, out_dir: str, progress) -> list:
         raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
                         "missing): pip install 'singcheck[plot]'") from None
     from singcheck import api
+    from singcheck.model.robot import require_polynomial
 
+    require_polynomial(machine.model, "plotting")
     written = []
     for spec in specs:
         report = api.check(machine, spec, tolerance=tolerance, regions=False)
@@ -225,7 +350,9 @@ def _plot_html(machine, specs, out_dir: str):
         raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
                         "pip install 'singcheck[html]'") from None
     from singcheck import api
+    from singcheck.model.robot import require_polynomial
 
+    require_polynomial(machine.model, "plotting")
     reports = [api.check(machine, s, regions=False).certificate for s in specs]
     return write_html(reports, os.path.join(out_dir, "singcheck.html"))
 
@@ -402,8 +529,22 @@ def _register_space_commands() -> None:
 _register_space_commands()
 
 
+def _interrupt_on_signals() -> None:
+    """SIGTERM and SIGHUP stop singcheck the way Ctrl-C does (exit 130, the streamed
+    results kept, no partial -o file).  In this process only: forked workers reset
+    them (:func:`singcheck.api._worker_signals`)."""
+    import signal
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, interrupt)
+
+
 def main() -> None:
     """Console-script entry point: never lets a traceback reach the user."""
+    _interrupt_on_signals()
     try:
         cli.main(standalone_mode=False)
     except click.exceptions.Abort:

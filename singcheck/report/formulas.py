@@ -50,9 +50,36 @@ def _square_part(n: int) -> tuple[int, int]:
     return m, r
 
 
-def joint_formula(path: PathModel, leg_index: int) -> JointFormula:
+@dataclass(frozen=True)
+class RevoluteFormula:
+    """A revolute leg's branches ``cos θ = (-a·d ± b·√Δ)/W``, ``sin θ = (-b·d ∓ a·√Δ)/W``
+    with ``a cos θ + b sin θ + d = 0`` along the path, ``W = a² + b²``, ``Δ = W - d²``."""
+
+    joint: str
+    a: fmpq_mpoly
+    b: fmpq_mpoly
+    d: fmpq_mpoly
+    delta: fmpq_mpoly
+
+    def text(self, sign: str = "±") -> str:
+        j = self.joint
+        return (f"cos({j}) = (-({self.a})*({self.d}) {sign} ({self.b})*sqrt({self.delta})) / W, "
+                f"sin({j}) = (-({self.b})*({self.d}) ∓ ({self.a})*sqrt({self.delta})) / W, "
+                f"W = ({self.a})^2 + ({self.b})^2")
+
+    def latex(self) -> str:
+        j = _latex_name(self.joint)
+        a, b, d, r = (latex(p) for p in (self.a, self.b, self.d, self.delta))
+        w = f"({a})^2 + ({b})^2"
+        return (f"\\cos {j} = \\frac{{-({a})({d}) \\pm ({b})\\sqrt{{{r}}}}}{{{w}}},\\ "
+                f"\\sin {j} = \\frac{{-({b})({d}) \\mp ({a})\\sqrt{{{r}}}}}{{{w}}}")
+
+
+def joint_formula(path: PathModel, leg_index: int) -> JointFormula | RevoluteFormula:
     leg = path.legs[leg_index]
     joint = leg.leg.joint
+    if leg.revolute:
+        return RevoluteFormula(joint, *leg.coefficients, leg.discriminant)
     if leg.leg.degree == 1:
         b, c = leg.coefficients
         return JointFormula(joint, -c / b.leading_coefficient(), Fraction(0), None)
@@ -157,7 +184,8 @@ def render(projection, epsilon, path: PathModel | None, style: str) -> str:
                 "pose": {v: str(p) for v, p in zip(model.pose, path.phi, strict=True)},
                 "joints": {j.joint: {"centre": str(j.centre), "scale": str(j.scale),
                                      "radicand": None if j.radicand is None else
-                                     str(j.radicand)} for j in joints},
+                                     str(j.radicand)} if isinstance(j, JointFormula) else
+                           {"cos_sin": j.text()} for j in joints},
                 "notation": "s = sin t, c = cos t; joint = centre ± scale·sqrt(radicand)",
             }
         return json.dumps(doc, indent=2) + "\n"

@@ -21,6 +21,7 @@ import numpy as np
 from flint import acb, arb, fmpq
 
 from singcheck.algebra.intervals import evaluate
+from singcheck.algebra.radicals import angle_names, radical_prime
 from singcheck.algebra.trig import evaluate_trig
 from singcheck.certify.classification import TrajectoryReport
 from singcheck.certify.path import compose_pose
@@ -52,8 +53,19 @@ def _mid(value) -> float:
 
 
 def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:
-    """The drawing at these joint and pose values (balls, or anything ``arb`` takes)."""
-    values = [v if isinstance(v, (arb, acb)) else arb(v) for v in (*joints, *pose)]
+    """The drawing at these joint and pose values (balls, or anything ``arb`` takes; an
+    angle in radians), each spec variable by name: an angle's ``cos(v)``, ``sin(v)``
+    and a parameter's ``sqrt(p)`` are enclosed by Arb."""
+    given = {n: v if isinstance(v, (arb, acb)) else arb(v)
+             for n, v in zip((*spec.joints, *spec.pose), (*joints, *pose), strict=True)}
+    named = {}
+    for n, v in given.items():
+        if n in spec.angles:
+            named.update(zip(angle_names(n), (v.cos(), v.sin()), strict=True))
+        else:
+            named[n] = v
+    values = [named[n] if n in named else arb(radical_prime(n)).sqrt()
+              for n in spec.context.names()]
 
     def point(coords) -> list[float]:
         return [_mid(evaluate(c, values)) for c in coords]
@@ -133,7 +145,7 @@ def traced_points(report: TrajectoryReport, t: np.ndarray) -> list[np.ndarray]:
     (len(t), dim)."""
     model = report.path.projection.model
     spec = model.spec
-    joint_index = [spec.context.names().index(j) for j in model.joints]
+    joint_index = [spec.context.names().index(v) for v in spec.joint_variables]
     located = [(piece_index(report, float(x)), float(x)) for x in t]
     located = [(i, _on_piece(report, i, arb(x))) for i, x in located]
     def pose_only(p) -> bool:

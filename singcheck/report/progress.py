@@ -5,19 +5,41 @@ Silent with ``--quiet``; plain lines when stderr is not a terminal (CI logs).
 
 from __future__ import annotations
 
+import sys
+
 
 class Progress:
-    """Progress notes on stderr (silent with --quiet)."""
+    """Progress notes on stderr (silent with --quiet).
+
+    rich is imported only when stderr is a terminal: plain lines need nothing but
+    ``sys.stderr``, so a run piped into a file or a CI log starts faster.
+    """
 
     def __init__(self, quiet: bool) -> None:
-        from rich.console import Console
-
         self.quiet = quiet
-        self.console = Console(stderr=True, highlight=False, soft_wrap=True)
+        self._console = None
+
+    @property
+    def console(self):
+        if self._console is None:
+            from rich.console import Console
+
+            self._console = Console(stderr=True, highlight=False, soft_wrap=True)
+        return self._console
+
+    def _terminal(self) -> bool:
+        return sys.stderr.isatty() and self.console.is_terminal
 
     def note(self, message: str) -> None:
-        if not self.quiet:
-            self.console.print(f"[dim]singcheck:[/dim] {message}")
+        if self.quiet:
+            return
+        if self._terminal():
+            from rich.markup import escape
+
+            self.console.print(f"[dim]singcheck:[/dim] {escape(message)}")
+        else:
+            sys.stderr.write(f"singcheck: {message}\n")
+            sys.stderr.flush()
 
     def bar(self, total: int):
         """A context giving ``advance(name, verdict)``: a bar on a terminal, else notes."""
@@ -62,12 +84,12 @@ class Progress:
             def silent():
                 yield lambda name, verdict: None
             return silent()
-        return rich_bar() if self.console.is_terminal and total > 1 else plain()
+        return rich_bar() if total > 1 and self._terminal() else plain()
 
     def status(self, message: str):
         from contextlib import nullcontext
 
-        if self.quiet or not self.console.is_terminal:
+        if self.quiet or not self._terminal():
             self.note(message)
             return nullcontext()
         return self.console.status(message)

@@ -78,6 +78,13 @@ def time_limited_json(spec, reason: str) -> dict[str, Any]:
             "root_isolation": None, "candidates": [], "working_modes": [], "undecided": []}
 
 
+def error_json(spec, kind: str, message: str) -> dict[str, Any]:
+    """The trajectory object of a trajectory whose check failed (``kind``: backend or
+    internal): verdict ``error``, the reason, and nothing certified."""
+    return {**time_limited_json(spec, f"error: {message}"), "verdict": "error",
+            "error": {"kind": kind, "message": message}}
+
+
 def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
     return {
         **_trajectory_head(report.trajectory),

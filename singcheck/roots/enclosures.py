@@ -38,12 +38,15 @@ class RealRoot:
     t: arb  # holds exactly one root in the range
     multiplicity: int | None  # exact where the method knows it
     _refine: Callable[[float], arb] | None = field(default=None, compare=False, repr=False)
+    # (i, k): this root is exactly the method's i-th root of a 2π-periodic function
+    # shifted by 2kπ (tangent half-angle roots); None when not known to be one
+    period: tuple[int, int] | None = field(default=None, compare=False)
 
     def refined(self, tolerance: float) -> RealRoot:
         """The same root in a ball of width at most ``tolerance`` (when refinable)."""
         if self._refine is None or 2 * float(self.t.rad()) <= tolerance:
             return self
-        return RealRoot(self._refine(tolerance), self.multiplicity, self._refine)
+        return RealRoot(self._refine(tolerance), self.multiplicity, self._refine, self.period)
 
 
 @dataclass(frozen=True)

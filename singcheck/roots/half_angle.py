@@ -131,7 +131,7 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
         # multiplicity of t = π: the degree drop of M counts it
         bases.append((base_pi, LinearInPi(Fraction(0), Fraction(1)), None))
     roots, undecided = [], []
-    for base, exact, mult in bases:
+    for index, (base, exact, mult) in enumerate(bases):
         for k in _periods(base(tolerance), interval):
             def make(tol: float, base=base, k=k) -> arb:
                 with working_precision(bits_for(tol)):
@@ -144,7 +144,7 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
             if where is None:
                 undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
             elif where:
-                roots.append(RealRoot(make(tolerance), mult, make))
+                roots.append(RealRoot(make(tolerance), mult, make, (index, k)))
     roots.sort(key=lambda r: float(r.t.mid()))
     return RootIsolation(tuple(roots), tuple(undecided), HALF_ANGLE)
 

@@ -112,8 +112,11 @@ def project(polys: list[fmpq_mpoly], var_index: int) -> list[fmpq_mpoly]:
 def simplest_between(lo: Fraction | None, hi: Fraction | None) -> Fraction:
     """The rational with the smallest denominator (then numerator) in the open (lo, hi).
 
-    ``None`` stands for -∞ / +∞.  Stern–Brocot descent, exact.
+    ``None`` stands for -∞ / +∞.  Stern–Brocot descent, exact.  An empty interval
+    (lo ≥ hi) is a caller's error: ValueError, never a division by zero deep inside.
     """
+    if lo is not None and hi is not None and not lo < hi:
+        raise ValueError(f"simplest_between: empty interval ({lo}, {hi})")
     if lo is None and hi is None:
         return Fraction(0)
     if lo is None:

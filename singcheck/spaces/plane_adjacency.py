@@ -32,7 +32,7 @@ from fractions import Fraction
 from flint import acb, acb_poly, arb, arb_poly, fmpq, fmpq_poly
 
 from singcheck.algebra.intervals import working_precision
-from singcheck.roots.rational import RationalRoot, arb_to_fmpq, to_fraction
+from singcheck.roots.rational import RationalRoot, ball_ends, to_fraction
 from singcheck.spaces.cad import fiber, sector_of, simplest_between
 from singcheck.spaces.segments import segment_is_free
 
@@ -186,8 +186,7 @@ def separators(points: list[arb]) -> list[Fraction]:
     """Rationals s₀ < y₁ < s₁ < … < y_k < s_k (k + 1 of them)."""
     if not points:
         return [Fraction(0)]
-    ends = [(to_fraction(arb_to_fmpq(p.lower())), to_fraction(arb_to_fmpq(p.upper())))
-            for p in points]
+    ends = [tuple(map(to_fraction, ball_ends(p))) for p in points]
     out = [simplest_between(None, ends[0][0])]
     out += [simplest_between(lo_hi[1], nxt[0]) for lo_hi, nxt in zip(ends, ends[1:],
                                                                      strict=False)]

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import os
 import re
+import sys
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from fractions import Fraction
 
@@ -38,8 +40,8 @@ from singcheck.spec.trajectory import (
     trajectory_piece,
 )
 
-__all__ = ["RobotSpec", "TrajectorySpec", "load_robot", "load_trajectory", "parse_robot",
-           "parse_trajectory"]
+__all__ = ["RobotSpec", "TrajectorySpec", "load_robot", "load_trajectory",
+           "load_trajectories", "parse_robot", "parse_trajectory", "parse_trajectories"]
 
 ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
               "parameters": False, "constraints": True, "joint_limits": False,
@@ -50,6 +52,9 @@ RESERVED = {"pi", "sin", "cos", "sqrt"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
 MAX_YAML_DEPTH = 16  # lists and mappings inside one another (specs need 3)
+MAX_STREAM_BYTES = 200_000_000  # a file (or stdin) of several trajectory documents
+STDIN = "-"  # the path that reads standard input
+STDIN_NAME = "<stdin>"  # how its trajectories name their file
 MAX_DRAWING_POINTS = 1000  # every point of a drawing is evaluated once per frame drawn
 
 
@@ -212,31 +217,61 @@ def _check_depth(text: str, path: str) -> None:
     """Refuse YAML nested deeper than MAX_YAML_DEPTH, from the event stream (PyYAML's
     parser is a state machine; its composer, and our walks, recurse once per level)."""
     depth = 0
-    for event in yaml.parse(text, Loader=yaml.SafeLoader):
-        if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
-            depth += 1
-            if depth > MAX_YAML_DEPTH:
-                raise SpecError(f"lists and mappings are nested more than {MAX_YAML_DEPTH} "
-                                "levels deep", path=path, line=event.start_mark.line + 1)
-        elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
-            depth -= 1
-
-
-def _compose(text: str, path: str):
     try:
-        _check_depth(text, path)
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.MarkedYAMLError as e:
+        for event in yaml.parse(text, Loader=yaml.SafeLoader):
+            if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
+                depth += 1
+                if depth > MAX_YAML_DEPTH:
+                    raise SpecError(f"lists and mappings are nested more than "
+                                    f"{MAX_YAML_DEPTH} levels deep", path=path,
+                                    line=event.start_mark.line + 1)
+            elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
+                depth -= 1
+    except yaml.YAMLError as e:
+        raise _yaml_error(e, path) from None
+
+
+def _yaml_error(e: yaml.YAMLError, path: str) -> SpecError:
+    if isinstance(e, yaml.MarkedYAMLError):
         mark = e.problem_mark or e.context_mark
         line = mark.line + 1 if mark else None
         problem = (e.problem or e.context or "invalid YAML").strip()
-        raise SpecError(f"not valid YAML: {problem}", path=path, line=line) from None
+        return SpecError(f"not valid YAML: {problem}", path=path, line=line)
+    return SpecError(f"not valid YAML: {str(e).splitlines()[0]}", path=path)
+
+
+def _compose(text: str, path: str):
+    _check_depth(text, path)
+    try:
+        node = yaml.compose(text, Loader=yaml.SafeLoader)
     except yaml.YAMLError as e:
-        raise SpecError(f"not valid YAML: {str(e).splitlines()[0]}", path=path) from None
+        raise _yaml_error(e, path) from None
     if node is None:
         raise SpecError("the file is empty", path=path, line=1)
     _refuse_tags(node, _Doc(path), set())
     return node
+
+
+def _compose_all(text: str, path: str) -> Iterator:
+    """Every document of a YAML stream (``---`` between documents), composed one at a
+    time; empty documents are skipped, a stream with none is an error."""
+    _check_depth(text, path)
+    stream = yaml.compose_all(text, Loader=yaml.SafeLoader)
+    found = False
+    while True:
+        try:
+            node = next(stream)
+        except StopIteration:
+            break
+        except yaml.YAMLError as e:
+            raise _yaml_error(e, path) from None
+        if node is None:
+            continue
+        _refuse_tags(node, _Doc(path), set())
+        found = True
+        yield node
+    if not found:
+        raise SpecError("the file is empty", path=path, line=1)
 
 
 _PLAIN_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "null", "bool",
@@ -261,15 +296,20 @@ def _refuse_tags(node, doc: _Doc, seen: set[int]) -> None:
         _refuse_tags(child, doc, seen)
 
 
-def _read(path: str | os.PathLike) -> str:
+def _read(path: str | os.PathLike, limit: int = MAX_BYTES) -> str:
+    """A spec file's text (``-``: standard input, read to its end), at most ``limit``
+    bytes of UTF-8."""
     p = os.fspath(path)
     try:
-        with open(p, "rb") as f:
-            data = f.read(MAX_BYTES + 1)
+        if p == STDIN:
+            data = sys.stdin.buffer.read(limit + 1)
+        else:
+            with open(p, "rb") as f:
+                data = f.read(limit + 1)
     except OSError as e:
         raise SpecError(f"cannot read the file: {e.strerror or e}", path=p) from None
-    if len(data) > MAX_BYTES:
-        raise SpecError(f"the file is larger than {MAX_BYTES} bytes", path=p)
+    if len(data) > limit:
+        raise SpecError(f"the file is larger than {limit} bytes", path=p)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as e:
@@ -440,8 +480,11 @@ def trajectory_parameter(doc: _Doc, top, robot: RobotSpec) -> str:
 
 
 def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
+    return _trajectory(_compose(text, path), path, robot)
+
+
+def _trajectory(root, path: str, robot: RobotSpec) -> TrajectorySpec:
     doc = _Doc(path)
-    root = _compose(text, path)
     top = doc.keys(root, TRAJECTORY_KEYS, "trajectory")
     lines = {k: _line(knode) for k, (knode, _) in top.items()}
     name = doc.text(top["name"][1], "name")
@@ -468,3 +511,45 @@ def load_trajectory(path: str | os.PathLike, robot: RobotSpec,
     if p.lower().endswith(".csv"):
         return parse_csv(_read(path), p, robot, interpolation or "cubic")
     return parse_trajectory(_read(path), p, robot)
+
+
+def parse_trajectories(text: str, path: str, robot: RobotSpec) -> Iterator[TrajectorySpec]:
+    """Each YAML document of ``text`` (separated by ``---``) as one trajectory; errors
+    name the file, the line in it and, past the first, the document."""
+    for number, node in enumerate(_compose_all(text, path), 1):
+        try:
+            yield _trajectory(node, path, robot)
+        except SpecError as e:
+            if number == 1:
+                raise
+            raise SpecError(f"{e.message} (document {number})", path=e.path, line=e.line,
+                            key=e.key) from None
+
+
+def load_trajectories(paths: Iterable[str | os.PathLike], robot: RobotSpec,
+                      interpolation: str | None = None) -> list[TrajectorySpec]:
+    """Every trajectory of the files: a YAML file (or ``-``, standard input, once) holds
+    one or more documents, a CSV file one path; names must be unique across them all."""
+    out: list[TrajectorySpec] = []
+    seen: dict[str, TrajectorySpec] = {}
+    read_stdin = False
+    for path in map(os.fspath, paths):
+        if path == STDIN:
+            if read_stdin:
+                raise SpecError("standard input (-) is given twice", path=path)
+            read_stdin = True
+        if path.lower().endswith(".csv"):
+            specs: Iterable[TrajectorySpec] = [load_trajectory(path, robot, interpolation)]
+        else:
+            specs = parse_trajectories(_read(path, MAX_STREAM_BYTES),
+                                       STDIN_NAME if path == STDIN else path, robot)
+        for spec in specs:
+            if spec.name in seen:
+                first = seen[spec.name]
+                raise SpecError(f"trajectory name {spec.name!r} is already used by "
+                                f"{first.path}:{first.lines.get('name', '?')} (names must be "
+                                "unique in a run)", path=spec.path,
+                                line=spec.lines.get("name"), key="name")
+            seen[spec.name] = spec
+            out.append(spec)
+    return out

@@ -1,0 +1,397 @@
+"""Batches as CI jobs and shell pipelines run them (issue 15): streams in and out, one
+bad path never sinks a batch, signals, and the crash that once lost a whole batch."""
+
+from __future__ import annotations
+
+import json
+from fractions import Fraction
+
+import pytest
+
+from tests.conftest import ROOT
+from tests.test_cli import singcheck
+
+DATA = ROOT / "tests" / "data" / "batch"
+DELTA = str(DATA / "linear-delta-decimal.yaml")
+
+
+# -- the region step's crash on a linear Delta's plane z = -2/5 ------------------------
+
+
+def test_separators_of_fibre_points_closer_than_a_double_ulp():
+    """Two fibre points 5e-17 apart (the linear Delta's plane z = -2/5): each separator
+    lies strictly between consecutive points, checked exactly against the balls."""
+    from flint import arb, fmpq
+
+    from singcheck.algebra.intervals import working_precision
+    from singcheck.spaces.plane_adjacency import separators
+
+    with working_precision(200):
+        a = arb("-0.866025408514986947466435412038 +/- 1.21e-31")
+        b = arb("-0.866025408514986897853545875265 +/- 1.64e-31")
+        points = [a, b, -b, -a]
+    seps = separators(points)  # at the default precision, as the caller does
+    assert len(seps) == len(points) + 1
+    with working_precision(200):
+        for s, p, nxt in zip(seps, points, seps[1:], strict=False):
+            q = arb(fmpq(s.numerator, s.denominator))
+            r = arb(fmpq(nxt.numerator, nxt.denominator))
+            assert q < p < r, (s, p, nxt)
+
+
+def test_simplest_between_refuses_an_empty_interval():
+    from singcheck.spaces.cad import simplest_between
+
+    assert simplest_between(Fraction(1, 3), Fraction(1, 2)) == Fraction(2, 5)
+    with pytest.raises(ValueError):
+        simplest_between(Fraction(1, 2), Fraction(1, 2))
+
+
+@pytest.mark.slow
+def test_linear_delta_path_at_constant_z_gets_its_region(tmp_path):
+    """The path of the bug report's kind: the plane z = -2/5 is decomposed, the path
+    named in one region with 8 IK solutions; 8 checked here at t = 0 by hand."""
+    out = singcheck("run", DELTA, str(DATA / "delta-short.yaml"), "--backend", "flint",
+                    "--format", "json", "-q", env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 0, out.stderr
+    (t,) = json.loads(out.stdout)["trajectories"]
+    assert t["workspace"]["one_region"] is True and t["workspace"]["region"]
+    # independent count at the start pose (0, 0, -2/5): r = z ± sqrt(L² - d²) per rail
+    import math
+
+    rails = [(2, 0), (-1, 0.8660254 * 2), (-1, -0.8660254 * 2)]
+    count = 1
+    for ax, ay in rails:
+        d2 = ax * ax + ay * ay
+        roots = [-0.4 + sign * math.sqrt(9 - d2) for sign in (1, -1)]
+        count *= sum(-3 < r < 3 for r in roots)
+    assert t["workspace"]["ik_counts"] == [count] == [8]
+
+
+# -- input: standard input, several documents, unique names ---------------------------
+
+ORTHO = str(ROOT / "robots" / "orthoglide.yaml")
+PAPER = {"heart1": "singular", "heart2": "singularity-free", "helix": "singularity-free"}
+
+
+def _stream(*names: str) -> str:
+    return "".join("---\n" + (ROOT / "trajectories" / f"{n}.yaml").read_text()
+                   for n in names)
+
+
+def singcheck_in(stdin: str, *args: str, env: dict | None = None):
+    import os
+    import subprocess
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "singcheck", *args], input=stdin,
+                          capture_output=True, text=True, cwd=ROOT, timeout=300,
+                          env={**os.environ, **(env or {})})
+
+
+def test_a_multi_document_stream_on_stdin_in_jsonl(tmp_path):
+    """Three documents on stdin: three JSON lines, nothing else on stdout, each the
+    trajectory object plus the robot, with the paper's verdicts."""
+    out = singcheck_in(_stream("heart1", "heart2", "helix"), "run", ORTHO, "-", "--format",
+                       "jsonl", "--backend", "flint", "--no-regions",
+                       env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 1, out.stderr  # heart 1 is singular
+    lines = out.stdout.splitlines()
+    assert len(lines) == 3 and out.stdout.endswith("\n")
+    docs = [json.loads(line) for line in lines]
+    assert {d["name"]: d["verdict"] for d in docs} == PAPER
+    for d in docs:
+        assert d["robot"]["name"] == "orthoglide" and d["path"] == "<stdin>"
+        assert "workspace" not in d  # --no-regions
+        assert "time_s" not in d  # the schema's object, unchanged
+    heart1 = next(d for d in docs if d["name"] == "heart1")
+    assert [round(c["t"], 2) for c in heart1["candidates"]] == [-1.51, -0.98, 0.98, 1.51]
+
+
+def test_a_file_of_several_documents_and_a_file_of_one(tmp_path):
+    many = tmp_path / "many.yaml"
+    many.write_text(_stream("heart1", "heart2"))
+    out = singcheck("run", ORTHO, str(many), str(ROOT / "trajectories" / "helix.yaml"),
+                    "--format", "json", "--backend", "flint", "-q",
+                    env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 1, out.stderr
+    docs = json.loads(out.stdout)["trajectories"]
+    assert [(d["name"], d["verdict"]) for d in docs] == list(PAPER.items())  # input order
+
+
+def test_names_must_be_unique_in_a_run(tmp_path):
+    out = singcheck_in(_stream("heart1", "heart2"), "run", ORTHO, "-",
+                       str(ROOT / "trajectories" / "heart1.yaml"), "--backend", "flint")
+    assert out.returncode == 2
+    assert out.stdout == ""
+    err = out.stderr.strip()
+    assert err.count("\n") == 0 and "Traceback" not in err
+    assert "heart1.yaml:" in err and "'heart1' is already used by <stdin>:" in err
+
+
+def test_an_error_in_a_later_document_names_the_line_and_the_document():
+    text = _stream("heart1") + "---\nname: bad\nparameter: t\nrange: [0, 1]\npose:\n" \
+        "  x: t\n  y: 0\n  z: sin(t\n"
+    out = singcheck_in(text, "run", ORTHO, "-", "--backend", "flint")
+    assert out.returncode == 2
+    line = len(_stream("heart1").splitlines()) + 8
+    assert out.stderr.startswith(f"singcheck: error: <stdin>:{line}: pose.z:")
+    assert "(document 2)" in out.stderr
+
+
+# -- output: JUnit XML for CI ----------------------------------------------------------
+
+
+def test_junit_parsed_back_by_a_ci_parser(tmp_path):
+    """junitparser (what CI report tools use) reads the file: one suite for the robot,
+    a case per trajectory, a failure for the singular heart 1 with its singular times,
+    an error for a trajectory stopped by its time limit."""
+    from junitparser import Error, Failure, JUnitXml
+
+    report = tmp_path / "report.xml"
+    out = singcheck("run", ORTHO, *(str(ROOT / "trajectories" / f"{n}.yaml") for n in PAPER),
+                    str(DATA / "slow.yaml"), "--format", "junit", "-o", str(report),
+                    "--backend", "flint", "--time-limit", "2", "--no-regions", "-q",
+                    env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 1, out.stderr
+    assert out.stdout == ""
+    xml = JUnitXml.fromfile(str(report))
+    (suite,) = list(xml)
+    assert suite.name == "orthoglide"
+    assert (suite.tests, suite.failures, suite.errors) == (4, 1, 1)
+    cases = {case.name: case for case in suite}
+    assert set(cases) == {*PAPER, "slow"}
+    (failure,) = cases["heart1"].result
+    assert isinstance(failure, Failure)
+    # the paper's S3 and S4 (Table 1): t ≈ 0.98 and 1.51 on mode +++
+    times = [float(x) for x in failure.message.split("≈")[1].split(",")]
+    assert [round(x, 2) for x in times] == [0.98, 1.51]
+    (error,) = cases["slow"].result
+    assert isinstance(error, Error) and "time limit" in error.message
+    assert cases["heart2"].result == [] and cases["helix"].result == []
+    assert cases["slow"].time >= 2 and all(c.time < 2 for n, c in cases.items() if n != "slow")
+
+
+# -- one path never sinks a batch -----------------------------------------------------
+
+
+@pytest.mark.slow
+def test_one_path_past_the_time_limit_and_the_others_come_back_right(tmp_path):
+    import time
+
+    start = time.monotonic()
+    out = singcheck("run", ORTHO, str(ROOT / "trajectories" / "heart1.yaml"),
+                    str(DATA / "slow.yaml"), str(ROOT / "trajectories" / "heart2.yaml"),
+                    "--format", "jsonl", "--backend", "flint", "--time-limit", "2", "-q",
+                    "--jobs", "1", env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    elapsed = time.monotonic() - start
+    assert out.returncode == 1, out.stderr  # the worst outcome: heart 1 is singular
+    docs = {d["name"]: d for d in map(json.loads, out.stdout.splitlines())}
+    assert docs["slow"]["verdict"] == "unknown"
+    assert "time limit (2 s)" in docs["slow"]["reason"]
+    assert docs["heart1"]["verdict"] == "singular" and docs["heart2"]["verdict"] == \
+        "singularity-free"
+    assert elapsed < 60  # unbounded, the slow path runs for minutes
+
+
+def _fail_on(name: str, monkeypatch):
+    from singcheck import api
+
+    real = api.check
+
+    def check(robot, trajectory, **options):
+        if trajectory.name == name:
+            raise ZeroDivisionError("Fraction(1, 0)")
+        return real(robot, trajectory, **options)
+
+    monkeypatch.setattr(api, "check", check)
+
+
+@pytest.fixture(scope="module")
+def orthoglide_robot():
+    import singcheck as sc
+
+    return sc.load_robot(ORTHO, backend="flint", cache=False)
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_an_internal_error_is_that_paths_result(orthoglide_robot, tmp_path, monkeypatch, jobs):
+    """A bug on one path: that path is an error with the reason, the others are
+    certified (in one process, and in forked workers)."""
+    import sys
+
+    sys.path.insert(0, str(ROOT / "bench"))
+    from generate import write
+
+    from singcheck import api
+    from singcheck.spec.files import load_trajectories
+
+    paths = write(tmp_path, 6)
+    specs = load_trajectories(paths, orthoglide_robot.spec)
+    expected = [api.check(orthoglide_robot, s, regions=False).verdict for s in specs]
+    _fail_on(specs[2].name, monkeypatch)
+    docs = list(api.check_batch(orthoglide_robot, specs, regions=False, jobs=jobs))
+    assert [d["name"] for d in docs] == [s.name for s in specs]
+    assert docs[2]["verdict"] == "error"
+    assert docs[2]["error"] == {"kind": "internal", "message": "ZeroDivisionError: Fraction(1, 0)"}
+    assert [d["verdict"] for i, d in enumerate(docs) if i != 2] == \
+        [v for i, v in enumerate(expected) if i != 2]
+
+
+def test_the_batch_exits_with_its_worst_outcome(monkeypatch, capsys):
+    """An error on one path: the others are printed, and the exit status is 70."""
+    import sys
+
+    from singcheck.cli import commands as cli
+
+    _fail_on("heart2", monkeypatch)
+    monkeypatch.setattr(sys, "argv", ["singcheck", "run", ORTHO,
+                                      str(ROOT / "trajectories" / "heart1.yaml"),
+                                      str(ROOT / "trajectories" / "heart2.yaml"),
+                                      "--format", "jsonl", "--backend", "flint", "-q",
+                                      "--no-cache", "--no-regions"])
+    with pytest.raises(SystemExit) as exit_:
+        cli.main()
+    assert exit_.value.code == 70
+    docs = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [(d["name"], d["verdict"]) for d in docs] == [("heart1", "singular"),
+                                                         ("heart2", "error")]
+    assert [cli._worst(c) for c in ([0, 3], [3, 1], [1, 4], [4, 70], [])] == [3, 1, 4, 70, 0]
+
+
+def test_the_hard_time_limit_stops_a_loop_without_checkpoints():
+    import time
+
+    from singcheck.api import hard_time_limit
+    from singcheck.budget import TimeLimitExceeded
+
+    start = time.monotonic()
+    with pytest.raises(TimeLimitExceeded), hard_time_limit(0.1):
+        while True:
+            pass
+    assert time.monotonic() - start < 5
+
+
+def test_robots_and_trajectories_pickle_exactly(orthoglide_robot):
+    """What a Dask cluster ships: the unpickled robot and path give the same report."""
+    import pickle
+
+    import singcheck as sc
+    from singcheck.algebra import pickling  # noqa: F401  (installs the reducers)
+
+    heart1 = sc.load_trajectory(str(ROOT / "trajectories" / "heart1.yaml"), orthoglide_robot)
+    robot2, heart2 = pickle.loads(pickle.dumps((orthoglide_robot, heart1)))
+    assert robot2.singularity_surface == orthoglide_robot.singularity_surface
+    assert sc.check(robot2, heart2).to_dict() == sc.check(orthoglide_robot, heart1).to_dict()
+
+
+# -- signals: what was streamed stays valid, -o writes nothing partial -----------------
+
+
+def _generated(tmp_path, count: int) -> list[str]:
+    import sys
+
+    sys.path.insert(0, str(ROOT / "bench"))
+    from generate import write
+
+    return [str(p) for p in write(tmp_path / "paths", count)]
+
+
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP"])
+def test_a_signal_mid_batch_leaves_valid_jsonl_lines(tmp_path, sig):
+    """Stopped mid-batch (forked workers busy), singcheck exits 130; every line it wrote
+    is a whole JSON object, and no worker printed a traceback."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    paths = _generated(tmp_path, 40)
+    proc = subprocess.Popen([sys.executable, "-m", "singcheck", "run", ORTHO, *paths,
+                             str(DATA / "slow.yaml"), "--format", "jsonl", "--jobs", "2",
+                             "--backend", "flint", "--no-regions"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT,
+                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)})
+    first = proc.stdout.readline()  # a result streamed: the batch is under way
+    time.sleep(0.5)
+    proc.send_signal(getattr(signal, sig))
+    rest = proc.stdout.read()  # (communicate() would skip what readline buffered)
+    err = proc.stderr.read()
+    proc.wait(timeout=60)
+    assert proc.returncode == 130, err
+    lines = (first + rest).decode().splitlines()
+    assert 1 <= len(lines) < 41  # the slow path never finished
+    for line in lines:
+        assert line.startswith("{") and line.endswith("}"), (line[:200], line[-200:])
+        assert json.loads(line)["verdict"] in ("singular", "singularity-free", "infeasible")
+    text = err.decode()
+    assert "interrupted" in text
+    assert "Traceback" not in text and "ForkPoolWorker" not in text
+
+
+def test_a_signal_leaves_no_output_file(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "results.jsonl"
+    proc = subprocess.Popen([sys.executable, "-m", "singcheck", "run", ORTHO,
+                             str(ROOT / "trajectories" / "heart1.yaml"), str(DATA / "slow.yaml"),
+                             "--format", "jsonl", "-o", str(out), "--jobs", "1",
+                             "--backend", "flint", "--no-regions"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT,
+                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)})
+    err = b""
+    for line in proc.stderr:  # progress notes: heart 1 is done, the slow path running
+        err += line
+        if b"heart1" in line:
+            break
+    time.sleep(0.5)
+    proc.send_signal(signal.SIGTERM)
+    _, rest = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err + rest
+    assert not out.exists() and list(tmp_path.glob(".results.jsonl*")) == []
+
+
+# -- Dask ------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def local_cluster():
+    """A dask.distributed cluster of two worker processes, on loopback only."""
+    distributed = pytest.importorskip("distributed")
+    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                       host="127.0.0.1", dashboard_address=None)
+    yield cluster
+    cluster.close()
+
+
+@pytest.mark.slow
+def test_the_dask_run_gives_the_local_verdicts(local_cluster, tmp_path, orthoglide_robot):
+    """Generated heart-like paths on the cluster (SINGCHECK_SCHEDULER): the verdicts of
+    a local run of the API, each path once; jsonl in completion order, json in input
+    order."""
+    from singcheck import api
+    from singcheck.spec.files import load_trajectories
+
+    paths = _generated(tmp_path, 30)
+    local = {d["name"]: d for d in api.check_batch(
+        orthoglide_robot, load_trajectories(paths, orthoglide_robot.spec), regions=False)}
+    env = {"SINGCHECK_CACHE_DIR": str(tmp_path),
+           "SINGCHECK_SCHEDULER": local_cluster.scheduler_address}
+    lines = singcheck("run", ORTHO, *paths, "--format", "jsonl", "--backend", "flint",
+                      "--no-regions", "-q", env=env)
+    assert lines.returncode == 1, lines.stderr
+    streamed = [json.loads(line) for line in lines.stdout.splitlines()]
+    assert sorted(d["name"] for d in streamed) == sorted(local)
+    for d in streamed:
+        del d["robot"]
+        assert d == {k: v for k, v in local[d["name"]].items() if k != "time_s"}
+    doc = singcheck("run", ORTHO, *paths, "--format", "json", "--backend", "flint", "-q",
+                    env=env)
+    assert [t["name"] for t in json.loads(doc.stdout)["trajectories"]] == list(local)
+    assert {t["name"]: t["verdict"] for t in json.loads(doc.stdout)["trajectories"]} == \
+        {n: d["verdict"] for n, d in local.items()}

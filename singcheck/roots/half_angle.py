@@ -81,8 +81,8 @@ def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
     for rr, mult in real_roots_exact(fmpq_poly(deflated), nonnegative_only=k % 2 == 0):
         for q in (fmpq(0), fmpq(1), fmpq(-1)):  # u = 0, ±1 (t = 0, ±π/2) are exact
             rr.pin(q)
-        if rr.lo == rr.hi == 0:
-            out.append(_HalfAngleRoot(_atan_ball(rr, k, 1), LinearInPi(Fraction(0)), mult * k))
+        if rr.lo == rr.hi == 0:  # u = 0 exactly: t = 0 (Arb's k-th root of 0 is NaN)
+            out.append(_HalfAngleRoot(lambda tol: arb(0), LinearInPi(Fraction(0)), mult * k))
             continue
         positive = rr.lo >= 0
         if not positive and k % 2 == 0:

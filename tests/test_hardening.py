@@ -527,6 +527,25 @@ def test_costly_paths_stop_at_the_time_limit(tmp_path, cache_env, robot, pose, r
         assert report.certificate is not None
 
 
+@pytest.mark.parametrize("robot, pose", [
+    (ORTHO, {"x": "3*sin(t) + cos(256*t)", "y": "0", "z": "1"}),
+    (BIGLIDE, {"x": "sin(100*t)", "y": "t"}),
+    (BIGLIDE, {"x": "sin(100*t)", "y": "t + 1/1000"}),
+])
+def test_costly_paths_end_unknown_at_the_command_lines_time_limit(
+        tmp_path, monkeypatch, capsys, cache_env, robot, pose):
+    spec = trajectory(tmp_path, pose)
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, "run", robot, spec, "-q", "--backend",
+                             "flint", "--time-limit", "3", "--format", "json")
+    assert code in (0, 1, 3), err
+    assert "Traceback" not in err
+    (doc,) = json.loads(out)["trajectories"]
+    if code == 3:  # stopped; or decided in time (the biglide meets y = 0 at t = 0 exactly)
+        assert doc["verdict"] == "unknown" and "time limit" in doc["reason"]
+    assert time.monotonic() - start < 3 + 15
+
+
 def test_near_double_roots_of_huge_size_are_separated():
     """x² + Bx + C with roots a and a + 2⁻¹⁰, a = -2²⁴⁵ (what the workspace decomposition
     of a robot with the constant (2147483648-364349)^8 meets): the isolating intervals
@@ -561,3 +580,25 @@ def test_a_robot_with_a_huge_constant_is_decided(tmp_path, monkeypatch, capsys, 
     (doc,) = json.loads(out)["trajectories"]
     # q = x ± √(C - y²) with C ≈ 2^247: far outside [-4, 4] from the start
     assert doc["verdict"] == "infeasible" and "q is outside [-4, 4]" in doc["reason"]
+
+
+# -- found by the fuzz campaign -------------------------------------------------------------
+
+
+def test_a_triple_root_at_t_0_of_the_half_angle_polynomial(tmp_path, monkeypatch, capsys,
+                                                           cache_env):
+    """On the biglide (ξ vanishes where y = 0), y = (9/14)·sin(t)³ gives M(u) = c·u³,
+    which deflates to a root v = 0 of N(v) = c·v: Arb's cube root of 0 is NaN, which gave
+    exit 70.  The roots are t = kπ, exactly: here 0, π and 2π."""
+    import math
+
+    spec = trajectory(tmp_path, {"x": "2*sin(2*t) + cos(t)", "y": "sin(t)^3 - 5/14*sin(t)^3"},
+                      "-45/54, 2*pi")
+    code, out, err = run_cli(monkeypatch, capsys, "run", BIGLIDE, spec, "-q", "--backend",
+                             "flint", "--format", "json")
+    assert code in (0, 1, 3) and "Traceback" not in err, err
+    (doc,) = json.loads(out)["trajectories"]
+    intervals = [c["t_interval"] for c in doc["candidates"]]
+    assert len(intervals) == 3
+    for (lo, hi), root in zip(intervals, (0.0, math.pi, 2 * math.pi), strict=True):
+        assert lo <= root <= hi and hi - lo < 1e-8

@@ -485,11 +485,18 @@ def test_undecided_boxes_and_a_known_root_are_kept_when_no_mode_is_feasible(
 
 def test_a_path_whose_mu_would_explode_is_refused_up_front(tmp_path, monkeypatch, capsys,
                                                            cache_env):
+    """Refused before composing; in a batch that is this trajectory's result (verdict
+    error, kind spec), the others still complete, and the exit status is 2."""
     spec = trajectory(tmp_path, {"x": "(sin(t)+cos(t)+t)^64", "y": "0", "z": "1"})
     start = time.monotonic()
-    code, _, err = run_cli(monkeypatch, capsys, "run", ORTHO, spec, "-q", "--backend", "flint")
-    one_line_error(code, err, 2, "too costly")
-    assert time.monotonic() - start < 10
+    code, out, err = run_cli(monkeypatch, capsys, "run", ORTHO, spec,
+                             str(TRAJECTORIES / "heart2.yaml"), "-q", "--backend", "flint",
+                             "--format", "json")
+    assert code == 2 and "Traceback" not in err, err
+    costly, heart2 = json.loads(out)["trajectories"]
+    assert costly["verdict"] == "error" and costly["error"]["kind"] == "spec"
+    assert "too costly" in costly["reason"] and heart2["verdict"] == "singularity-free"
+    assert time.monotonic() - start < 30
 
 
 def test_mu_size_bound_holds_for_a_composed_path(orthoglide_projection):

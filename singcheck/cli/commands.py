@@ -140,7 +140,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
 #: a trajectory's outcome as an exit status, and how bad each is (a batch exits with
 #: the worst of its trajectories)
 _SEVERITY = [ExitCode.SINGULARITY_FREE, ExitCode.UNKNOWN, ExitCode.SINGULAR,
-             ExitCode.BACKEND, ExitCode.INTERNAL]
+             ExitCode.USAGE, ExitCode.BACKEND, ExitCode.INTERNAL]
 
 
 def _outcome(doc: dict) -> ExitCode:
@@ -150,7 +150,8 @@ def _outcome(doc: dict) -> ExitCode:
     if verdict == "singularity-free":
         return ExitCode.SINGULARITY_FREE
     if verdict == "error":
-        return ExitCode.BACKEND if doc["error"]["kind"] == "backend" else ExitCode.INTERNAL
+        return {"backend": ExitCode.BACKEND, "spec": ExitCode.USAGE}.get(
+            doc["error"]["kind"], ExitCode.INTERNAL)
     return ExitCode.UNKNOWN
 
 

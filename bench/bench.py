@@ -31,7 +31,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "bench"))
 
 from contender import contender  # noqa: E402
-from generate import waypoints_yaml, write  # noqa: E402
+from generate import waypoints_yaml, write, write_stream  # noqa: E402
 
 from singcheck.certify.classification import certify_path  # noqa: E402
 from singcheck.certify.path import build_path  # noqa: E402
@@ -297,6 +297,72 @@ def cli_rows() -> list[dict]:
              "verdicts": verdicts}]
 
 
+def _timed_run(cmd: list[str], stdin_path: Path, env: dict) -> dict:
+    """One singcheck process: wall time, the jsonl lines it streamed, its verdicts, and
+    the CPU seconds and peak resident memory of it and its forked workers (wait4's
+    rusage; a Dask cluster's workers are not its children: their CPU is not counted)."""
+    with stdin_path.open("rb") as stdin, tempfile.TemporaryFile() as out:
+        start = time.perf_counter()
+        proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdin=stdin, stdout=out,
+                                stderr=subprocess.DEVNULL)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - start
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        verdicts: dict[str, int] = {}
+        for line in out:
+            v = json.loads(line)["verdict"]
+            verdicts[v] = verdicts.get(v, 0) + 1
+    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime,
+            "exit_code": proc.returncode, "verdicts": verdicts,
+            "peak_rss_mb": usage.ru_maxrss / 1024}
+
+
+BATCH_COUNTS = tuple(int(n) for n in os.environ.get("BENCH_BATCH", "1000,10000").split(","))
+
+
+def batch_rows(counts=BATCH_COUNTS) -> list[dict]:
+    """Generated heart-like paths streamed through one command (stdin, --format jsonl,
+    --no-regions): --jobs 2, and a 2-worker dask LocalCluster (process workers, loopback).
+    Peak memory at 1,000 and 10,000 paths shows whether it stays flat."""
+    exe = [sys.executable, "-m", "singcheck", "run", "robots/orthoglide.yaml", "-", "-q",
+           "--format", "jsonl", "--no-regions", "--backend", "flint"]
+    rows = []
+    cluster = None
+    try:
+        from distributed import LocalCluster
+
+        cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                               host="127.0.0.1", dashboard_address=None)
+    except ImportError:  # the dask extra is missing: no cluster rows
+        pass
+    with tempfile.TemporaryDirectory() as tmp:
+        env = {**os.environ, "SINGCHECK_CACHE_DIR": tmp}
+        subprocess.run([*exe[:5], "trajectories/heart1.yaml", "-q"], cwd=ROOT, env=env,
+                       capture_output=True)  # warm the projection cache
+        for n in counts:
+            stream = write_stream(Path(tmp) / f"paths-{n}.yaml", n)
+            runs = [("--jobs 2", ["--jobs", "2"])]
+            if cluster is not None:
+                runs.append(("2-worker LocalCluster", ["--scheduler",
+                                                       cluster.scheduler_address]))
+            for what, extra in runs:
+                row = _timed_run([*exe, *extra], stream, env)
+                rows.append({"what": f"{n} paths, jsonl, {what}", "paths": n,
+                             "paths_per_s": n / row["wall_s"], **row})
+    if cluster is not None:
+        cluster.close()
+    return rows
+
+
+def print_batch(rows: list[dict]) -> None:
+    print("\nbatches: generated heart-like paths on stdin, --format jsonl --no-regions")
+    for r in rows:
+        print(f"  {r['what']:42} {r['wall_s']:8.2f} s  {r['paths_per_s']:7.1f} paths/s  "
+              f"CPU {r['cpu_s']:7.2f} s  "
+              f"peak RSS {r['peak_rss_mb']:6.1f} MB  exit {r['exit_code']}  {r['verdicts']}")
+
+
 def growth_rows() -> list[dict]:
     """Certification time per trajectory, singcheck and the branch-and-bound contender
     round-robin, as the path gains harmonics; then robots of growing size."""
@@ -376,6 +442,41 @@ def spline_rows() -> list[dict]:
              "candidates": len(report.candidates)}]
 
 
+#: issue 12's robots: (robot, its paths, target per path in seconds, projection cached)
+ROBOT_PATHS = (
+    ("five-bar", ("five-bar-cross", "five-bar-free"), 0.050),
+    ("3-rpr", ("3-rpr-cross", "3-rpr-free"), 0.050),
+    ("3-prr", ("3-prr-cross", "3-prr-free"), 0.050),
+    ("linear-delta", ("linear-delta-cross", "linear-delta-free"), 0.200),
+    ("rotary-delta", ("rotary-delta-cross", "rotary-delta-free"), 0.200),
+    ("gough-stewart", ("gough-stewart-translate", "gough-stewart-rotate"), 5.0),
+)
+
+
+def robot_rows() -> list[dict]:
+    """Certification time per path of each bundled robot of issue 12 (flint, in-process):
+    with the projection cached (done once, as ``run`` does from its cache) and not cached
+    (projection included)."""
+    rows = []
+    for robot, paths, target in ROBOT_PATHS:
+        model = build_model(load_robot(ROOT / "robots" / f"{robot}.yaml"))
+        backend = get_backend("flint")
+        projection = project_robot(model, backend)
+        repeat = max(3, REPEAT // 3) if robot == "gough-stewart" else REPEAT
+        for name in paths:
+            spec = load_trajectory(ROOT / "trajectories" / f"{name}.yaml", model.spec)
+            report = certify_path(build_path(projection, spec))
+            cached, uncached = interleaved(
+                [lambda p=projection, s=spec: certify_path(build_path(p, s)),
+                 lambda s=spec, m=model, b=backend: certify_path(build_path(
+                     project_robot(m, b), s))],
+                repeat)
+            rows.append({"robot": robot, "trajectory": name, "verdict": report.verdict,
+                         "target_s": target, "cached": stats(cached),
+                         "uncached": stats(uncached)})
+    return rows
+
+
 def machine() -> dict:
     cpu = "unknown"
     try:
@@ -414,6 +515,14 @@ def main() -> None:
     print("(vs singcheck: its median time / singcheck's; right answer: singcheck decided; "
           "branch-and-bound: same verdict and singular times as singcheck; sampling: "
           "sign changes at exactly singcheck's singular times)")
+    results["robots"] = robots = robot_rows()
+    print("\nbundled robots (issue 12): certification per path, flint, in-process; "
+          "projection cached / not cached")
+    for r in robots:
+        c, u = r["cached"], r["uncached"]
+        print(f"  {r['robot']:14} {r['trajectory']:24} {r['verdict']:17} cached median "
+              f"{ms(c['median_s'])} ms (target {ms(r['target_s'])} ms), not cached "
+              f"{ms(u['median_s'])} ms")
     results["spline"] = spline = spline_rows()
     print("\nwaypoints: read and certify, whole path (spline built exactly)")
     for r in spline:
@@ -440,6 +549,8 @@ def main() -> None:
     for r in cli:
         print(f"  {r['what']:66} median {ms(r['median_s'])} ms" +
               (f"  {r['verdicts']}" if "verdicts" in r else ""))
+    results["batch"] = batch = batch_rows()
+    print_batch(batch)
     results["growth"] = growth = growth_rows()
     print("\ngrowth: certification time per trajectory (projection cached), singcheck and "
           "the branch-and-bound round-robin")
@@ -469,5 +580,17 @@ def main() -> None:
     print(f"\nwritten: {out.relative_to(ROOT)}")
 
 
+def batch_only() -> None:
+    """``python bench/bench.py batch``: only the batch rows, merged into results.json."""
+    out = ROOT / "bench" / "results.json"
+    results = json.loads(out.read_text()) if out.exists() else {"machine": machine()}
+    results["batch"] = batch_rows()
+    print_batch(results["batch"])
+    out.write_text(json.dumps(results, indent=2) + "\n")
+
+
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:] == ["batch"]:
+        batch_only()
+    else:
+        main()

@@ -61,6 +61,17 @@ def write(out: Path, count: int, harmonics: int = 4, seed: int = 2015) -> list[P
     return paths
 
 
+def write_stream(out: Path, count: int, harmonics: int = 4, seed: int = 2015) -> Path:
+    """The same trajectories as :func:`write`, as one file of YAML documents (``---``
+    between them), for ``singcheck run ROBOT - < out``."""
+    rng = random.Random(seed)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with out.open("w") as f:
+        for i in range(count):
+            f.write("---\n" + heart_like(rng, f"heart-{harmonics}h-{i:04d}", harmonics))
+    return out
+
+
 if __name__ == "__main__":
     args = sys.argv[1:]
     write(Path(args[0]), int(args[1]) if len(args) > 1 else 1000,

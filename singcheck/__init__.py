@@ -21,8 +21,8 @@ foundation modules every stage may use.  The API is loaded on first use, so that
 
 from singcheck.version import __version__
 
-__all__ = ["Report", "Robot", "check", "check_batch", "load_robot", "load_trajectory",
-           "robot_from_spec", "__version__"]
+__all__ = ["Report", "Robot", "check", "check_batch", "check_safely", "load_robot",
+           "load_trajectory", "load_trajectories", "robot_from_spec", "__version__"]
 
 
 def __getattr__(name: str):

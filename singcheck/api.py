@@ -115,6 +115,16 @@ def load_trajectory(path: str, robot: Robot, interpolation: str | None = None) -
     return read_trajectory_spec(path, robot.spec, interpolation)
 
 
+def load_trajectories(paths, robot: Robot, interpolation: str | None = None
+                      ) -> list[TrajectorySpec]:
+    """Every trajectory of the files (``-``: standard input): a YAML file may hold several
+    documents, one trajectory each; names must be unique across them all (else
+    :class:`~singcheck.errors.SpecError`, naming the file, line and document)."""
+    from singcheck.spec.files import load_trajectories as read_trajectories
+
+    return read_trajectories(paths, robot.spec, interpolation)
+
+
 @dataclass
 class Report:
     """The certified answer for one trajectory: a verdict with its proofs."""
@@ -190,27 +200,24 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
             certificate = certify_trajectory(robot.projection, trajectory, tolerance)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions or not _one_piece(trajectory) or not robot.model.polynomial:
+        if not regions or not robot.model.polynomial:
             # the workspace decomposition (CAD) needs rational polynomials in the pose:
             # robots with angles or square roots get the certificate without it
             return Report(trajectory, certificate)
-        path = certificate.path
-        from singcheck.spaces.path_regions import path_in_workspace
+        from singcheck.spaces.path_regions import path_in_workspace, pieces_in_workspace
 
         mu_roots = ([c.t for c in certificate.candidates]
                     if certificate.mu_roots_complete else None)
         try:
-            where = path_in_workspace(path, tolerance, mu_roots=mu_roots,
-                                      region_cache=robot.region_cache, notify=notify)
+            if certificate.pieces:
+                where = pieces_in_workspace(certificate, tolerance, robot.region_cache,
+                                            notify)
+            else:
+                where = path_in_workspace(certificate.path, tolerance, mu_roots=mu_roots,
+                                          region_cache=robot.region_cache, notify=notify)
         except TimeLimitExceeded as e:
             return Report(trajectory, certificate, time_limited=str(e))
         return Report(trajectory, certificate, where)
-
-
-def _one_piece(trajectory: TrajectorySpec) -> bool:
-    """Whether the workspace statement applies: one piece in the user's own time (the
-    regions of a multi-piece or rescaled path are not placed yet)."""
-    return not trajectory.segments and trajectory.time_scale is None
 
 
 #: the default per-trajectory time limit of a batch (seconds): generous, but finite
@@ -299,7 +306,7 @@ def prepare_regions(robot: Robot, trajectories: list[TrajectorySpec], time_limit
 
     try:
         with deadline(time_limit), hard_time_limit(time_limit):
-            prepare_region_maps(robot.projection, [t for t in trajectories if _one_piece(t)],
+            prepare_region_maps(robot.projection, [t.pieces[0] for t in trajectories],
                                 robot.region_cache, notify)
     except TimeLimitExceeded:
         notify(f"the workspace regions shared by the paths took more than {time_limit:g} s "

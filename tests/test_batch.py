@@ -297,10 +297,12 @@ def _generated(tmp_path, count: int) -> list[str]:
     return [str(p) for p in write(tmp_path / "paths", count)]
 
 
-@pytest.mark.parametrize("sig", ["SIGTERM", "SIGHUP"])
-def test_a_signal_mid_batch_leaves_valid_jsonl_lines(tmp_path, sig):
+@pytest.mark.parametrize("sig, group", [("SIGTERM", False), ("SIGHUP", False),
+                                        ("SIGINT", True)])
+def test_a_signal_mid_batch_leaves_valid_jsonl_lines(tmp_path, sig, group):
     """Stopped mid-batch (forked workers busy), singcheck exits 130; every line it wrote
-    is a whole JSON object, and no worker printed a traceback."""
+    is a whole JSON object, and no worker printed a traceback.  Ctrl-C reaches the whole
+    process group (``group``), workers included."""
     import os
     import signal
     import subprocess
@@ -312,10 +314,14 @@ def test_a_signal_mid_batch_leaves_valid_jsonl_lines(tmp_path, sig):
                              str(DATA / "slow.yaml"), "--format", "jsonl", "--jobs", "2",
                              "--backend", "flint", "--no-regions"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT,
-                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)})
+                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)},
+                            start_new_session=group)
     first = proc.stdout.readline()  # a result streamed: the batch is under way
     time.sleep(0.5)
-    proc.send_signal(getattr(signal, sig))
+    if group:
+        os.killpg(proc.pid, getattr(signal, sig))
+    else:
+        proc.send_signal(getattr(signal, sig))
     rest = proc.stdout.read()  # (communicate() would skip what readline buffered)
     err = proc.stderr.read()
     proc.wait(timeout=60)
@@ -395,3 +401,33 @@ def test_the_dask_run_gives_the_local_verdicts(local_cluster, tmp_path, orthogli
     assert [t["name"] for t in json.loads(doc.stdout)["trajectories"]] == list(local)
     assert {t["name"]: t["verdict"] for t in json.loads(doc.stdout)["trajectories"]} == \
         {n: d["verdict"] for n, d in local.items()}
+
+
+def test_the_region_statement_is_bounded_by_the_time_limit():
+    """The helix's region needs the 3-D workspace decomposed (seconds, no cache here):
+    with a 0.5 s limit the certified verdict stands and the region statement is left out
+    with the reason, promptly."""
+    import time
+
+    import singcheck as sc
+
+    robot = sc.load_robot(ORTHO, backend="flint", cache=False)
+    helix = sc.load_trajectory(str(ROOT / "trajectories" / "helix.yaml"), robot)
+    start = time.monotonic()
+    report = sc.check(robot, helix, time_limit=0.5)
+    assert time.monotonic() - start < 3  # unbounded, the decomposition takes 5 s or more
+    assert report.verdict == "singularity-free"
+    doc = report.to_dict()
+    assert "workspace" not in doc
+    assert "time limit (0.5 s) reached while naming the workspace region" in doc["reason"]
+
+
+def test_the_api_reads_several_documents(orthoglide_robot, tmp_path):
+    import singcheck as sc
+
+    many = tmp_path / "many.yaml"
+    many.write_text(_stream("heart1", "heart2"))
+    specs = sc.load_trajectories([many], orthoglide_robot)
+    assert [s.name for s in specs] == ["heart1", "heart2"]
+    assert [sc.check(orthoglide_robot, s, regions=False).verdict for s in specs] == \
+        ["singular", "singularity-free"]

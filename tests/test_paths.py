@@ -395,3 +395,41 @@ def test_a_serial_singularity_at_a_join_breaks_every_mode():
     assert report.verdict == "infeasible"
     assert not [m for m in report.working_modes if m.feasible]
     assert all("meet at t ≈ 1" in m.reason for m in report.working_modes)
+
+
+def test_csv_with_a_byte_order_mark_and_huge_exponents(robot_spec, tmp_path):
+    bom = tmp_path / "bom.csv"
+    bom.write_bytes("\ufefft,x,y,z\n0,0.5,0.5,1\n1,0.6,0.5,1\n".encode())
+    assert len(load_trajectory(bom, robot_spec).pieces) == 1
+    huge = tmp_path / "huge.csv"
+    huge.write_text("t,x,y,z\n0,1e99999999,0.5,1\n1,0.6,0.5,1\n")
+    with pytest.raises(SpecError, match=r"huge.csv:2: x: .*exponent"):
+        load_trajectory(huge, robot_spec)
+    text = "name: a\nparameter: t\nrange: [0, 1]\npose: {x: 1e99999999*t, y: 0, z: 1}\n"
+    with pytest.raises(SpecError, match="too large"):  # refused before 10^e is built
+        parse_trajectory(text, "a.yaml", robot_spec)
+
+
+def test_the_workspace_statement_covers_every_piece(orthoglide_projection, robot_spec):
+    from singcheck.spaces.path_regions import XI, pieces_in_workspace
+
+    report = _certify(orthoglide_projection, LINEAR_YAML.format(kind="linear"), robot_spec)
+    w = pieces_in_workspace(report)
+    roots = singular_times(_linear_pieces())
+    assert [c.surfaces for c in w.crossings] == [(XI,)] * 2  # only the two μ roots
+    for c, root in zip(w.crossings, roots, strict=True):
+        assert float(c.t.lower()) - 1e-12 <= float(root) <= float(c.t.upper()) + 1e-12
+    assert [s.count for s in w.stretches] == [1, 1, 1]  # one stretch across the join
+
+
+def test_a_crossing_exactly_at_a_join_is_counted_once():
+    from singcheck import api
+
+    robot = api.robot_from_spec(parse_robot(RAIL, "rail.yaml"), "sympy", cache=False)
+    text = ("name: touch\nparameter: t\ninterpolation: linear\nwaypoints:\n"
+            "  - {t: 0, x: 1, y: 1}\n  - {t: 1, x: 1, y: 2}\n  - {t: 2, x: 3/2, y: 1}\n")
+    report = api.check(robot, parse_trajectory(text, "p.yaml", robot.spec))
+    crossings = report.to_dict()["workspace"]["crossings"]
+    # independently: 4 − y² = 0 only at y = 2, i.e. t = 1 exactly, on both pieces
+    at_join = [c for c in crossings if c["t_interval"][0] <= 1 <= c["t_interval"][1]]
+    assert len(at_join) == 1 and "serial singularity of leg p" in at_join[0]["surfaces"]

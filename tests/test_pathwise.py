@@ -54,3 +54,23 @@ def test_pathwise_mu_has_the_zeros_of_xi_along_the_path(robot, name):
     mu = eliminate_along_path(machine.model, phi)
     expected = compose_pose(machine.singularity_surface, phi, machine.model.pose)
     assert squarefree_part(mu) == squarefree_part(expected)
+
+
+def test_the_rotary_delta_is_certified_along_each_path_and_project_says_so():
+    """Three revolute legs and √3: the bound on ξ's size is over the limit, so ``project``
+    says ξ was not expanded, and ``run`` still certifies (the answers themselves are
+    checked against the oracle in tests/test_robots.py)."""
+    from tests.test_cli import singcheck
+
+    out = singcheck("project", str(ROBOTS / "rotary-delta.yaml"), "--no-epsilon")
+    assert out.returncode == 0, out.stderr
+    assert "ξ(X) was not expanded" in out.stdout and "could reach degree" in out.stdout
+    out = singcheck("run", str(ROBOTS / "rotary-delta.yaml"),
+                    str(TRAJECTORIES / "rotary-delta-cross.yaml"), "--no-cache", "--format",
+                    "json", "--backend", "flint")
+    assert out.returncode == 1, out.stderr
+    import json
+
+    doc = json.loads(out.stdout)
+    assert doc["singularity_surface_degree"] is None
+    assert doc["trajectories"][0]["verdict"] == "singular"

@@ -6,6 +6,7 @@ the spec's drawing at the model's joints and pose there, recomputed here indepen
 from __future__ import annotations
 
 import mpmath
+import numpy as np
 import pytest
 import sympy
 import yaml
@@ -117,6 +118,12 @@ def test_the_posture_figure_is_written_with_one_panel_per_posture(case, tmp_path
     titles = [ax.get_title() for ax in fig.axes]
     assert titles[0].startswith("start · t = -3.141593 · mode")
     assert all(t.startswith("singular · t = ") for t in titles[1:])
+    if report.path.projection.model.spec.drawing_dimension == 3:  # the legs' common plane
+        from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+        shaded = [any(isinstance(c, Poly3DCollection) for c in ax.collections)
+                  for ax in fig.axes]
+        assert shaded == [False] + [True] * (len(titles) - 1)
     plt.close(fig)
     files = write_figures(report, tmp_path, ("png",), dpi=40)
     assert tmp_path / f"{traj_name}-postures.png" in files
@@ -201,3 +208,54 @@ drawing:
         [0, 0, float(2 * mpmath.cos(th)), float(2 * mpmath.sin(th)), 0.5, 2], abs=1e-12)
     assert slider.points.ravel().tolist() == pytest.approx([1.25, float(mpmath.sqrt(3) / 2)],
                                                            abs=1e-12)
+
+
+FIVE_BAR = """\
+name: fivebar
+joints: [th1, th2]
+pose: [x, y]
+parameters: {l1: 1, l2: 2, e: 1}
+constraints:
+  - (x + e - l1*cos(th1))^2 + (y - l1*sin(th1))^2 - l2^2
+  - (x - e - l1*cos(th2))^2 + (y - l1*sin(th2))^2 - l2^2
+drawing:
+  base: [[[-e, 0], [e, 0]]]
+  cranks: [[[-e, 0], [-e + l1*cos(th1), l1*sin(th1)]], [[e, 0], [e + l1*cos(th2), l1*sin(th2)]]]
+  rods: [[[-e + l1*cos(th1), l1*sin(th1)], [x, y]], [[e + l1*cos(th2), l1*sin(th2)], [x, y]]]
+  platform: [[x, y]]
+"""
+CIRCLE = """\
+name: circle
+parameter: t
+range: [0, 2*pi]
+pose: {x: 1/2*cos(t), y: 2 + 1/2*sin(t)}
+"""
+
+
+def test_a_five_bar_with_revolute_actuators_is_drawn_as_a_closed_chain(tmp_path):
+    """Revolute joints reach the drawing as (cos θ, sin θ): every posture closes the
+    chain (cranks of length 1, rods of length 2 meeting at the path's point at t, by
+    50-digit mpmath), and at the singular times the two rods are parallel."""
+    from singcheck.api import check, robot_from_spec
+    from singcheck.report.plots import write_figures
+    from singcheck.spec.files import parse_robot, parse_trajectory
+
+    robot = robot_from_spec(parse_robot(FIVE_BAR, "fivebar.yaml"), "flint", cache=False)
+    report = check(robot, parse_trajectory(CIRCLE, "circle.yaml", robot.spec),
+                   regions=False).certificate
+    posts = postures(report)
+    assert any(p.kind == "singular" for p in posts)
+    for post in posts:
+        bodies = {b.name: b for b in post.bodies}
+        t = mpmath.mpf(post.t)
+        point = [float(mpmath.cos(t) / 2), float(2 + mpmath.sin(t) / 2)]
+        assert bodies["platform"].points.ravel().tolist() == pytest.approx(point, abs=1e-9)
+        for crank, rod in zip(bodies["cranks"].chains, bodies["rods"].chains, strict=True):
+            assert float(np.hypot(*(crank[1] - crank[0]))) == pytest.approx(1, abs=1e-9)
+            assert rod[0].tolist() == pytest.approx(crank[1].tolist(), abs=1e-12)
+            assert float(np.hypot(*(rod[1] - rod[0]))) == pytest.approx(2, abs=1e-9)
+        (a0, a1), (b0, b1) = bodies["rods"].chains
+        u, v = a1 - a0, b1 - b0
+        assert (abs(u[0] * v[1] - u[1] * v[0]) < 1e-7) == (post.kind == "singular")
+    files = write_figures(report, tmp_path, ("png",), dpi=30)
+    assert len(files) == 5

@@ -165,15 +165,15 @@ def _random_trig(rng, degree: int, with_t: bool = False):
     return reduce_trig(p)
 
 
-def test_half_angle_polynomial_is_the_substitution():
+def testhalf_angle_polynomial_is_the_substitution():
     import random
 
-    from singcheck.roots.half_angle import _half_angle_polynomial
+    from singcheck.roots.half_angle import half_angle_polynomial
 
     rng = random.Random(5)
     for _ in range(20):
         p = _random_trig(rng, 7)
-        m, d = _half_angle_polynomial(p)
+        m, d = half_angle_polynomial(p)
         for u in (fmpq(0), fmpq(3, 7), fmpq(-5, 2), fmpq(1)):
             w = 1 + u * u
             direct = p.subs({"s": 2 * u / w, "c": (1 - u * u) / w}).subs({"t": 0})
@@ -274,3 +274,25 @@ def test_descartes_variation_count_stops_at_two():
     for coeffs, expected in [([1, 2, 3], 0), ([1, 0, -1], 1), ([1, -1, 1], 2),
                              ([-1, 0, 0, 2, -3, 4], 2), ([0, 0, 5, 0, -5], 1), ([], 0)]:
         assert _variations_up_to_two(coeffs) == expected
+
+
+def test_reduce_trig_is_the_same_function_with_degree_at_most_one_in_sine():
+    """The canonical form keeps the function (50-digit values at several t) and has
+    degree ≤ 1 in s; high powers of s included."""
+    import random
+
+    from singcheck.algebra.trig import reduce_trig
+
+    rng = random.Random(5)
+    for _ in range(10):
+        p = 0 * S
+        for _ in range(15):
+            p += fmpq(rng.randint(-9, 9), rng.randint(1, 9)) * T**rng.randint(0, 2) \
+                * S**rng.randint(0, 9) * C**rng.randint(0, 9)
+        r = reduce_trig(p)
+        assert r.degrees()[1] <= 1
+        for x in (mpmath.mpf("0.3"), mpmath.mpf("-2.1"), mpmath.mpf(5)):
+            def value(q, x=x):
+                return sum(mpmath.mpf(int(c.p)) / int(c.q) * x**int(i) * mpmath.sin(x)**int(j)
+                           * mpmath.cos(x)**int(k) for (i, j, k), c in q.terms())
+            assert abs(value(p) - value(r)) < mpmath.mpf(10) ** -30 * (1 + abs(value(p)))

@@ -192,7 +192,9 @@ drawing:
 def test_every_bundled_robot_has_a_drawing_of_its_dimension(path):
     spec = load_robot(path)
     assert spec.drawing, f"{path.name} has no drawing key"
-    assert spec.drawing_dimension == (3 if len(spec.pose) >= 3 else 2)
+    # planar robots with an orientation (3-RPR: x, y, phi) are drawn in the plane
+    positions = [v for v in spec.pose if v not in spec.angles]
+    assert spec.drawing_dimension == (3 if len(positions) >= 3 else 2)
     # the drawing moves with every joint and every pose coordinate
     used = {v for body in spec.drawing for chain in body.chains for point in chain
             for c in point for v, d in zip(spec.context.names(), c.degrees(), strict=True)

@@ -28,36 +28,20 @@ from flint import arb, arb_poly, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_pol
 #: Q[t, s, c]; exponents are (t, s, c).
 TRIG = fmpq_mpoly_ctx.get(("t", "s", "c"), "lex")
 T, S, C = TRIG.gens()
+_RELATION = S**2 + C**2 - 1
 
 
 def reduce_trig(p: fmpq_mpoly) -> fmpq_mpoly:
     """The representative of ``p`` modulo ``s² + c² - 1`` with degree ≤ 1 in s.
 
-    s^j = s^(j mod 2)·(1 - c²)^(j div 2): terms are grouped by (t-power, s-parity,
-    j div 2) so that each power of 1 - c² multiplies one polynomial in c.
+    FLINT's division with remainder by s² + c² - 1: in the lex order of (t, s, c) its
+    leading monomial is s², so the remainder has no term divisible by s², i.e. degree
+    ≤ 1 in s, and differs from p by a multiple of s² + c² - 1.  That representative is
+    unique (Q[t, c] ⊕ s·Q[t, c] meets the ideal in 0), hence the canonical form.
     """
     if p.degrees()[1] < 2:
         return p
-    groups: dict[int, dict[tuple[int, int, int], fmpq]] = {}
-    for (i, j, k), coeff in p.terms():
-        half, odd = divmod(j, 2)
-        groups.setdefault(half, {})[(i, odd, k)] = coeff
-    out = TRIG.from_dict({})
-    for half, terms in groups.items():
-        out += TRIG.from_dict(terms) * _one_minus_c2(half)
-    return out
-
-
-_ONE_MINUS_C2: list[fmpq_mpoly] = []
-
-
-def _one_minus_c2(n: int) -> fmpq_mpoly:
-    """(1 - c²)^n, memoised (the same few powers serve every path)."""
-    if not _ONE_MINUS_C2:
-        _ONE_MINUS_C2.append(TRIG.from_dict({(0, 0, 0): 1}))
-    while len(_ONE_MINUS_C2) <= n:
-        _ONE_MINUS_C2.append(_ONE_MINUS_C2[-1] * (1 - C**2))
-    return _ONE_MINUS_C2[n]
+    return divmod(p, _RELATION)[1]
 
 
 def _chebyshev_in_c(poly: fmpz_poly) -> fmpq_mpoly:

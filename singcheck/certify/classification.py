@@ -23,6 +23,13 @@ What is proven, and how:
 * **Singular, by sign change.**  When det A along a real mode has proven opposite signs
   at the two ends of T, it vanishes inside T (intermediate values); that zero is a
   root of μ in T, hence τ itself (T isolates one root).
+* **Singular or regular, exactly (algebraic).**  Where none of the above decides (a
+  tangency, several modes vanishing at once), a root whose time is algebraic (every
+  root of a polynomial or sin/cos path, and t = kπ of a mixed one) is decided exactly
+  in Q(α)(√D₁, …) by :mod:`singcheck.certify.exact`.
+* **On the surface.**  When μ ≡ 0, each feasible mode is decided on its own: det A ≡ 0
+  along it, or the roots of a non-zero polynomial holding its zeros are its candidates
+  (classified for that mode alone, without the elimination proof).
 * Anything else, after refining T, is ``unknown`` for that mode, with the reason.
 """
 
@@ -34,16 +41,25 @@ from flint import acb, arb
 
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
 from singcheck.algebra.radicals import evaluate_path
+from singcheck.budget import checkpoint
+from singcheck.certify.exact import (
+    AlgebraicPoint,
+    NotExact,
+    det_a_vanishes_at,
+    mode_zero_polynomial,
+)
 from singcheck.certify.path import PathModel, joint_float
 from singcheck.certify.working_modes import (
     FEASIBLE,
     INFEASIBLE,
     UNKNOWN,
     WorkingMode,
+    gap_points,
     working_modes,
 )
 from singcheck.roots.enclosures import IdenticallyZeroError, RealRoot
 from singcheck.roots.isolation import isolate_real_roots
+from singcheck.roots.rational import arb_to_fmpq
 from singcheck.spec.files import TrajectorySpec
 
 SINGULAR, REGULAR = "singular", "regular"
@@ -51,6 +67,9 @@ BY_ELIMINATION = "elimination"
 BY_SIGN_CHANGE = "sign change"
 BY_EXCLUSION = "det A ≠ 0 (ball arithmetic)"
 BY_EXACT_ZERO = "det A = 0 exactly"
+BY_ALGEBRAIC_ZERO = "det A = 0 exactly (algebraic)"
+BY_ALGEBRAIC_NONZERO = "det A ≠ 0 exactly (algebraic)"
+BY_IDENTICALLY_ZERO = "det A ≡ 0 along the path (exact)"
 BY_JOINT_FREE = "det A free of the joints (ξ = det A)"
 
 VERDICT_FREE = "singularity-free"
@@ -113,11 +132,14 @@ def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
     per_leg = [leg.branches(t) for leg in path.legs]
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}
+    complete = {}
     for mode in modes:
         js = [per_leg[i][b.label] for i, b in enumerate(mode.branches)]
         joints[mode.label] = js
-        values[mode.label] = None if any(j is None for j in js) else \
-            path.det_A(js, variables)
+        values[mode.label] = None
+        if not any(j is None for j in js):
+            complete[mode.label] = js
+    values.update(path.det_A_modes(complete, variables))  # the pose part once for all
     return pose, joints, values
 
 
@@ -163,7 +185,7 @@ def _branches_continuous(path: PathModel, t: arb) -> bool:
                for leg in path.legs)
 
 
-def _decide(path, modes, root: RealRoot):
+def _decide(path, modes, root: RealRoot, by_elimination: bool = True):
     """One attempt at the given enclosure; returns ``{mode: ModeAtCandidate}``."""
     pose, joints, values = _mode_values(path, modes, root.t)
     decided: dict[str, ModeAtCandidate] = {}
@@ -183,7 +205,8 @@ def _decide(path, modes, root: RealRoot):
             decided[mode.label] = ModeAtCandidate(mode.label, SINGULAR, BY_EXACT_ZERO)
         else:
             open_modes.append(mode)
-    if len(open_modes) == 1 and conjugates_regular and _integral(path, root.t):
+    if by_elimination and len(open_modes) == 1 and conjugates_regular and \
+            _integral(path, root.t):
         m = open_modes[0]
         decided[m.label] = ModeAtCandidate(m.label, SINGULAR, BY_ELIMINATION)
         open_modes = []
@@ -196,9 +219,27 @@ def _decide(path, modes, root: RealRoot):
     return pose, joints, decided
 
 
+def _decide_exactly(path, modes, time) -> dict[str, ModeAtCandidate]:
+    """The modes that ball arithmetic left open, decided in Q(α) (:mod:`.exact`)."""
+    out = {}
+    try:
+        point = AlgebraicPoint(time)
+        for mode in modes:
+            if det_a_vanishes_at(path, point, mode.label):
+                out[mode.label] = ModeAtCandidate(mode.label, SINGULAR, BY_ALGEBRAIC_ZERO)
+            else:
+                out[mode.label] = ModeAtCandidate(mode.label, REGULAR, BY_ALGEBRAIC_NONZERO)
+    except NotExact:
+        pass
+    return out
+
+
 def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot,
-                       tolerance: float) -> Candidate:
-    """Decide, for every working mode, whether it is singular at this root of μ."""
+                       tolerance: float, by_elimination: bool = True) -> Candidate:
+    """Decide, for every working mode, whether it is singular at this root of μ.
+
+    ``by_elimination=False`` when ``modes`` are not every mode that may vanish at the
+    root (candidates of one mode on a path lying on ξ = 0)."""
     decided: dict[str, ModeAtCandidate] = {}
     shown_at = None
     r = root
@@ -206,12 +247,15 @@ def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot
         if step:
             r = r.refined(tolerance * 10.0 ** (-8 * step))
         with working_precision(prec):
-            pose, joints, newly = _decide(path, modes, r)
+            pose, joints, newly = _decide(path, modes, r, by_elimination)
         shown_at = shown_at or (pose, joints)
         for label, verdict in newly.items():
             decided.setdefault(label, verdict)
         if len(decided) == len(modes):
             break
+    if len(decided) < len(modes) and root.exact is not None:
+        decided.update(_decide_exactly(path, [m for m in modes if m.label not in decided],
+                                       root.exact))
     pose, joints = shown_at
     per_mode = [decided.get(m.label) or ModeAtCandidate(
         m.label, UNKNOWN, "neither det A ≠ 0 nor a zero could be proven at this root")
@@ -246,7 +290,8 @@ def _classify_all(path: PathModel, modes: list[WorkingMode], roots, tolerance: f
     periodic = _periodic(path)
     done: dict[int, Candidate] = {}
     out = []
-    for r in roots:
+    for r in roots:  # hundreds for a high-degree μ
+        checkpoint()
         base = done.get(r.period[0]) if periodic and r.period is not None else None
         if base is None:
             candidate = classify_candidate(path, modes, r, tolerance)
@@ -275,9 +320,7 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
     try:
         isolation = isolate_real_roots(path.mu, path.trajectory.range, tolerance)
     except IdenticallyZeroError:
-        return TrajectoryReport(path, VERDICT_UNKNOWN,
-                                "the trajectory lies on the singularity surface ξ(X) = 0, so "
-                                "μ(t) ≡ 0 gives no candidates", [], modes, "none")
+        return _certify_on_surface(path, modes, tolerance)
     candidates = _classify_all(path, modes, isolation.roots, tolerance)
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
@@ -286,6 +329,55 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
     verdict, reason = verdict_of(modes, candidates, undecided)
     return TrajectoryReport(path, verdict, reason, candidates, modes, isolation.method,
                             undecided, not isolation.undecided)
+
+
+def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
+                        tolerance: float) -> TrajectoryReport:
+    """μ ≡ 0: the path lies on ξ(X) = 0, so μ gives no candidates.  Each feasible mode is
+    decided on its own (:func:`.exact.mode_zero_polynomial`): det A ≡ 0 along it (singular
+    all along), or a non-zero trig polynomial whose roots hold its zeros, which are then
+    isolated and classified for that mode alone (no elimination proof: the other modes
+    are not looked at).  Infeasible modes are not examined."""
+    interval = path.trajectory.range
+    feasible = [m for m in modes if m.status == FEASIBLE]
+    samples = gap_points(interval, [])
+    candidates, undecided, method, complete = [], [], "none", True
+    for mode in feasible:
+        try:
+            zeros = mode_zero_polynomial(path, mode.label, arb_to_fmpq(samples[0]))
+        except NotExact as why:
+            candidates.append(_on_surface_candidate(path, mode, UNKNOWN, str(why)))
+            continue
+        if zeros is None:
+            candidates.append(_on_surface_candidate(path, mode, SINGULAR, BY_IDENTICALLY_ZERO))
+            continue
+        isolation = isolate_real_roots(zeros, interval, tolerance)
+        method = isolation.method
+        complete = complete and not isolation.undecided
+        for r in isolation.roots:
+            c = classify_candidate(path, [mode], r, tolerance, by_elimination=False)
+            candidates.append(c)
+        undecided += [(b.t, b.reason) for b in isolation.undecided
+                      if not _clear_undecided(path, [mode], b)]
+    candidates.sort(key=lambda c: float(c.t.mid()))
+    for mode in modes:
+        mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
+    verdict, reason = verdict_of(modes, candidates, undecided)
+    if verdict == VERDICT_FREE:
+        reason += " (the path lies on ξ(X) = 0: each mode was decided on its own)"
+    return TrajectoryReport(path, verdict, reason, candidates, modes, method, undecided,
+                            complete)
+
+
+def _on_surface_candidate(path, mode, status, proof) -> Candidate:
+    """The whole path for one mode, shown at the range start."""
+    t = path.trajectory.range.start.ball()
+    pose, joints, _ = _mode_values(path, [mode], t)
+    shown = {mode.label: {leg.leg.joint: joint_float(v)
+                          for leg, v in zip(path.legs, joints[mode.label], strict=True)}}
+    state = "real" if status == SINGULAR else UNKNOWN
+    return Candidate(RealRoot(t, None), pose, shown, [ModeAtCandidate(mode.label, status, proof)],
+                     state)
 
 
 def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
@@ -297,6 +389,10 @@ def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
                 if m.label in c.singular_modes]
     if singular:
         label, c = singular[0]
+        if any(m.proof == BY_IDENTICALLY_ZERO for m in c.modes):
+            return VERDICT_SINGULAR, (f"working mode {label} is singular along the whole "
+                                      "path (det A ≡ 0: the path lies on its singularity "
+                                      "surface)")
         return VERDICT_SINGULAR, (f"working mode {label} is singular at t ≈ "
                                   f"{float(c.t.mid()):.6g}")
     if not feasible and not unsure:

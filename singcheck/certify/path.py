@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
+from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.intervals import evaluate, fraction_ball
 from singcheck.algebra.polynomials import restrict
@@ -164,7 +164,12 @@ class LegAlongPath:
         conjugate where D < 0; where the sign of D is not proven both are None.  A
         revolute branch is the pair (cos θ, sin θ).  ``tight`` spends more on a wide
         ball (:func:`~singcheck.algebra.trig.evaluate_trig`)."""
-        values = [evaluate_path(c, t, tight=tight) for c in self.coefficients]
+        if self.leg.kind != REVOLUTE and self.leg.degree == 2:
+            # ρ = (-b ± √D)/(2a) needs a, b and D only: c is in D already
+            a, b = (evaluate_path(c, t, tight=tight) for c in self.coefficients[:2])
+            values = [a, b, None]
+        else:
+            values = [evaluate_path(c, t, tight=tight) for c in self.coefficients]
         d = evaluate_path(self.discriminant, t, tight=tight) \
             if self.discriminant is not None else None
         return branch_values(self.leg, values, d)
@@ -202,6 +207,43 @@ def branch_values(leg: Leg, values: list, d) -> dict:
     return {"+": None, "-": None}
 
 
+_DET_A_SPLITS: dict[int, tuple] = {}
+
+
+def _det_a_by_joints(model: RobotModel) -> list[tuple[tuple[tuple[int, int], ...], fmpq_mpoly]]:
+    """det A as [(α, q_α)]: α the exponents of the joint variables (sparse pairs), q_α
+    the polynomial in the other variables; once per model."""
+    hit = _DET_A_SPLITS.get(id(model))
+    if hit is None or hit[0] is not model:
+        n_joint = len(model.joint_variables)
+        groups: dict[tuple[int, ...], dict] = {}
+        for exps, coeff in model.det_A.terms():
+            rest = (0,) * n_joint + tuple(exps[n_joint:])
+            groups.setdefault(tuple(exps[:n_joint]), {})[rest] = coeff
+        split = [(tuple((v, e) for v, e in enumerate(alpha) if e),
+                  model.context.from_dict(terms)) for alpha, terms in groups.items()]
+        if len(_DET_A_SPLITS) > 64:
+            _DET_A_SPLITS.clear()
+        hit = _DET_A_SPLITS[id(model)] = (model, split)
+    return hit[1]
+
+
+_LIMIT_BALLS: dict = {}
+
+
+def _limit_balls(limits) -> tuple[arb, arb]:
+    """The balls of a prismatic joint's rational limits (exact when dyadic), once per
+    limits and working precision: feasibility proofs compare against them thousands of
+    times."""
+    key = (tuple(limits), ctx.prec)
+    hit = _LIMIT_BALLS.get(key)
+    if hit is None:
+        if len(_LIMIT_BALLS) > 256:
+            _LIMIT_BALLS.clear()
+        hit = _LIMIT_BALLS[key] = tuple(fraction_ball(v) for v in limits)
+    return hit
+
+
 def inside_limits(leg: Leg, value, limits) -> bool | None:
     """Strictly inside (True), outside (False) or undecided (None).  For an angle θ and
     limits [lo, hi] of width w < 2π with middle m: θ is inside (mod 2π) exactly when
@@ -218,7 +260,7 @@ def inside_limits(leg: Leg, value, limits) -> bool | None:
         mid = (lo + hi) / 2
         margin = value[0] * mid.cos() + value[1] * mid.sin() - (width / 2).cos()
         return True if margin > 0 else False if margin < 0 else None
-    lo, hi = (fraction_ball(v) for v in limits)
+    lo, hi = _limit_balls(limits)
     if value > lo and value < hi:
         return True
     if value < lo or value > hi:
@@ -261,6 +303,32 @@ class PathModel:
         point += list(pose)
         point += [b for _, b in sorted(radical_balls(model.context, signs).items())]
         return evaluate(model.det_A, point)
+
+    def det_A_modes(self, joints_by_mode: dict, pose: list[arb],
+                    signs: dict[int, int] | None = None) -> dict:
+        """:meth:`det_A` for several modes at the same pose in one pass: det A is written
+        once as Σ_α q_α(pose) ρ^α (ρ the joint variables), each q_α is enclosed once at
+        the pose, and each mode only sums its few joint monomials.  The same polynomial,
+        grouped differently: every enclosure is as rigorous as :meth:`det_A`'s."""
+        model = self.projection.model
+        split = _det_a_by_joints(model)
+        n_joint = len(model.joint_variables)
+        point = [arb(0)] * n_joint + list(pose)
+        point += [b for _, b in sorted(radical_balls(model.context, signs).items())]
+        factors = [evaluate(q, point) for _, q in split]
+        out = {}
+        for label, joints in joints_by_mode.items():
+            flat: list = []
+            for j in joints:
+                flat += list(j) if isinstance(j, tuple) else [j]
+            total = arb(0)
+            for (alpha, _), factor in zip(split, factors, strict=True):
+                term = factor
+                for v, e in alpha:
+                    term = term * (flat[v] if e == 1 else flat[v] ** e)
+                total = total + term
+            out[label] = total
+        return out
 
     def conjugate_branches(self, t: arb, pose: list[arb], signs: dict[int, int]):
         """Per leg, the branches of the conjugate robot (its square roots' signs flipped
@@ -309,6 +377,12 @@ def _primes_of(*polys) -> set[int]:
     return out
 
 
+def _free_of_radicals(p: fmpq_mpoly) -> bool:
+    """``p`` (in a path ring) involves no ``sqrt(q)`` variable: it lives in Q[t, s, c]."""
+    names = p.context().names()
+    return all(p.degrees()[i] <= 0 for i, v in enumerate(names) if v not in ("t", "s", "c"))
+
+
 def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
                          where: dict | None = None) -> fmpq_mpoly:
     """μ(t) without ξ(X): substitute X = φ(t) first, then eliminate the joints.
@@ -324,7 +398,9 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
     one parameter (and s, c) are formed, never ξ(X) in every pose variable.  A path with
     square roots of its own is refused (they would be conjugated with the robot's).
     """
-    if any(x.context() is not TRIG for x in coordinates):
+    if all(_free_of_radicals(x) for x in coordinates):
+        coordinates = tuple(restrict(x, TRIG) for x in coordinates)
+    else:
         raise UnsupportedRobotError(
             "ξ(X) was not expanded and this path has square roots of its own (sqrt, or an "
             "angle offset like pi/6): eliminating along it is not supported yet",
@@ -339,6 +415,20 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
     det_a = model.det_A.compose(*args, ctx=ring)
     legs = [(v, f.compose(*args, ctx=ring)) for v, f in norm_legs(model)]
     return reduce_trig(restrict(norm_chain(det_a, legs), TRIG))
+
+
+_LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}
+
+
+def _leg_coefficients(leg: Leg) -> tuple[fmpq_mpoly, ...]:
+    """:func:`~singcheck.model.robot.leg_coefficients`, once per leg of a model (the same
+    legs serve every path of a batch); the entry keeps the leg, so its id is not reused."""
+    hit = _LEG_COEFFICIENTS.get(id(leg))
+    if hit is None or hit[0] is not leg:
+        if len(_LEG_COEFFICIENTS) > 256:
+            _LEG_COEFFICIENTS.clear()
+        hit = _LEG_COEFFICIENTS[id(leg)] = (leg, leg_coefficients(leg))
+    return hit[1]
 
 
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
@@ -381,7 +471,8 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
         mu = eliminate_along_path(model, coordinates, where)
     legs = []
     for leg in model.legs:
-        coeffs = tuple(compose_pose(c, coordinates, pose_vars) for c in leg_coefficients(leg))
+        in_pose_coeffs = _leg_coefficients(leg)
+        coeffs = tuple(compose_pose(c, coordinates, pose_vars) for c in in_pose_coeffs)
         disc = leg_discriminant(leg, coeffs)
         limits = {}
         if leg.kind == REVOLUTE and leg.joint in spec.joint_limits:

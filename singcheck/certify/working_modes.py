@@ -213,13 +213,24 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
     undecided = []
+    on_limit: dict = {}  # limit value -> w = 2aL + b, for a limit some branch sits on
     for value in limits:
         if value not in crossings:
             crossings[value] = _isolate(leg.limit_polynomial(value), interval, tolerance)
         iso = crossings[value]
         if iso is None:
-            return BranchFeasibility(joint, label, UNKNOWN,
-                                     f"a branch of {joint} sits on its limit {value} all along")
+            if leg.revolute:
+                return BranchFeasibility(joint, label, UNKNOWN,
+                                         f"a branch of {joint} sits on its limit {value} "
+                                         "all along")
+            if leg.leg.degree == 1:  # the only branch is the limit all along: inside
+                return BranchFeasibility(joint, label, FEASIBLE)
+            w = _switch_polynomial(leg, value)
+            on_limit[value] = w
+            iso = _isolate(w, interval, tolerance)
+            if iso is None:  # D = w² ≡ 0: the branches coincide (found by step 1)
+                return BranchFeasibility(joint, label, UNKNOWN,
+                                         f"both branches of {joint} sit on its limit {value}")
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
     for box in undecided:
@@ -232,6 +243,8 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         for prec in _PRECISIONS:
             with working_precision(prec):
                 verdict = leg.inside(leg.branches(point)[label], limits)
+                if verdict is None and _sits_on_limit(leg, label, on_limit, point):
+                    verdict = True  # exactly on a (closed) limit over this whole gap
             if verdict is not None:
                 break
         if verdict is None:
@@ -245,6 +258,26 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
                 f"{joint} leaves {bounds} at t ≈ {when(crossing)}"
             return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing)
     return BranchFeasibility(joint, label, FEASIBLE)
+
+
+def _switch_polynomial(leg: LegAlongPath, value) -> object:
+    """w = 2aL + b(t) for a limit L that the leg constraint has as a root all along
+    (a L² + b L + c ≡ 0).  Then D = b² - 4ac = w², so √D = |w| and the branch with sign
+    σ is exactly L where σ·w ≥ 0 and L - w/a (≠ L) where σ·w < 0: the roots of w are
+    where a branch gets on or off the limit, the events that replace the limit's
+    crossings."""
+    from flint import fmpq
+
+    a, b, _ = leg.coefficients
+    return b + 2 * a * fmpq(value.numerator, value.denominator)
+
+
+def _sits_on_limit(leg: LegAlongPath, label: str, on_limit: dict, point: arb) -> bool:
+    """True when the branch equals one of the limits in ``on_limit`` exactly at ``point``
+    (σ·w(point) > 0, proven; see :func:`_switch_polynomial`), hence over the whole gap
+    between two roots of w that holds it."""
+    sigma = 1 if label == "+" else -1
+    return any(sigma * evaluate_path(w, point) > 0 for w in on_limit.values())
 
 
 def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibility]]:

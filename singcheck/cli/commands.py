@@ -331,9 +331,7 @@ def _plot_all(machine, specs, tolerance: float, out_dir: str, progress) -> list:
         raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
                         "missing): pip install 'singcheck[plot]'") from None
     from singcheck import api
-    from singcheck.model.robot import require_polynomial
 
-    require_polynomial(machine.model, "plotting")
     written = []
     for spec in specs:
         report = api.check(machine, spec, tolerance=tolerance, regions=False)
@@ -351,9 +349,7 @@ def _plot_html(machine, specs, out_dir: str):
         raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
                         "pip install 'singcheck[html]'") from None
     from singcheck import api
-    from singcheck.model.robot import require_polynomial
 
-    require_polynomial(machine.model, "plotting")
     reports = [api.check(machine, s, regions=False).certificate for s in specs]
     return write_html(reports, os.path.join(out_dir, "singcheck.html"))
 
@@ -384,9 +380,11 @@ Examples:
 def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
-    and the working modes in joint space with the joint-limit box (PNG and SVG).
-    With --regions, draw a plane of the workspace or joint space coloured by the
-    exact number of solutions of each region."""
+    and the working modes in joint space with the joint-limit box (PNG and SVG); when
+    the robot spec has a drawing, the robot at the start and at each proven singular
+    time (and, with --format html, animated along the path).
+    With --regions, draw a plane of the workspace or joint space: each region filled by
+    its exact number of solutions and labelled, the discriminant variety's curves."""
     require_extra("html" if fmt == "html" else "plot")
     progress = Progress(quiet)
     with exit_codes():

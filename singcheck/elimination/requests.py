@@ -15,6 +15,7 @@ from typing import Protocol
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import coefficient_in, squarefree_part
+from singcheck.algebra.radicals import radical_prime
 
 
 @dataclass(frozen=True)
@@ -67,8 +68,14 @@ def leg_structure(request: EliminationRequest):
     with a generator f_v that involves no other eliminated variable and has a constant
     leading coefficient in v, or an angle's pair ``(cos(v), sin(v))`` (then ``v`` in the
     list is that pair) with the circle ``cos² + sin² - 1`` among the generators and one
-    generator ``a·cos + b·sin + d`` involving no other eliminated variable."""
+    generator ``a·cos + b·sin + d`` involving no other eliminated variable.
+
+    Square roots ``sqrt(p)`` being eliminated (after the joints: a robot's √3 with its
+    pseudo-leg ``sqrt(p)² - p``) may appear in a joint's leg: the chain eliminates the
+    joints first, then each square root by its monic pseudo-leg, so it is still the norm
+    (a linear Delta's rail at (-1/2, √3/2) keeps its legs)."""
     names = request.context.names()
+    radicals = {v for v in request.eliminate if radical_prime(v) is not None}
     pairs = _circle_pairs(request)
     partners = set(pairs.values())
     circles = {c for c, s in pairs.items()
@@ -77,6 +84,7 @@ def leg_structure(request: EliminationRequest):
     rest = []
     for f in request.generators:
         involved = [v for v in request.eliminate if f.degrees()[names.index(v)] > 0]
+        involved = [v for v in involved if v not in radicals] or involved
         pair = [c for c in pairs if set(involved) <= {c, pairs[c]}] if involved else []
         if pair and len(involved) == 2 and _is_circle(f, *(names.index(v) for v in involved)):
             continue  # the circle of that angle

@@ -54,6 +54,33 @@ def numpy_polynomial(poly):
     return f
 
 
+def named_arrays(ctx, table: dict) -> list:
+    """The values of ``ctx``'s variables by name, for :func:`numpy_polynomial`: from
+    ``table``, an angle's ``cos(v)``/``sin(v)`` from ``table[v]`` when only the angle is
+    there, a ``sqrt(p)`` as √p, anything else 0 (drawing only)."""
+    import math
+
+    from singcheck.algebra.radicals import radical_prime
+
+    out = []
+    for name in ctx.names():
+        if name in table:
+            out.append(table[name])
+        elif name.startswith(("cos(", "sin(")) and name[4:-1] in table:
+            out.append((np.cos if name[0] == "c" else np.sin)(table[name[4:-1]]))
+        elif radical_prime(name) is not None:
+            out.append(math.sqrt(radical_prime(name)))
+        else:
+            out.append(0.0)
+    return out
+
+
+def _along(p, t: np.ndarray) -> np.ndarray:
+    """A path polynomial (in t, s = sin t, c = cos t and square roots) at the times t."""
+    return numpy_polynomial(p)(named_arrays(p.context(), {"t": t, "s": np.sin(t),
+                                                          "c": np.cos(t)}))
+
+
 @dataclass
 class FigureData:
     t: np.ndarray
@@ -70,23 +97,53 @@ class FigureData:
 
 
 def _sample_piece(path, n: int):
-    """Samples of one piece in its own time: (own t, pose, μ, joints per leg branch)."""
+    """Samples of one piece in its own time: (own t, pose, μ, joints per leg branch, the
+    model's pose variables).  A pose angle is in radians (its π offset included); a
+    revolute branch is its (cos θ, sin θ) pair of arrays."""
+    from singcheck.model.robot import REVOLUTE
+
     lo, hi = float(path.trajectory.range.start), float(path.trajectory.range.end)
     t = np.linspace(lo, hi, n)
-    tsc = [t, np.sin(t), np.cos(t)]
-    pose = [numpy_polynomial(p)(tsc) for p in path.phi]
-    mu = numpy_polynomial(path.mu)(tsc)
+    offsets = path.trajectory.angle_offsets
+    model = path.projection.model
+    pose = [_along(p, t) + np.pi * float(offsets.get(v, 0))
+            for v, p in zip(model.pose, path.phi, strict=True)]
+    variables = [_along(x, t) for x in path.coordinates] if path.coordinates else pose
+    mu = _along(path.mu, t)
     legs = []
     for leg in path.legs:
-        values = [numpy_polynomial(c)(tsc) for c in leg.coefficients]
-        if len(values) == 2:
+        values = [_along(c, t) for c in leg.coefficients]
+        if leg.leg.kind == REVOLUTE:
+            a, b, dd = values
+            w = a * a + b * b
+            with np.errstate(invalid="ignore"):
+                root = np.sqrt(_along(leg.discriminant, t))
+            legs.append({label: ((-a * dd + sigma * b * root) / w,
+                                 (-b * dd - sigma * a * root) / w)
+                         for label, sigma in (("+", 1), ("-", -1))})
+        elif len(values) == 2:
             legs.append({"o": -values[1] / values[0]})
         else:
             a, b, c = values
             with np.errstate(invalid="ignore"):
                 root = np.sqrt(b * b - 4 * a * c)
             legs.append({"+": (-b + root) / (2 * a), "-": (-b - root) / (2 * a)})
-    return t, pose, mu, legs
+    return t, pose, mu, legs, variables
+
+
+def _joined(arrays: list):
+    """Pieces' samples end to end (a revolute branch's (cos, sin) pairs pairwise)."""
+    if isinstance(arrays[0], tuple):
+        return tuple(np.concatenate([a[k] for a in arrays]) for k in range(2))
+    return np.concatenate(arrays)
+
+
+def _pair(value) -> tuple:
+    return value if isinstance(value, tuple) else (value,)
+
+
+def _display(value) -> np.ndarray:
+    return np.arctan2(value[1], value[0]) if isinstance(value, tuple) else value
 
 
 def _to_user_time(spec, t: np.ndarray) -> np.ndarray:
@@ -109,12 +166,23 @@ def figure_data(report: TrajectoryReport, samples: int = 2000) -> FigureData:
     pose = [np.concatenate([part[1][i] for part in parts]) for i in range(len(model.pose))]
     mu = np.concatenate([part[2] for part in parts])
     mu = mu / (np.max(np.abs(mu)) or 1.0)
-    legs = [{label: np.concatenate([part[3][i][label] for part in parts])
+    legs = [{label: _joined([part[3][i][label] for part in parts])
              for label in parts[0][3][i]} for i in range(len(model.legs))]
-    joints = {m.label: [legs[i][ch] for i, ch in enumerate(m.label)] for m in report.modes}
+    # displayed joints: a revolute branch as its angle atan2(sin, cos)
+    joints = {m.label: [_display(legs[i][ch]) for i, ch in enumerate(m.label)]
+              for m in report.modes}
+    variables = [np.concatenate([part[4][i] for part in parts])
+                 for i in range(len(parts[0][4]))]
+    pose_names = [v for p in model.pose for v in model.spec.variables(p)]
     det = numpy_polynomial(model.det_A)
     feasible = [m.label for m in report.modes if m.feasible]
-    det_a = {label: det([*joints[label], *pose]) for label in feasible}
+    det_a = {}
+    for label in feasible:
+        table = dict(zip(pose_names, variables, strict=True))
+        for leg, ch in zip(model.legs, label, strict=True):
+            table.update(zip(leg.variables, _pair(legs[model.legs.index(leg)][ch]),
+                             strict=True))
+        det_a[label] = det(named_arrays(model.det_A.context(), table))
     singular = {m.label: [float(c.t.mid()) for c in m.singular_times] for m in report.modes
                 if m.feasible}
     candidates = []
@@ -186,7 +254,8 @@ def _workspace_figure(plt, d: FigureData, xi, title: str):
         (x0, x1), (y0, y1) = _box(d.pose[0]), _box(d.pose[1])
         gx, gy = np.meshgrid(np.linspace(x0, x1, 300), np.linspace(y0, y1, 300))
         if f is not None:
-            ax.contour(gx, gy, f([gx, gy]), levels=[0], colors="orange")
+            ax.contour(gx, gy, f(named_arrays(xi.context(), {pose[0]: gx, pose[1]: gy})),
+                       levels=[0], colors="orange")
         ax.plot(d.pose[0], d.pose[1], color="black", lw=1)
         _mark_points(ax, d, 2)
         ax.set_xlabel(pose[0])
@@ -200,8 +269,8 @@ def _workspace_figure(plt, d: FigureData, xi, title: str):
         n = 48
         axes = [np.linspace(a, b, n) for a, b in boxes]
         grid = list(np.meshgrid(*axes, indexing="ij"))
-        values = f(grid + [np.zeros_like(grid[0])] * (len(pose) - 3)) if f is not None \
-            else np.ones_like(grid[0])
+        values = f(named_arrays(xi.context(), dict(zip(pose, grid, strict=False)))) \
+            if f is not None else np.ones_like(grid[0])
         if values.min() < 0 < values.max():
             verts, faces, _, _ = marching_cubes(values, 0.0)
             verts = np.array([b[0] for b in boxes]) + verts * np.array(

@@ -22,9 +22,7 @@ from flint import acb, arb, fmpq
 
 from singcheck.algebra.intervals import evaluate
 from singcheck.algebra.radicals import angle_names, radical_prime
-from singcheck.algebra.trig import evaluate_trig
 from singcheck.certify.classification import TrajectoryReport
-from singcheck.certify.path import compose_pose
 from singcheck.spec.files import RobotSpec
 
 
@@ -52,20 +50,25 @@ def _mid(value) -> float:
     return float(arb(value).mid())
 
 
-def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:
-    """The drawing at these joint and pose values (balls, or anything ``arb`` takes; an
-    angle in radians), each spec variable by name: an angle's ``cos(v)``, ``sin(v)``
-    and a parameter's ``sqrt(p)`` are enclosed by Arb."""
-    given = {n: v if isinstance(v, (arb, acb)) else arb(v)
-             for n, v in zip((*spec.joints, *spec.pose), (*joints, *pose), strict=True)}
+def _values(spec: RobotSpec, joints: list, pose: list) -> list:
+    """Balls of the spec's variables, in its context's order, from joint and pose values
+    (balls or anything ``arb`` takes; an angle in radians, or a revolute branch's
+    (cos θ, sin θ) pair): an angle's ``cos(v)``, ``sin(v)`` and a parameter's ``sqrt(p)``
+    are enclosed by Arb."""
     named = {}
-    for n, v in given.items():
+    for n, v in zip((*spec.joints, *spec.pose), (*joints, *pose), strict=True):
         if n in spec.angles:
-            named.update(zip(angle_names(n), (v.cos(), v.sin()), strict=True))
+            pair = v if isinstance(v, tuple) else (arb(v).cos(), arb(v).sin())
+            named.update(zip(angle_names(n), pair, strict=True))
         else:
-            named[n] = v
-    values = [named[n] if n in named else arb(radical_prime(n)).sqrt()
-              for n in spec.context.names()]
+            named[n] = v if isinstance(v, (arb, acb)) else arb(v)
+    return [named[n] if n in named else arb(radical_prime(n)).sqrt()
+            for n in spec.context.names()]
+
+
+def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:
+    """The drawing at these joint and pose values (see :func:`_values`)."""
+    values = _values(spec, joints, pose)
 
     def point(coords) -> list[float]:
         return [_mid(evaluate(c, values)) for c in coords]
@@ -112,7 +115,8 @@ def drawing_at(report: TrajectoryReport, label: str, t: arb,
     path, local = _on_piece(report, index, t)
     per_leg = [leg.branches(local) for leg in path.legs]
     joints = [per_leg[i][ch] for i, ch in enumerate(label)]
-    if any(j is None or isinstance(j, acb) for j in joints):
+    if any(j is None or isinstance(j, acb) or isinstance(j, tuple) and
+           not all(isinstance(v, arb) for v in j) for j in joints):
         return None
     return draw_bodies(path.projection.model.spec, joints, path.pose_at(local))
 
@@ -148,6 +152,7 @@ def traced_points(report: TrajectoryReport, t: np.ndarray) -> list[np.ndarray]:
     joint_index = [spec.context.names().index(v) for v in spec.joint_variables]
     located = [(piece_index(report, float(x)), float(x)) for x in t]
     located = [(i, _on_piece(report, i, arb(x))) for i, x in located]
+
     def pose_only(p) -> bool:
         return not any(c.degrees()[i] for c in p for i in joint_index) and \
             not all(c.is_constant() for c in p)
@@ -156,17 +161,14 @@ def traced_points(report: TrajectoryReport, t: np.ndarray) -> list[np.ndarray]:
     # every end point of a segment that does
     traced = [p for body in spec.drawing for p in body.points if pose_only(p)] or \
         [q for body in spec.drawing for chain in body.chains for q in chain if pose_only(q)]
+    samples = [_values(spec, [arb(0)] * len(spec.joints), path.pose_at(local))
+               for _, (path, local) in located]
     seen, out = set(), []
     for p in traced:
         if tuple(map(str, p)) not in seen:
             seen.add(tuple(map(str, p)))
-            along: dict[int, list] = {}
-            rows = []
-            for i, (path, local) in located:
-                if i not in along:
-                    along[i] = [compose_pose(c, path.phi, model.pose) for c in p]
-                rows.append([_mid(evaluate_trig(c, local)) for c in along[i]])
-            out.append(np.array(rows))
+            out.append(np.array([[_mid(evaluate(c, values)) for c in p]
+                                 for values in samples]))
     return out
 
 
@@ -181,6 +183,30 @@ def drawing_box(drawings: list[list[DrawnBody]], traces: list[np.ndarray]) -> np
     lo, hi = allp.min(axis=0), allp.max(axis=0)
     centre, half = (lo + hi) / 2, max(float(np.max(hi - lo)) / 2, 0.5) * 1.08
     return np.stack([centre - half, centre + half], axis=1)
+
+
+def _shade_common_plane(ax, bodies: list[DrawnBody]) -> None:
+    """When every moving point of a 3-D posture lies in one plane (the Orthoglide's legs
+    at a parallel singularity), shade their convex hull in that plane (drawing only)."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = [b.points for b in bodies if not b.fixed] + \
+        [c for b in bodies if not b.fixed for c in b.chains]
+    pts = np.unique(np.round(np.concatenate([q for q in pts if len(q)]), 12), axis=0)
+    if len(pts) < 4:
+        return
+    centre = pts.mean(axis=0)
+    _, sv, basis = np.linalg.svd(pts - centre)
+    if sv[2] > 1e-6 * sv[0]:
+        return  # not coplanar
+    flat = (pts - centre) @ basis[:2].T
+    try:
+        hull = ConvexHull(flat)
+    except QhullError:
+        return
+    ax.add_collection3d(Poly3DCollection([pts[hull.vertices]], facecolor=_SINGULAR,
+                                         alpha=0.12, edgecolor=_SINGULAR, linewidth=0.6))
 
 
 def posture_figure(plt, report: TrajectoryReport, title: str, samples: int = 600):
@@ -203,6 +229,8 @@ def posture_figure(plt, report: TrajectoryReport, title: str, samples: int = 600
     for k, post in enumerate(posts):
         ax = fig.add_subplot(rows, cols, k + 1, **({"projection": "3d"} if dim == 3 else {}))
         singular = post.kind == "singular"
+        if singular and dim == 3:
+            _shade_common_plane(ax, post.bodies)
         for trace in traces:
             ax.plot(*trace.T, color="grey", lw=0.8, ls="--")
         moving = 0

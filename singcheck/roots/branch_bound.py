@@ -6,14 +6,28 @@ strictly monotone (the one-dimensional interval-Newton uniqueness condition), so
 proven sign change at its ends proves exactly one root there and equal signs prove
 none; a root met exactly at a box end is kept.  Boxes that stay ambiguous down to the
 minimum width become :class:`~singcheck.roots.Undecided`, with the reason.
+
+**Roots at multiples of π, of any multiplicity.**  At t = kπ, sin t and cos t are
+exact (0, ±1), so whether F and its derivatives vanish there is decided exactly: at
+t = 0 by rational evaluation; at t = kπ, k ≠ 0, F(t, 0, ±1) is a polynomial in t with
+rational coefficients and π is transcendental, so it vanishes at kπ only when it is the
+zero polynomial.  When F, F', …, F⁽ᵐ⁻¹⁾ vanish at z = kπ and F⁽ᵐ⁾ is enclosed away from
+0 on a box B around z, Taylor's theorem with the Lagrange remainder,
+F(t) = F⁽ᵐ⁾(ξ)(t - z)ᵐ/m!, proves z the only root in B, of multiplicity m (a tangency
+when m is even).  B is then taken out of the branch-and-bound, which could never prove
+a multiple root.  (By the Lindemann–Weierstrass theorem these are the only algebraic
+times where a function genuinely mixing t with sin t, cos t can vanish.)
 """
 
 from __future__ import annotations
 
+import math
+from fractions import Fraction
+
 from flint import arb, fmpq, fmpq_mpoly
 
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
-from singcheck.algebra.trig import TimeRange, derivative, evaluate_trig
+from singcheck.algebra.trig import LinearInPi, TimeRange, derivative, evaluate_trig
 from singcheck.budget import checkpoint
 from singcheck.roots.enclosures import (
     BRANCH_AND_BOUND,
@@ -22,8 +36,9 @@ from singcheck.roots.enclosures import (
     Undecided,
     inside_range,
     locate_root,
+    point_time,
 )
-from singcheck.roots.rational import arb_to_fmpq, exact_tolerance, rational_ball
+from singcheck.roots.rational import arb_to_fmpq, bits_for, exact_tolerance, rational_ball
 
 _MAX_BOXES = 200_000
 _SPLIT = fmpq(1, 2) - fmpq(1, 97)  # off-centre, so a root rarely sits on a split point
@@ -67,12 +82,75 @@ def _bisect_root(p, lo: fmpq, hi: fmpq, s_lo: int, width: fmpq) -> tuple[fmpq, f
     return lo, hi
 
 
+_MAX_ORDER = 64
+
+
+def _vanishes_at_multiple_of_pi(p: fmpq_mpoly, k: int) -> bool:
+    """Exactly: p(kπ, 0, (-1)^k) = 0 (see the module docstring)."""
+    q = p.subs({"s": 0, "c": 1 if k % 2 == 0 else -1})
+    if k == 0:
+        q = q.subs({"t": 0})
+    return q.is_zero()
+
+
+def _exact_zeros(p: fmpq_mpoly, interval: TimeRange) -> list[tuple[int, int, fmpq, fmpq]]:
+    """(k, m, a, b): t = kπ in the range is a root of multiplicity m, the only one in the
+    rational box [a, b] (proven by the Taylor argument of the module docstring)."""
+    start, end = float(interval.start), float(interval.end)
+    out = []
+    for k in range(math.floor(start / math.pi) - 1, math.ceil(end / math.pi) + 2):
+        if not _vanishes_at_multiple_of_pi(p, k):
+            continue
+        with working_precision(128):
+            z = k * arb.pi()
+        if not inside_range(z, LinearInPi(Fraction(0), Fraction(k)), interval, 128):
+            continue
+        dk, order = p, 0
+        while order < _MAX_ORDER and _vanishes_at_multiple_of_pi(dk, k):
+            checkpoint()
+            dk, order = derivative(dk), order + 1
+        if _vanishes_at_multiple_of_pi(dk, k):
+            continue
+        for e in range(1, 64):
+            checkpoint()
+            with working_precision(128):
+                a = arb_to_fmpq((z - arb(2) ** -e).lower())
+                b = arb_to_fmpq((z + arb(2) ** -e).upper())
+            if excludes_zero(_eval(dk, a, b)):
+                out.append((k, order, a, b))
+                break
+    return out
+
+
+def _without(lo: fmpq, hi: fmpq, boxes: list[tuple[fmpq, fmpq]]) -> list[tuple[fmpq, fmpq]]:
+    """[lo, hi] minus the open insides of the boxes (sorted, disjoint)."""
+    pieces, at = [], lo
+    for a, b in sorted(boxes):
+        if a > at:
+            pieces.append((at, min(a, hi)))
+        at = max(at, b)
+    if at < hi:
+        pieces.append((at, hi))
+    return [(x, y) for x, y in pieces if x < y]
+
+
+def _exact_root(k: int, order: int) -> RealRoot:
+    def make(tol: float) -> arb:
+        with working_precision(bits_for(tol)):
+            return k * arb.pi()
+
+    time = point_time(Fraction(0) if k == 0 else None, 0, 1 if k % 2 == 0 else -1)
+    return RealRoot(arb(0) if k == 0 else make(1e-9), order, None if k == 0 else make,
+                    exact=time)
+
+
 def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
     dp = derivative(p)
     a, b = interval.start.ball(), interval.end.ball()
     lo0, hi0 = arb_to_fmpq(a.lower()), arb_to_fmpq(b.upper())
     min_width = exact_tolerance(max(tolerance, 1e-12) / 1000)
-    stack = [(lo0, hi0)]
+    exact_zeros = _exact_zeros(p, interval)
+    stack = _without(lo0, hi0, [(za, zb) for _, _, za, zb in exact_zeros])[::-1]
     found: list[tuple[fmpq, fmpq]] = []
     exact_points: list[fmpq] = []
     zero = fmpq(0)
@@ -115,11 +193,13 @@ def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Ro
             continue
         cut = lo + (hi - lo) * _SPLIT
         stack += [(cut, hi), (lo, cut)]
-    return _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambiguous)
+    return _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambiguous,
+                                    [_exact_root(k, order) for k, order, _, _ in exact_zeros])
 
 
-def _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambiguous):
-    roots, undecided = [], []
+def _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambiguous,
+                             exact_roots):
+    roots, undecided = list(exact_roots), []
     for lo, hi, s_lo in found:
         bracket = {"lo": lo, "hi": hi}
 
@@ -138,7 +218,8 @@ def _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambigu
         t = arb(q)
         where = inside_range(t, None, interval, 53)
         if where:
-            roots.append(RealRoot(t, None, None))
+            roots.append(RealRoot(t, None, None, exact=point_time(Fraction(0), 0, 1)
+                                  if q == 0 else None))
     for lo, hi, reason in _merge(ambiguous):
         box = rational_ball(lo, hi)
         undecided.append(Undecided(box, f"{reason} near t ≈ {float(box.mid()):.6g}"))

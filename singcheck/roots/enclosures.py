@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from fractions import Fraction
 
 from flint import arb
 
@@ -33,6 +34,39 @@ class IdenticallyZeroError(SingcheckError):
     """The function is identically zero along the path: it has no isolated roots."""
 
 
+#: kinds of :class:`ExactTime`
+IN_T, IN_U, AT_POINT = "t", "u", "point"
+
+
+@dataclass(frozen=True)
+class ExactTime:
+    """A root's time as an exact algebraic number, for exact decisions at that root.
+
+    * ``IN_T``: t = α, the root of a squarefree polynomial in t isolated by a rational
+      interval (polynomial paths);
+    * ``IN_U``: t = 2·atan(α) + 2kπ, α the root of a squarefree polynomial in
+      u = tan(t/2) isolated by a rational interval (paths in sin t, cos t only), so
+      s = 2α/(1+α²) and c = (1-α²)/(1+α²);
+    * ``AT_POINT``: s and c are exact rationals (t = kπ), and so is t when it is 0
+      (``t_value``); ``None`` means t is a non-zero multiple of π (not rational).
+
+    ``locate()`` returns the :class:`~singcheck.roots.rational.RationalRoot` of α (its
+    squarefree polynomial and isolating interval): built lazily, since only the roots
+    that ball arithmetic could not decide need it.
+    """
+
+    kind: str
+    locate: Callable[[], tuple] | None = field(default=None, compare=False, repr=False)
+    s: Fraction | None = None
+    c: Fraction | None = None
+    t_value: Fraction | None = None
+
+
+def point_time(t: Fraction | None, s: int, c: int) -> ExactTime:
+    """The exact time of a root at t = kπ (s, c in {0, ±1}; t rational only when 0)."""
+    return ExactTime(AT_POINT, None, Fraction(s), Fraction(c), t)
+
+
 @dataclass(frozen=True)
 class RealRoot:
     t: arb  # holds exactly one root in the range
@@ -41,12 +75,14 @@ class RealRoot:
     # (i, k): this root is exactly the method's i-th root of a 2π-periodic function
     # shifted by 2kπ (tangent half-angle roots); None when not known to be one
     period: tuple[int, int] | None = field(default=None, compare=False)
+    exact: ExactTime | None = field(default=None, compare=False, repr=False)
 
     def refined(self, tolerance: float) -> RealRoot:
         """The same root in a ball of width at most ``tolerance`` (when refinable)."""
         if self._refine is None or 2 * float(self.t.rad()) <= tolerance:
             return self
-        return RealRoot(self._refine(tolerance), self.multiplicity, self._refine, self.period)
+        return RealRoot(self._refine(tolerance), self.multiplicity, self._refine,
+                        period=self.period, exact=self.exact)
 
 
 @dataclass(frozen=True)

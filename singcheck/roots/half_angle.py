@@ -17,7 +17,17 @@ from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.trig import LinearInPi, TimeRange
-from singcheck.roots.enclosures import HALF_ANGLE, RealRoot, RootIsolation, Undecided, locate_root
+from singcheck.budget import checkpoint
+from singcheck.roots.enclosures import (
+    HALF_ANGLE,
+    IN_U,
+    ExactTime,
+    RealRoot,
+    RootIsolation,
+    Undecided,
+    locate_root,
+    point_time,
+)
 from singcheck.roots.rational import (
     RationalRoot,
     bits_for,
@@ -25,35 +35,38 @@ from singcheck.roots.rational import (
     real_roots_exact,
 )
 
-_ONE_PLUS_U2, _ONE_MINUS_U2, _TWO_U = (fmpq_poly(c) for c in ([1, 0, 1], [1, 0, -1], [0, 2]))
+_TWO_U = fmpq_poly([0, 2])
 
 
 
-def _half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
+def half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
     """M(u) = (1+u²)^d · p(2u/(1+u²), (1-u²)/(1+u²)) and d (p reduced, free of t).
 
-    With p = P₀(c) + s·P₁(c), M = H(P₀, d) + 2u·H(P₁, d-1) where
-    H(Σ aₖcᵏ, n) = Σ aₖ (1-u²)ᵏ (1+u²)ⁿ⁻ᵏ, summed by Horner's rule in 1-u²
-    (exact rational arithmetic throughout).
+    With p = P₀(c) + s·P₁(c), M = H(P₀, d)(u²) + 2u·H(P₁, d-1)(u²) where
+    H(Σ aₖcᵏ, n)(w) = Σ aₖ (1-w)ᵏ (1+w)ⁿ⁻ᵏ, a polynomial in w = u² (exact rational
+    arithmetic throughout).  Writing c = (1-w)/(1+w) = -1 + 2y with y = 1/(1+w),
+    (1+w)^m P(c) = y^(-m) P(-1 + 2y) is the reversal of P(-1 + 2y) taken at 1 + w: two
+    compositions with linear polynomials in FLINT and a reversal.
     """
     d = max((j + k for (_i, j, k), _ in p.terms()), default=0)
     by_s: list[dict[int, fmpq]] = [{}, {}]
     for (_i, j, k), c in p.terms():
         by_s[j][k] = c
-    one_plus = [fmpq_poly([1])]
-    for _ in range(d):
-        one_plus.append(one_plus[-1] * _ONE_PLUS_U2)
 
     def homogenised(coeffs: dict[int, fmpq], n: int) -> fmpq_poly:
         if not coeffs:
             return fmpq_poly([])
         top = max(coeffs)
-        r = fmpq_poly([coeffs[top]])
-        for k in range(top - 1, -1, -1):
-            r = r * _ONE_MINUS_U2 + coeffs.get(k, 0) * one_plus[top - k]
-        return r * one_plus[n - top]
+        shifted = fmpq_poly([coeffs.get(k, 0) for k in range(top + 1)])(_MINUS_ONE_PLUS_2Y)
+        cs = list(shifted.coeffs()) + [fmpq(0)] * (top + 1 - len(shifted.coeffs()))
+        return fmpq_poly(cs[::-1])(_ONE_PLUS_W) * _ONE_PLUS_W ** (n - top)
 
-    return homogenised(by_s[0], d) + _TWO_U * homogenised(by_s[1], d - 1), d
+    even = homogenised(by_s[0], d)(_U2)
+    odd = homogenised(by_s[1], d - 1)(_U2) if by_s[1] else fmpq_poly([])
+    return even + _TWO_U * odd, d
+
+
+_MINUS_ONE_PLUS_2Y, _ONE_PLUS_W, _U2 = (fmpq_poly(c) for c in ([-1, 2], [1, 1], [0, 0, 1]))
 
 
 @dataclass(frozen=True)
@@ -63,6 +76,7 @@ class _HalfAngleRoot:
     ball: Callable[[float], arb]
     exact: LinearInPi | None
     multiplicity: int
+    time: ExactTime | None = None  # α = u₀ exactly, for exact decisions at the root
 
 
 def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
@@ -82,7 +96,8 @@ def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
         for q in (fmpq(0), fmpq(1), fmpq(-1)):  # u = 0, ±1 (t = 0, ±π/2) are exact
             rr.pin(q)
         if rr.lo == rr.hi == 0:  # u = 0 exactly: t = 0 (Arb's k-th root of 0 is NaN)
-            out.append(_HalfAngleRoot(lambda tol: arb(0), LinearInPi(Fraction(0)), mult * k))
+            out.append(_HalfAngleRoot(lambda tol: arb(0), LinearInPi(Fraction(0)), mult * k,
+                                      ExactTime(IN_U, lambda rr=rr: rr)))
             continue
         positive = rr.lo >= 0
         if not positive and k % 2 == 0:
@@ -92,8 +107,40 @@ def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
             exact = None
             if rr.lo == rr.hi and abs(rr.lo) == 1:
                 exact = LinearInPi(Fraction(0), Fraction(sign, 2))
-            out.append(_HalfAngleRoot(_atan_ball(rr, k, sign), exact, mult))
+            out.append(_HalfAngleRoot(_atan_ball(rr, k, sign), exact, mult,
+                                      ExactTime(IN_U, _u_root(rr, k, sign))))
     return out
+
+
+def _u_root(rr: RationalRoot, k: int, sign: int) -> Callable[[], RationalRoot]:
+    """The exact u = sign·v^(1/k) for the root v of N isolated by ``rr``: a rational
+    interval isolating u among the real roots of g(u) = f(u^k) (f(0) ≠ 0).
+
+    u ↦ u^k is injective on each sign, so among g's roots of that sign exactly one has
+    u^k = v; every other one's interval image eventually misses rr's interval."""
+
+    def locate():
+        if k == 1:
+            return rr
+        g_coeffs = [fmpq(0)] * (k * rr.poly.degree() + 1)
+        for i, c in enumerate(rr.poly.coeffs()):
+            g_coeffs[k * i] = c
+        g = fmpq_poly(g_coeffs)
+        # a positive root's interval may start at 0, a negative one's end there
+        candidates = [r for r, _ in real_roots_exact(g) if (r.lo + r.hi > 0) == (sign > 0)]
+        while True:
+            checkpoint()
+            hits = [r for r in candidates
+                    if not (max(r.lo**k, r.hi**k) < rr.lo or min(r.lo**k, r.hi**k) > rr.hi)]
+            if len(hits) == 1:
+                return hits[0]
+            if not hits:
+                raise AssertionError("no root of f(u^k) maps onto the isolated root of f")
+            for r in hits:
+                r.bisect_to(r.width() / 4)
+            rr.bisect_to(rr.width() / 4)
+
+    return locate
 
 
 def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
@@ -118,10 +165,11 @@ def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
 
 
 def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
-    m, _ = _half_angle_polynomial(p)
+    m, _ = half_angle_polynomial(p)
     at_pi = p.subs({"s": 0, "c": -1})
-    bases: list[tuple[Callable[[float], arb], LinearInPi | None, int | None]] = [
-        (r.ball, r.exact, r.multiplicity) for r in _half_angle_roots(m)]
+    bases: list[tuple[Callable[[float], arb], LinearInPi | None, int | None,
+                      ExactTime | None]] = [
+        (r.ball, r.exact, r.multiplicity, r.time) for r in _half_angle_roots(m)]
     if at_pi.is_zero():
 
         def base_pi(tol: float) -> arb:
@@ -129,9 +177,10 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
                 return arb.pi()
 
         # multiplicity of t = π: the degree drop of M counts it
-        bases.append((base_pi, LinearInPi(Fraction(0), Fraction(1)), None))
+        bases.append((base_pi, LinearInPi(Fraction(0), Fraction(1)), None,
+                      point_time(None, 0, -1)))
     roots, undecided = [], []
-    for index, (base, exact, mult) in enumerate(bases):
+    for index, (base, exact, mult, time) in enumerate(bases):
         for k in _periods(base(tolerance), interval):
             def make(tol: float, base=base, k=k) -> arb:
                 with working_precision(bits_for(tol)):
@@ -141,12 +190,63 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
             if exact is not None:
                 shifted = LinearInPi(exact.rational, exact.pi_coefficient + 2 * k)
             where, t = locate_root(make, shifted, interval, tolerance)
+            if where is None and time is not None and _at_range_end(time, k, interval):
+                where = True  # exactly at a (closed) end of the range
             if where is None:
                 undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
             elif where:
-                roots.append(RealRoot(make(tolerance), mult, make, (index, k)))
+                roots.append(RealRoot(make(tolerance), mult, make, period=(index, k),
+                                      exact=time))
     roots.sort(key=lambda r: float(r.t.mid()))
     return RootIsolation(tuple(roots), tuple(undecided), HALF_ANGLE)
+
+
+def tan_polynomial(b: int) -> fmpq_poly:
+    """P(u) = ((1 + iu)^b - (1 - iu)^b)/(2i), whose real roots are exactly tan(mπ/b) for the
+    integers m with |m/b| < 1/2: (1 + iu)/(1 - iu) = e^(2i·atan u) is a b-th root of
+    unity exactly when atan u is a multiple of π/b."""
+    coeffs = [0] * (b + 1)
+    for j in range(1, b + 1, 2):
+        coeffs[j] = math.comb(b, j) * (-1) ** ((j - 1) // 2)
+    return fmpq_poly(coeffs)
+
+
+def _at_range_end(time: ExactTime, k: int, interval: TimeRange) -> bool:
+    """Exactly: is the root t = 2·atan(u₀) + 2kπ equal to an end of the range?
+
+    Only an end that is a rational multiple qπ can be (t is then π-rational and u₀ is
+    algebraic; a rational non-zero end is transcendental's opposite, and t = 0 is found
+    before).  t = qπ means atan(u₀) = φ = (q/2 - k)π, possible only for |φ| < π/2, i.e.
+    u₀ = tan(aπ/b) with φ = aπ/b: u₀ must be a root of :func:`tan_polynomial` (b) — a
+    common factor with u₀'s polynomial vanishing on its isolating interval, decided
+    exactly — and then it is *some* tan(mπ/b); it is the one for m = a when its interval,
+    refined, excludes every other tan(mπ/b) ball and meets that one.
+    """
+    for end in (interval.start, interval.end):
+        if end.rational != 0:
+            continue
+        phi = end.pi_coefficient / 2 - k
+        if not -Fraction(1, 2) < phi < Fraction(1, 2):
+            continue
+        a, b = phi.numerator, phi.denominator
+        rr = time.locate()
+        h = rr.poly.gcd(tan_polynomial(b))
+        if h.degree() < 1:
+            continue
+        on_h = h(rr.lo) == 0 if rr.lo == rr.hi else h(rr.lo) * h(rr.hi) < 0
+        if not on_h:
+            continue
+        others = [m for m in range(-b, b + 1) if 2 * abs(m) < b and m != a]
+        for _ in range(200):
+            with working_precision(64 + 4 * max(0, -int(math.log2(float(rr.width()) or 1e-300)))):
+                box = rr.ball()
+                target = (arb.pi() * a / b).tan()
+                if not box.overlaps(target):
+                    break
+                if not any(box.overlaps((arb.pi() * m / b).tan()) for m in others):
+                    return True
+            rr.bisect_to(rr.width() / 16)
+    return False
 
 
 def _periods(t0: arb, interval: TimeRange) -> list[int]:

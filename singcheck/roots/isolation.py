@@ -23,7 +23,10 @@ from singcheck.algebra.radicals import conjugates, evaluate_path, norm_radicals
 from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig, uses_t, uses_trig
 from singcheck.roots.branch_bound import branch_and_bound
 from singcheck.roots.enclosures import (
+    BRANCH_AND_BOUND,
     EXACT,
+    IN_T,
+    ExactTime,
     IdenticallyZeroError,
     RealRoot,
     RootIsolation,
@@ -40,7 +43,8 @@ from singcheck.roots.rational import (
 )
 
 
-def _as_univariate_t(p: fmpq_mpoly) -> fmpq_poly:
+def as_univariate_t(p: fmpq_mpoly) -> fmpq_poly:
+    """A trig polynomial free of s and c as a univariate polynomial in t."""
     coeffs = [fmpq(0)] * (p.degrees()[0] + 1)
     for (i, _j, _k), c in p.terms():  # free of s and c here: one term per power of t
         coeffs[i] += c
@@ -51,7 +55,7 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
     roots, undecided = [], []
     ends = [fmpq(e.rational.numerator, e.rational.denominator)
             for e in (interval.start, interval.end) if not e.pi_coefficient]
-    poly = _as_univariate_t(p)
+    poly = as_univariate_t(p)
     if len(ends) == 2 and (nonzero_on(poly, *ends) or no_root_between(poly, *ends)):
         return RootIsolation((), (), EXACT)  # quick proofs: ball arithmetic, Descartes on [a, b]
     for rr, mult in real_roots_exact(poly):
@@ -67,10 +71,56 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
         if where is None:
             undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
         elif where:
-            roots.append(RealRoot(make(tolerance), mult, make))
+            roots.append(RealRoot(make(tolerance), mult, make,
+                                  exact=ExactTime(IN_T, lambda rr=rr: rr)))
     return RootIsolation(tuple(roots), tuple(undecided), EXACT)
 
 
+
+
+def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
+    """t mixed with sin t, cos t: each irreducible factor of p in Q[t, s, c] by its own
+    method (a factor free of t or of s, c exactly; the rest by branch-and-bound), so that
+    a repeated factor costs one isolation and pure factors keep their exact roots.
+
+    Roots of different factors are merged: balls that overlap are refined apart; a root
+    two factors share (proven only for the same exact point) is kept once; two balls
+    that stay overlapping otherwise become an undecided stretch."""
+    _, factors = p.factor()
+    if len(factors) == 1 and factors[0][1] == 1:
+        return branch_and_bound(p, interval, tolerance)
+    roots: list[tuple[RealRoot, int]] = []
+    undecided: list[Undecided] = []
+    for f, mult in factors:
+        if f.is_constant():
+            continue
+        iso = isolate_real_roots(f, interval, tolerance)
+        roots += [(r, int(mult)) for r in iso.roots]
+        undecided += list(iso.undecided)
+    roots.sort(key=lambda item: float(item[0].t.mid()))
+    merged: list[RealRoot] = []
+    for r, mult in roots:
+        r = RealRoot(r.t, None if r.multiplicity is None else r.multiplicity * mult,
+                     r._refine, exact=r.exact)
+        if merged and merged[-1].t.overlaps(r.t):
+            prev, tol = merged[-1], tolerance
+            for _ in range(6):
+                if not prev.t.overlaps(r.t):
+                    break
+                tol /= 1e4
+                prev, r = prev.refined(tol), r.refined(tol)
+            if prev.t.overlaps(r.t):
+                if prev.t.is_exact() and r.t.is_exact() and prev.t == r.t:
+                    merged[-1] = RealRoot(prev.t, None, prev._refine,
+                                          exact=prev.exact or r.exact)
+                    continue
+                merged.pop()
+                undecided.append(Undecided(prev.t.union(r.t), "two factors of the function "
+                                           "have roots that could not be separated"))
+                continue
+            merged[-1] = prev
+        merged.append(r)
+    return RootIsolation(tuple(merged), tuple(undecided), BRANCH_AND_BOUND)
 
 
 def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
@@ -85,7 +135,7 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
     if p.is_zero():
         raise IdenticallyZeroError("the function is identically zero along the path")
     if uses_t(p) and uses_trig(p):
-        return branch_and_bound(p, interval, tolerance)
+        return _mixed(p, interval, tolerance)
     if uses_trig(p):
         return _half_angle(p, interval, tolerance)
     return _exact_univariate(p, interval, tolerance)

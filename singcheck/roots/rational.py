@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 from fractions import Fraction
 
-from flint import arb, arb_poly, fmpq, fmpq_poly, fmpz_poly
+from flint import arb, arb_poly, ctx, fmpq, fmpq_poly, fmpz_poly
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.budget import checkpoint
@@ -79,6 +79,7 @@ class RationalRoot:
     hi: fmpq
     _balls: arb_poly | None = None
     _newton_polys: tuple | None = None  # (precision, f, f') as ball polynomials
+    _sign_lo: int | None = None  # the sign of f at lo (the same at every later lo < root)
 
     def width(self) -> fmpq:
         return self.hi - self.lo
@@ -100,27 +101,40 @@ class RationalRoot:
     def bisect_to(self, width: fmpq) -> None:
         """Shrink [lo, hi] to ``width`` or less, keeping the root inside.
 
-        Each step is an interval Newton step when it halves the interval at least:
+        First a guess is verified: Newton's iteration from the midpoint, in plain
+        (unproven) ball midpoints, proposes the root; a short dyadic interval of the
+        width asked for around it is accepted only when the exact signs of f at its ends
+        differ and it lies inside [lo, hi] (which holds exactly one root): then the root
+        is in it.  Otherwise, step by step:
+
+        each step is an interval Newton step when it halves the interval at least:
         where the ball of f' over [lo, hi] excludes 0, f is monotone there and the root
         lies in m - f(m)/f'([lo, hi]) (mean value theorem; m the midpoint), intersected
         with [lo, hi] and rounded outward to rationals.  Otherwise (or when Newton gains
         too little) it is a bisection on exact signs.  Newton's quadratic convergence
         takes a root to 10⁻⁹ in a handful of steps instead of some thirty bisections.
         """
-        f = self.poly
-        slo = _qsign(f(self.lo))
-        if slo == 0:
-            self.hi = self.lo
+        if self.hi - self.lo <= width:
             return
-        if _qsign(f(self.hi)) == 0:
-            self.lo = self.hi
+        slo = self._sign_lo
+        if slo is None:  # first refinement: are the ends roots themselves?
+            slo = self.sign_at(self.lo)
+            if slo == 0:
+                self.hi = self.lo
+                return
+            if self.sign_at(self.hi) == 0:
+                self.lo = self.hi
+                return
+            self._sign_lo = slo
+        if self._guess_and_verify(width, slo):
             return
         retry_below = self.hi - self.lo  # after a failed Newton step, bisect 4 times first
         while self.hi - self.lo > width:
             if self.hi - self.lo <= retry_below:
                 if self._newton_step(width):
-                    slo = self.sign_at(self.lo)
-                    if slo == 0:
+                    # f is monotone on the old interval, which held the one root: the
+                    # new ends keep their signs unless one is the root itself
+                    if self.sign_at(self.lo) == 0:
                         self.hi = self.lo
                         return
                     if self.sign_at(self.hi) == 0:
@@ -138,6 +152,61 @@ class RationalRoot:
             else:
                 self.hi = mid
 
+    def _guess_and_verify(self, target: fmpq, slo: int) -> bool:
+        """Narrow [lo, hi] to about ``target`` around Newton's guess when exact signs
+        confirm it (see :meth:`bisect_to`); False, with nothing changed, otherwise."""
+        w = float(target)
+        if not w > 0 or not math.isfinite(w):
+            return False
+        bits = max(128, 2 * int(-math.log2(w)) + 64)
+        old = ctx.prec
+        ctx.prec = bits
+        try:
+            value, slope_poly = self._ball_polys(bits)
+            a, b = arb(self.lo), arb(self.hi)  # a bracket: f has sign slo at a, -slo at b
+            x = ((a + b) / 2).mid()
+            for _ in range(200):  # safeguarded Newton (unproven guesses, checked below)
+                fx = value(x).mid()
+                if (fx > 0) == (slo > 0):
+                    a = x
+                else:
+                    b = x
+                slope = slope_poly(x).mid()
+                guess = (x - fx / slope).mid() if slope != 0 else a
+                if not (guess > a and guess < b):
+                    guess = ((a + b) / 2).mid()
+                step = abs(guess - x)
+                x = guess
+                if step < w / 16 or b - a < w / 16:
+                    break
+            else:
+                return False
+            centre = arb_to_fmpq(x)
+        finally:
+            ctx.prec = old
+        a, b = _short_dyadic_hull(centre - target / 4, centre + target / 4, target)
+        if not (self.lo < a < b < self.hi):
+            return False
+        sa, sb = self.sign_at(a), self.sign_at(b)
+        if sa == 0:
+            self.lo = self.hi = a
+            return True
+        if sb == 0:
+            self.lo = self.hi = b
+            return True
+        if sa != slo or sb != -slo:
+            return False
+        self.lo, self.hi = a, b
+        return True
+
+    def _ball_polys(self, bits: int) -> tuple[arb_poly, arb_poly]:
+        """f and f' as ball polynomials at ``bits`` of precision (memoised)."""
+        if self._newton_polys is None or self._newton_polys[0] != bits:
+            coeffs = [arb(c) for c in self.poly.coeffs()]
+            value = arb_poly(coeffs)
+            self._newton_polys = (bits, value, value.derivative())
+        return self._newton_polys[1], self._newton_polys[2]
+
     def _newton_step(self, target: fmpq) -> bool:
         """One interval Newton step on [lo, hi]; False (nothing changed) when f' may
         vanish there or the step would not halve the interval.  The new ends are
@@ -150,11 +219,7 @@ class RationalRoot:
             return False
         bits = max(128, int(-math.log2(w)) * 2 + 64)
         with working_precision(bits):
-            if self._newton_polys is None or self._newton_polys[0] != bits:
-                coeffs = [arb(c) for c in self.poly.coeffs()]
-                value = arb_poly(coeffs)
-                self._newton_polys = (bits, value, value.derivative())
-            _, value, slope_poly = self._newton_polys
+            value, slope_poly = self._ball_polys(bits)
             box = arb(self.lo).union(arb(self.hi))
             slope = slope_poly(box)
             if slope.contains(0):
@@ -249,12 +314,17 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     """
     cs = [int(c) for c in f.coeffs()]
     n = len(cs) - 1
-    # Fujiwara: every root has |z| <= 2 max |a_i / a_n|^(1/(n-i)); bounded with bit
-    # lengths (|a| < 2^bitlen), plus one more bit so that every root is < 2^b strictly.
-    top = abs(cs[-1]).bit_length() - 1  # 2^top <= |a_n|
-    b = 2 + max((-(-(abs(c).bit_length() - top) // (n - i)) for i, c in enumerate(cs[:-1])
-                 if c), default=0)
-    b = max(b, 1)
+    if cs[-1] < 0:
+        cs = [-c for c in cs]
+    # Cauchy's bound for the positive roots: with a_n > 0 and λ negative coefficients,
+    # every positive root x has x^(n-i) <= λ|a_i|/a_n for some a_i < 0 (otherwise a_n x^n
+    # outweighs every negative term).  Bounded with bit lengths (|a| < 2^bitlen,
+    # a_n >= 2^(bitlen-1)), so every positive root is < 2^b strictly.
+    negative = [(i, c) for i, c in enumerate(cs[:-1]) if c < 0]
+    if not negative:
+        return []  # no sign variation: no positive root (Descartes)
+    spare = len(negative).bit_length() + 1 - cs[-1].bit_length()
+    b = max(0, max(-(-(spare + (-c).bit_length()) // (n - i)) for i, c in negative))
     g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)])  # g(x) = f(2^b x)
     out: list[tuple[int, int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
     stack = [(g, 0, 0)]

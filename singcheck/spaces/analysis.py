@@ -29,6 +29,7 @@ from fractions import Fraction
 from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import restrict, squarefree_part
+from singcheck.budget import checkpoint
 from singcheck.elimination.projection import RobotProjection, joint_space_singularities
 from singcheck.elimination.requests import EliminationRequest
 from singcheck.errors import SingcheckError
@@ -223,7 +224,8 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     start = time.perf_counter()
     cells = []
     invariants = {}  # cell index -> what is constant on a component (for proofs)
-    for cell in cad.cells:
+    for cell in cad.cells:  # up to tens of thousands in 3-D
+        checkpoint()
         point = _point(axes, free, cell.sample, fixed)
         if space == WORKSPACE:
             placement = ik_root_placement(model, point, use_limits)

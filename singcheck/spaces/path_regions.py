@@ -32,6 +32,7 @@ from flint import acb, arb
 from singcheck.algebra.intervals import fraction_ball, working_precision
 from singcheck.algebra.polynomials import constant_value
 from singcheck.algebra.trig import uses_t, uses_trig
+from singcheck.budget import checkpoint
 from singcheck.certify.path import PathModel
 from singcheck.certify.working_modes import gap_points
 from singcheck.roots.enclosures import IdenticallyZeroError
@@ -125,6 +126,7 @@ def _crossings(path: PathModel, tolerance: float,
     events: list[tuple[arb, str]] = []
     undecided = []
     for label, poly in path_surfaces(path):
+        checkpoint()
         if label == XI and mu_roots is not None:
             events += [(t, label) for t in mu_roots]
             continue
@@ -160,13 +162,67 @@ def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: boo
     points = gap_points(path.trajectory.range, [c.t for c in crossings])
     stretches = [Stretch(p, ik_count_at(path, p)) for p in points]
     result = PathInWorkspace(crossings, stretches, undecided)
-    if not undecided and len(stretches) == len(crossings) + 1:
-        for before, crossing, after in zip(stretches, crossings, stretches[1:], strict=False):
-            if before.count and after.count == 0:
-                result.exit_time = crossing.t
-                break
+    result.exit_time = _exit_time(result)
     if name_region and result.one_region:
         result.region = locate_region(path, region_cache, notify)
+    return result
+
+
+def _exit_time(w: PathInWorkspace) -> arb | None:
+    """The crossing after which no IK solution is left, when every count is known."""
+    if not w.undecided and len(w.stretches) == len(w.crossings) + 1:
+        for before, crossing, after in zip(w.stretches, w.crossings, w.stretches[1:],
+                                           strict=False):
+            if before.count and after.count == 0:
+                return crossing.t
+    return None
+
+
+def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
+                        notify=None) -> PathInWorkspace:
+    """:func:`path_in_workspace` for a path of several pieces (or a rescaled one), in the
+    user's parameter.  Each piece is placed on its own closed range; then, at each join,
+    a stretch ending one piece and a stretch starting the next are one stretch (the path
+    between their points crosses nothing), and a crossing ending one piece and one
+    starting the next are one crossing when every surface of both vanishes exactly at the
+    join (:func:`singcheck.algebra.trig_values.sum_is_zero`).  The region is named, for a
+    path crossing nothing, in the smallest subspace holding the first piece when every
+    piece lies in that same subspace."""
+    from singcheck.algebra.trig_values import sum_is_zero
+
+    spec = report.trajectory
+    items: list = []  # crossings and stretches in time order, in the user's parameter
+    undecided: list[str] = []
+    for i, (piece, r) in enumerate(zip(spec.pieces, report.pieces, strict=True)):
+        mu_roots = [c.t for c in r.candidates] if r.mu_roots_complete else None
+        w = path_in_workspace(r.path, tolerance, False, mu_roots)
+        undecided += [f"segment {i + 1}: {u}" for u in w.undecided]
+        own = sorted([*w.crossings, *w.stretches],
+                     key=lambda x: float((x.t if isinstance(x, Crossing) else x.point).mid()))
+        own = [Crossing(piece.to_global(x.t), x.surfaces) if isinstance(x, Crossing)
+               else Stretch(piece.to_global(x.point), x.count) for x in own]
+        if items and own:
+            at = piece.global_range.start
+            last, first = items[-1], own[0]
+            if isinstance(last, Stretch) and isinstance(first, Stretch):
+                own = own[1:]  # one stretch across the join
+            elif isinstance(last, Crossing) and isinstance(first, Crossing):
+                surfaces = dict(path_surfaces(r.path))
+                if set(last.surfaces) == set(first.surfaces) and all(
+                        sum_is_zero([(surfaces[s], piece.local_time(at))]) is True
+                        for s in first.surfaces):
+                    own = own[1:]  # the same crossing, exactly at the join
+        items += own
+    crossings = [x for x in items if isinstance(x, Crossing)]
+    stretches = [x for x in items if isinstance(x, Stretch)]
+    result = PathInWorkspace(crossings, stretches, undecided)
+    result.exit_time = _exit_time(result)
+    if result.one_region:
+        pose = report.path.projection.model.pose
+        subspaces = {tuple(_subspace(pose, [p.pose[v] for v in pose])[0].items())
+                     for p in spec.pieces}
+        if len(subspaces) == 1:
+            result.region = locate_region(report.pieces[0].path, region_cache, notify)
     return result
 
 

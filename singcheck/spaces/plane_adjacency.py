@@ -32,6 +32,7 @@ from fractions import Fraction
 from flint import acb, acb_poly, arb, arb_poly, fmpq, fmpq_poly
 
 from singcheck.algebra.intervals import working_precision
+from singcheck.budget import checkpoint
 from singcheck.roots.rational import RationalRoot, ball_ends, to_fraction
 from singcheck.spaces.cad import fiber, sector_of, simplest_between
 from singcheck.spaces.segments import segment_is_free
@@ -97,6 +98,7 @@ class _Field:
 
     def gcd(self, a: list, b: list) -> list:
         while b:
+            checkpoint()
             a, b = b, self.divmod(a, b)[1]
         return self.monic(a)
 
@@ -217,6 +219,7 @@ def exact_joins(cad, base, i: int, brackets, memo: dict | None = None
         return []
     seps = separators(points)
     for round_ in range(6):
+        checkpoint()
         a, b = brackets(base, i, round_)
         if all(segment_is_free(cad, (a, s), 0, a, b) for s in seps):
             left, right = (fiber(cad.levels, cad.variables, (x,)) for x in (a, b))

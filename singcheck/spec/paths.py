@@ -42,7 +42,8 @@ def _line(node) -> int:
 
 
 MAX_WAYPOINTS = 5000
-_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?(?:/\d+)?\Z")
+_NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE](?P<exponent>[+-]?\d+))?(?:/\d+)?\Z")
+MAX_EXPONENT = 300  # of a decimal in a CSV cell (10^300 is far beyond any robot)
 
 
 def multi_piece(doc, root, top, name: str, parameter: str, robot,
@@ -185,6 +186,7 @@ def _check_table(path: str, parameter: str, times, lines, where) -> None:
 
 def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec:
     """A CSV table of poses: header ``PARAMETER,POSE...`` then one exact row per waypoint."""
+    text = text.removeprefix("\ufeff")  # a byte-order mark some spreadsheets write
     rows = [(n, line) for n, line in enumerate(text.splitlines(), 1)
             if line.strip() and not line.lstrip().startswith("#")]
     if not rows:
@@ -215,8 +217,12 @@ def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec
                             line=n)
         exact = []
         for name, cell in zip(names, cells, strict=True):
-            if not _NUMBER.match(cell):
+            number = _NUMBER.match(cell)
+            if not number:
                 raise SpecError(f"{name}: {cell!r} is not a number", path=path, line=n)
+            if number.group("exponent") and abs(int(number.group("exponent"))) > MAX_EXPONENT:
+                raise SpecError(f"{name}: {cell!r} has an exponent beyond ±{MAX_EXPONENT}",
+                                path=path, line=n)
             try:
                 exact.append(Fraction(cell))
             except ZeroDivisionError:

@@ -1,0 +1,383 @@
+"""Exact decisions for one working mode: is det A zero at an algebraic root of μ, or
+identically zero along the path?
+
+Ball arithmetic proves det A ≠ 0, and a sign change proves a crossing, but neither can
+prove that det A *touches* 0 (a tangency: a root of even multiplicity) nor say which of
+several modes vanishing at one time are singular.  This module decides those exactly.
+
+**det A along a mode.**  Each quadratic leg's joint is ρᵢ = (-bᵢ + rᵢ)/(2aᵢ) with
+rᵢ² = Dᵢ (its discriminant along the path) and aᵢ constant; a linear leg's joint is
+-cᵢ/bᵢ.  Substituting into det A and reducing rᵢ² → Dᵢ gives one polynomial E(r),
+multilinear in the r's, whose coefficients are trig polynomials in t, sin t, cos t.  A
+working mode picks rᵢ = σᵢ·√Dᵢ (σᵢ = ±1 from its label; i·√-Dᵢ where Dᵢ < 0, the
+convention of :meth:`~singcheck.certify.path.LegAlongPath.branches`).
+
+**The zero test (a tower of quadratic extensions).**  Write E = x + y·r_k with x, y free
+of r_k, and Ē = x - y·r_k (the mode with σ_k flipped).  Then E·Ē = x² - y²·D_k.
+
+* if D_k = 0 exactly, r_k = 0 and E = x;
+* if y = 0 (decided recursively), E = x;
+* if N = x² - y²·D_k ≠ 0 (recursively), E ≠ 0 (every zero of E is a zero of N);
+* otherwise E·Ē = 0 while E - Ē = 2·y·r_k ≠ 0: *exactly one* of E and Ē is zero, and
+  ball arithmetic at rising precision decides which (the non-zero one is eventually
+  enclosed away from 0; the other one then is proven zero).
+
+The bottom of the recursion is an exact test in the base field:
+
+* at a root of μ: Q(α), α the root's exact algebraic value (t itself, or u = tan(t/2))
+  with its minimal polynomial f (the irreducible factor of its squarefree polynomial
+  that changes sign on its isolating interval) — an element is 0 exactly when its
+  polynomial is 0 modulo f;
+* along the path (μ ≡ 0): the field of trig functions on the range (reduced trig
+  polynomials are 0 exactly when they are 0 as polynomials); "exactly one of E, Ē
+  vanishes" then holds on every interval where the branches are analytic (the identity
+  theorem: a product of analytic functions that vanishes identically has a factor that
+  does), and is decided at a rational sample time.
+
+For the μ ≡ 0 case the recursion also returns, for a mode whose det A is not ≡ 0, a
+non-zero trig polynomial P (a product of conjugates with the identically vanishing ones
+dropped) whose roots hold every zero of det A along that mode: its candidates.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
+
+from singcheck.algebra.intervals import excludes_zero, working_precision
+from singcheck.algebra.polynomials import constant_value
+from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig, uses_t, uses_trig
+from singcheck.budget import checkpoint
+from singcheck.certify.path import PathModel
+from singcheck.roots.enclosures import AT_POINT, IN_T, IN_U, ExactTime
+from singcheck.roots.half_angle import half_angle_polynomial
+from singcheck.roots.isolation import as_univariate_t
+from singcheck.roots.rational import RationalRoot, rational_ball
+
+_MAX_BITS = 1 << 16
+
+
+class NotExact(Exception):
+    """The root's time is not an algebraic number this module can compute with (a path
+    mixing t with sin t, at a time other than 0)."""
+
+
+# ---------------------------------------------------------------------------------
+# det A along the path as a multilinear polynomial in the square roots r_i
+
+
+class ModeExpression:
+    """E(r) = det A along the path, multilinear in one rᵢ per quadratic leg.
+
+    ``terms`` maps a bit mask of r's to its trig-polynomial coefficient; ``D[q]`` is the
+    discriminant whose square root r_q is; ``legs[q]`` the leg index of r_q.
+    """
+
+    def __init__(self, path: PathModel) -> None:
+        model = path.projection.model
+        if any(leg.revolute for leg in path.legs):
+            raise NotExact("exact decisions are not implemented for revolute legs yet")
+        if path.mu.context() is not TRIG or any(x.context() is not TRIG
+                                                for x in path.coordinates):
+            raise NotExact("exact decisions are not implemented for square roots among "
+                           "the robot's or the path's numbers yet")
+        quadratic = [i for i, leg in enumerate(path.legs) if leg.leg.degree == 2]
+        names = ("t", "s", "c", *(f"r{q}" for q in range(len(quadratic))))
+        ring = fmpq_mpoly_ctx.get(names, "lex")
+        pad = (0,) * len(quadratic)
+
+        def lift(p: fmpq_mpoly) -> fmpq_mpoly:
+            return ring.from_dict({(*e, *pad): c for e, c in p.terms()})
+
+        r = ring.gens()[3:]
+        joints = []
+        for i, leg in enumerate(path.legs):
+            if leg.leg.degree == 2:
+                a, b, _ = leg.coefficients
+                joints.append((r[quadratic.index(i)] - lift(b)) / (2 * constant_value(a)))
+            else:
+                b, c = leg.coefficients
+                joints.append(-lift(c) / constant_value(b))
+        images = dict(zip((leg.leg.joint for leg in path.legs), joints, strict=True))
+        images.update(zip(model.pose_variables, (lift(x) for x in path.coordinates),
+                          strict=True))
+        names = model.det_A.context().names()
+        if any(v not in images for v in names):
+            raise NotExact("det A involves variables other than the joints and the pose")
+        full = model.det_A.compose(*(images[v] for v in names), ctx=ring)
+        self.D = [path.legs[i].discriminant for i in quadratic]
+        self.legs = quadratic
+        by_r: dict[tuple[int, ...], dict] = {}
+        for exps, coeff in full.terms():
+            by_r.setdefault(tuple(exps[3:]), {})[tuple(exps[:3])] = coeff
+        terms: dict[int, fmpq_mpoly] = {}
+        for r_exps, trig_terms in by_r.items():
+            checkpoint()
+            value = TRIG.from_dict(trig_terms)
+            mask = 0
+            for q, e in enumerate(r_exps):
+                mask |= (e % 2) << q
+                for _ in range(e // 2):
+                    value = value * self.D[q]
+            terms[mask] = terms.get(mask, TRIG.from_dict({})) + value
+        self.terms = {m: reduce_trig(v) for m, v in terms.items() if not v.is_zero()}
+
+    def signs(self, label: str) -> list[int]:
+        """σ_q for a working mode label (one character per leg)."""
+        return [1 if label[i] == "+" else -1 for i in self.legs]
+
+
+_EXPRESSIONS: dict[int, tuple[PathModel, ModeExpression]] = {}
+
+
+def mode_expression(path: PathModel) -> ModeExpression:
+    """The (memoised) E(r) of a path: built once, only when an exact decision is needed."""
+    hit = _EXPRESSIONS.get(id(path))
+    if hit is None or hit[0] is not path:
+        if len(_EXPRESSIONS) > 64:
+            _EXPRESSIONS.clear()
+        hit = _EXPRESSIONS[id(path)] = (path, ModeExpression(path))
+    return hit[1]
+
+
+# ---------------------------------------------------------------------------------
+# base fields: Q(α) at a root, trig functions along the path
+
+
+class AlgebraicPoint:
+    """Q(α) for the exact time of a root: elements are polynomials in α modulo its
+    minimal polynomial ``f``; ``ball`` encloses an element's value at the root."""
+
+    def __init__(self, time: ExactTime) -> None:
+        self.time = time
+        if time.kind == AT_POINT:
+            self.f = fmpq_poly([0, 1])
+            self.root = RationalRoot(self.f, fmpq(0), fmpq(0))
+            return
+        rr = time.locate()
+        self.f, self.root = _minimal_polynomial(rr)
+        if time.kind == IN_U:
+            one_plus = fmpq_poly([1, 0, 1]) % self.f
+            g, inverse, _ = one_plus.xgcd(self.f)  # 1 + α² ≠ 0 for a real α: g = 1
+            self._inverse = (inverse / g.leading_coefficient()) % self.f
+
+    def zero(self) -> fmpq_poly:
+        return fmpq_poly([])
+
+    def of(self, p: fmpq_mpoly) -> fmpq_poly:
+        """A trig polynomial's value at the root, as an element of Q(α)."""
+        time = self.time
+        if time.kind == AT_POINT:
+            if uses_t(p) and time.t_value is None:
+                raise NotExact("t is a non-zero multiple of π, not algebraic")
+            values = {"s": _q(time.s), "c": _q(time.c)}
+            if uses_t(p):
+                values["t"] = _q(time.t_value)
+            return fmpq_poly([constant_value(p.subs(values))]) if values else fmpq_poly([])
+        if time.kind == IN_T:
+            if uses_trig(p):
+                raise NotExact("a path mixing t with sin t, cos t at a time other than 0")
+            return as_univariate_t(p) % self.f if not p.is_zero() else fmpq_poly([])
+        if uses_t(p):
+            raise NotExact("a path mixing t with sin t, cos t at a time other than 0")
+        if p.is_zero():
+            return fmpq_poly([])
+        m, d = half_angle_polynomial(p)
+        value = m % self.f
+        for _ in range(d):
+            value = (value * self._inverse) % self.f
+        return value
+
+    def mul(self, a: fmpq_poly, b: fmpq_poly) -> fmpq_poly:
+        return (a * b) % self.f
+
+    def is_zero(self, a: fmpq_poly) -> bool:
+        return a.is_zero()
+
+    def ball(self, a: fmpq_poly, bits: int) -> arb:
+        """An enclosure of the element at the root, at about ``bits`` of precision."""
+        if self.root.lo != self.root.hi:
+            self.root.bisect_to(fmpq(1, 2**bits))
+        alpha = rational_ball(self.root.lo, self.root.hi)
+        total = arb(0)
+        for c in reversed(a.coeffs()):
+            total = total * alpha + arb(c)
+        return total
+
+
+class PathFunctions:
+    """The trig functions along the path (μ ≡ 0): elements are reduced trig polynomials,
+    exact zero tests are polynomial ones, and balls are taken at a rational time."""
+
+    def __init__(self, t0: fmpq) -> None:
+        self.t0 = t0
+
+    def zero(self) -> fmpq_mpoly:
+        return TRIG.from_dict({})
+
+    def of(self, p: fmpq_mpoly) -> fmpq_mpoly:
+        return reduce_trig(p)
+
+    def mul(self, a: fmpq_mpoly, b: fmpq_mpoly) -> fmpq_mpoly:
+        return reduce_trig(a * b)
+
+    def is_zero(self, a: fmpq_mpoly) -> bool:
+        return a.is_zero()
+
+    def ball(self, a: fmpq_mpoly, bits: int) -> arb:
+        return evaluate_trig(a, arb(self.t0))
+
+
+def _q(x: Fraction) -> fmpq:
+    return fmpq(x.numerator, x.denominator)
+
+
+def _minimal_polynomial(rr: RationalRoot) -> tuple[fmpq_poly, RationalRoot]:
+    """The irreducible factor of ``rr.poly`` that vanishes at its isolated root.
+
+    The interval isolates one root of the squarefree polynomial, so exactly one
+    irreducible factor has a root there: the one that vanishes at a point interval, or
+    changes sign between the ends (roots of a squarefree polynomial are simple, and the
+    ends of an isolating interval are not roots).
+    """
+    _, factors = rr.poly.numer().factor()
+    for h, _e in factors:
+        f = fmpq_poly(h)
+        f = f / f.leading_coefficient()
+        if rr.lo == rr.hi:
+            if f(rr.lo) == 0:
+                return f, RationalRoot(f, rr.lo, rr.hi)
+        elif f(rr.lo) * f(rr.hi) < 0:
+            return f, RationalRoot(f, rr.lo, rr.hi)
+    raise AssertionError("no factor of an isolated root's polynomial vanishes there")
+
+
+# ---------------------------------------------------------------------------------
+# the tower
+
+
+class _Tower:
+    """The zero test of the module docstring for one working mode over one base field."""
+
+    def __init__(self, expr: ModeExpression, base, signs: list[int]) -> None:
+        self.base = base
+        self.signs = signs
+        self.D = [base.of(d) for d in expr.D]
+        self.D_zero = [base.is_zero(d) for d in self.D]
+        self.E = {m: base.of(v) for m, v in expr.terms.items()}
+        self.E = {m: v for m, v in self.E.items() if not base.is_zero(v)}
+
+    # multilinear arithmetic (dicts mask → base element)
+    def _mul(self, a: dict, b: dict) -> dict:
+        out: dict = {}
+        base = self.base
+        for ma, va in a.items():
+            for mb, vb in b.items():
+                checkpoint()
+                v = base.mul(va, vb)
+                common = ma & mb
+                q = 0
+                while common:
+                    if common & 1:
+                        v = base.mul(v, self.D[q])
+                    common >>= 1
+                    q += 1
+                m = ma ^ mb
+                out[m] = out[m] + v if m in out else v
+        return {m: v for m, v in out.items() if not base.is_zero(v)}
+
+    def _sub(self, a: dict, b: dict) -> dict:
+        out = dict(a)
+        for m, v in b.items():
+            out[m] = out[m] - v if m in out else -v
+        return {m: v for m, v in out.items() if not self.base.is_zero(v)}
+
+    def reduce(self, e: dict | None = None, k: int | None = None):
+        """None when the element (at this mode's signs) is exactly 0; otherwise a non-zero
+        base element whose zeros hold the element's (for the path field) / True."""
+        e = self.E if e is None else e
+        k = len(self.D) if k is None else k
+        checkpoint()
+        if k == 0:
+            value = e.get(0)
+            return None if value is None or self.base.is_zero(value) else value
+        bit = 1 << (k - 1)
+        x = {m: v for m, v in e.items() if not m & bit}
+        y = {m ^ bit: v for m, v in e.items() if m & bit}
+        if not y or self.D_zero[k - 1] or self.reduce(y, k - 1) is None:
+            return self.reduce(x, k - 1)
+        d = {0: self.D[k - 1]}
+        norm = self._sub(self._mul(x, x), self._mul(self._mul(y, y), d))
+        found = self.reduce(norm, k - 1)
+        if found is not None:
+            return found
+        # E·Ē = 0 and E - Ē = 2·y·r_k ≠ 0: exactly one of them is 0
+        if self._which_vanishes(e, k):
+            return None
+        return self.reduce(x, k - 1)  # Ē = 0, so E = 2x ≠ 0
+
+    def _which_vanishes(self, e: dict, k: int) -> bool:
+        """True when E is the zero one of {E, Ē} (flipping σ_k), decided by balls."""
+        bits = 64
+        while bits <= _MAX_BITS:
+            checkpoint()
+            with working_precision(bits):
+                value = self._ball(e, k, flip=None)
+                flipped = self._ball(e, k, flip=k - 1)
+            if flipped is not None and excludes_zero(flipped):
+                return True
+            if value is not None and excludes_zero(value):
+                return False
+            bits *= 2
+        raise NotExact("ball arithmetic did not separate a mode from its conjugate")
+
+    def _ball(self, e: dict, k: int, flip: int | None):
+        bits = int(working_bits())
+        roots = []
+        for q in range(k):
+            if self.D_zero[q]:
+                roots.append(arb(0))
+                continue
+            d = self.base.ball(self.D[q], bits)
+            sigma = -self.signs[q] if q == flip else self.signs[q]
+            if d > 0:
+                roots.append(sigma * d.sqrt())
+            elif d < 0:
+                roots.append(acb(0, sigma * (-d).sqrt()))
+            else:
+                return None
+        total = arb(0)
+        for m, v in e.items():
+            term = self.base.ball(v, bits)
+            q = 0
+            while m:
+                if m & 1:
+                    term = term * roots[q]
+                m >>= 1
+                q += 1
+            total = total + term
+        return total
+
+
+def working_bits() -> int:
+    from flint import ctx
+
+    return ctx.prec
+
+
+def det_a_vanishes_at(path: PathModel, point: AlgebraicPoint, label: str) -> bool:
+    """det A of working mode ``label`` at the root, exactly: True when it is 0.
+
+    Raises :class:`NotExact` when the root is not an algebraic number we can compute with.
+    """
+    expr = mode_expression(path)
+    return _Tower(expr, point, expr.signs(label)).reduce() is None
+
+
+def mode_zero_polynomial(path: PathModel, label: str, t0: fmpq) -> fmpq_mpoly | None:
+    """Along the whole path (for a mode whose branches are real and analytic on the
+    range, with every discriminant ≠ 0 at the rational sample ``t0``): None when det A ≡ 0
+    along the mode, else a non-zero trig polynomial whose roots hold its zeros."""
+    expr = mode_expression(path)
+    return _Tower(expr, PathFunctions(t0), expr.signs(label)).reduce()

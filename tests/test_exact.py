@@ -1,0 +1,290 @@
+"""Exact decisions where ball arithmetic cannot decide (issue 13): tangencies, several
+modes singular at one time, roots at t = 0 and at the range ends, paths lying on the
+singularity surface, and paths mixing t with cos t through such a point.
+
+Every expected answer is computed here, independently of singcheck: exact rational
+arithmetic (``Fraction``) at poses and joints that are rational, SymPy for a symbolic
+determinant, and 50-digit mpmath along the path.
+"""
+
+from __future__ import annotations
+
+import time
+from fractions import Fraction
+from itertools import product
+
+import mpmath
+import pytest
+import sympy
+
+from singcheck.certify.classification import certify_path
+from singcheck.certify.path import build_path
+from singcheck.elimination.cas import get_backend
+from singcheck.elimination.projection import project_robot
+from singcheck.model.robot import build_model
+from singcheck.spec.files import parse_robot, parse_trajectory
+from tests.test_certify import BIGLIDE
+
+ORTHOGLIDE = """\
+name: orthoglide
+joints: [rho1, rho2, rho3]
+pose: [x, y, z]
+parameters: {l: 2}
+constraints:
+  - (x - rho1)^2 + y^2 + z^2 - l^2
+  - x^2 + (y - rho2)^2 + z^2 - l^2
+  - x^2 + y^2 + (z - rho3)^2 - l^2
+joint_limits: {rho1: [LO, 4], rho2: [LO, 4], rho3: [LO, 4]}
+"""
+
+# the issue's biglide: rods of length 2, sliders on the x and on the y axis
+XY_BIGLIDE = """\
+name: xy-biglide
+joints: [p, q]
+pose: [x, y]
+constraints:
+  - (x - p)^2 + y^2 - 4
+  - x^2 + (y - q)^2 - 4
+"""
+
+_PROJECTIONS: dict[str, object] = {}
+
+
+def certify(robot_text: str, trajectory_text: str):
+    if robot_text not in _PROJECTIONS:
+        model = build_model(parse_robot(robot_text, "r.yaml"))
+        _PROJECTIONS[robot_text] = project_robot(model, get_backend("flint"))
+    projection = _PROJECTIONS[robot_text]
+    spec = parse_trajectory(trajectory_text, "t.yaml", projection.model.spec)
+    return certify_path(build_path(projection, spec))
+
+
+def orthoglide(lower: str = "0") -> str:
+    return ORTHOGLIDE.replace("LO", lower)
+
+
+def trajectory(start: str, end: str, **pose: str) -> str:
+    lines = "".join(f"  {k}: {v}\n" for k, v in pose.items())
+    return f"name: p\nparameter: t\nrange: [{start}, {end}]\npose:\n{lines}"
+
+
+def along(direction: tuple[str, str, str], scale: str) -> dict[str, str]:
+    """The pose scale·X0 for X0 = ``direction`` (exact rationals as text)."""
+    return {axis: f"{d}*({scale})" for axis, d in zip("xyz", direction, strict=True)}
+
+
+# X0 = (2/3, 4/3, 4/3) lies on the sphere x² + y² + z² = 4 (|(1, 2, 2)| = 3)
+X0 = (Fraction(2, 3), Fraction(4, 3), Fraction(4, 3))
+X0_TEXT = ("2/3", "4/3", "4/3")
+
+
+def det3(m) -> Fraction:
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+def orthoglide_det_a(pose, joints) -> Fraction:
+    """det ∂F/∂X of the Orthoglide: row i is 2(X - ρᵢ eᵢ)."""
+    rows = [[2 * (pose[j] - (joints[i] if i == j else 0)) for j in range(3)] for i in range(3)]
+    return det3(rows)
+
+
+def modes_singular_on_sphere(pose) -> set[str]:
+    """At a pose on the sphere |X| = 2 with positive coordinates, the joints are exactly
+    ρᵢ = xᵢ ± xᵢ (D = xᵢ²): the modes whose exact det A is 0."""
+    out = set()
+    for label in ("".join(s) for s in product("+-", repeat=3)):
+        joints = [x + x if s == "+" else x - x for x, s in zip(pose, label, strict=True)]
+        if orthoglide_det_a(pose, joints) == 0:
+            out.add(label)
+    return out
+
+
+def singular_at(report, index: int = 0) -> set[str]:
+    return set(report.candidates[index].singular_modes)
+
+
+# -- the issue's biglide path ------------------------------------------------------------
+
+
+def test_biglide_path_through_a_rational_singular_pose_is_singular_in_two_modes():
+    report = certify(XY_BIGLIDE, trajectory("0", "1", x="8/5 - 3/5*(t - 1/2)",
+                                            y="6/5 + 4/5*(t - 1/2)"))
+    # independent: at t = 1/2 the pose is (8/5, 6/5); p = x ± √(4 - y²) = 8/5 ± 8/5 and
+    # q = y ± √(4 - x²) = 6/5 ± 6/5; det A = det [[2(x - p), 2y], [2x, 2(y - q)]]
+    x, y = Fraction(8, 5), Fraction(6, 5)
+    expected = set()
+    for sp, sq in product((1, -1), repeat=2):
+        p, q = x + sp * Fraction(8, 5), y + sq * Fraction(6, 5)
+        if 4 * (x - p) * (y - q) - 4 * x * y == 0:
+            expected.add(("+" if sp > 0 else "-") + ("+" if sq > 0 else "-"))
+    assert expected == {"++", "--"}
+    # and a tangency in both (50 digits): det A has one sign on either side of t = 1/2
+    mpmath.mp.dps = 50
+
+    def det_a(t, sp, sq):
+        x = mpmath.mpf(8) / 5 - mpmath.mpf(3) / 5 * (t - mpmath.mpf(1) / 2)
+        y = mpmath.mpf(6) / 5 + mpmath.mpf(4) / 5 * (t - mpmath.mpf(1) / 2)
+        p, q = x + sp * mpmath.sqrt(4 - y * y), y + sq * mpmath.sqrt(4 - x * x)
+        return 4 * (x - p) * (y - q) - 4 * x * y
+
+    for sp in (1, -1):
+        before, after = (det_a(mpmath.mpf(1) / 2 + e, sp, sp) for e in (-mpmath.mpf("1e-3"),
+                                                                         mpmath.mpf("1e-3")))
+        assert before * after > 0
+    assert report.verdict == "singular"
+    [candidate] = report.candidates
+    assert candidate.t.contains(Fraction(1, 2).__float__()) and candidate.t.rad() < 1e-9
+    assert singular_at(report) == expected
+    proofs = {m.mode: m.proof for m in candidate.modes}
+    assert {proofs[m] for m in expected} == {"det A = 0 exactly (algebraic)"}
+
+
+# -- tangency at an irrational time, four modes at once -------------------------------
+
+
+def test_orthoglide_tangent_to_the_sphere_at_t_asin_3_5_is_singular_in_four_modes():
+    # X(t) = (1 + (1 - cos(t - t0))/4)·X0 with t0 = asin(3/5): |X| ≥ 2, = 2 only at t0
+    w = "(4*cos(t) + 3*sin(t))/5"
+    report = certify(orthoglide(), trajectory("0", "1", **along(X0_TEXT, f"1 + (1 - {w})/4")))
+    mpmath.mp.dps = 50
+    t0 = mpmath.asin(mpmath.mpf(3) / 5)
+
+    def radius2_minus_4(t):
+        scale = 1 + (1 - mpmath.cos(t - t0)) / 4
+        return scale**2 * 4 - 4
+
+    # a tangency: no sign change around t0 (sampling and sign changes cannot see it)
+    assert radius2_minus_4(t0 - mpmath.mpf("1e-3")) > 0 < radius2_minus_4(t0 + mpmath.mpf("1e-3"))
+    expected = modes_singular_on_sphere(X0)
+    assert expected == {"+--", "-+-", "--+", "---"}
+    assert report.verdict == "singular"
+    at_t0 = [c for c in report.candidates if c.t.contains(float(t0))]
+    assert len(at_t0) == 1 and at_t0[0].t.rad() < 1e-9
+    assert abs(float(at_t0[0].t.mid()) - float(t0)) < 1e-9
+    assert set(at_t0[0].singular_modes) == expected
+    assert all(m.status == "regular" for m in at_t0[0].modes if m.mode not in expected)
+
+
+def test_the_same_tangency_is_spurious_when_limits_exclude_the_singular_modes():
+    # with ρ ≥ 1/10 the branches near ρ = 0 are infeasible; +++ (ρ = 2X at t0) is not singular
+    w = "(4*cos(t) + 3*sin(t))/5"
+    report = certify(orthoglide("1/10"),
+                     trajectory("0", "1", **along(X0_TEXT, f"1 + (1 - {w})/4")))
+    assert orthoglide_det_a(X0, [2 * x for x in X0]) != 0
+    assert [m.label for m in report.modes if m.feasible] == ["+++"]
+    assert report.verdict == "singularity-free"
+    assert [c.status for c in report.candidates] == ["spurious"]
+
+
+# -- roots at t = 0 and at the range ends -------------------------------------------------
+
+
+@pytest.mark.parametrize("start, end, scale", [
+    ("0", "1/5", "1 + t/4"),                  # radial, crossing outward at the range start
+    ("-1/5", "0", "1 - t/4"),                 # the same, ending on the sphere
+    ("0", "1", "1 + (1 - cos(t))/16"),        # tangency at t = 0, the range start (u = 0)
+    ("-1", "1", "1 + (1 - cos(t))/16"),       # tangency at t = 0 inside the range
+    ("2", "pi", "1 + (1 + cos(t))/16"),       # tangency at t = π, the range end (u = ∞)
+])
+def test_roots_at_zero_and_at_the_range_ends_are_decided_exactly(start, end, scale):
+    report = certify(orthoglide(), trajectory(start, end, **along(X0_TEXT, scale)))
+    # independent: the pose at the root is X0 exactly, on the sphere
+    expected = modes_singular_on_sphere(X0)
+    assert report.verdict == "singular"
+    root = 0.0 if "pi" not in end else float(mpmath.pi)
+    at = [c for c in report.candidates if c.t.contains(root)
+          or abs(float(c.t.mid()) - root) < 1e-12]
+    assert len(at) == 1
+    assert set(at[0].singular_modes) == expected
+    assert all(m.status != "unknown" for c in report.candidates for m in c.modes)
+
+
+# -- paths lying on the singularity surface (μ ≡ 0) ----------------------------------------
+
+
+def test_a_constant_pose_on_the_sphere_is_singular_all_along_in_four_modes():
+    report = certify(orthoglide(), trajectory("0", "1", x="2/3", y="4/3", z="4/3"))
+    assert report.verdict == "singular"
+    assert "whole path" in report.reason
+    expected = modes_singular_on_sphere(X0)
+    assert {m for c in report.candidates for m in c.singular_modes} == expected
+    # every mode is feasible (the branches at ρ = 0 sit on the closed limit)
+    assert all(m.feasible for m in report.modes)
+
+
+def test_a_circle_on_the_sphere_is_singular_in_four_modes_and_free_without_them():
+    # x² + y² = 64/25, z = 6/5: on the sphere x² + y² + z² = 4 for every t
+    circle = trajectory("1/4", "1", x="8/5*cos(t)", y="8/5*sin(t)", z="6/5")
+    report = certify(orthoglide(), circle)
+    mpmath.mp.dps = 50
+    expected = None
+    for k in range(1, 8):  # independent: 50-digit det A per mode at sample times
+        t = mpmath.mpf(1) / 4 + mpmath.mpf(k) * (mpmath.mpf(3) / 4) / 8
+        pose = [8 * mpmath.cos(t) / 5, 8 * mpmath.sin(t) / 5, mpmath.mpf(6) / 5]
+        zero = set()
+        for label in ("".join(s) for s in product("+-", repeat=3)):
+            joints = [x + x if s == "+" else x - x for x, s in zip(pose, label, strict=True)]
+            if abs(orthoglide_det_a(pose, joints)) < mpmath.mpf("1e-40"):
+                zero.add(label)
+        expected = zero if expected is None else expected & zero
+    assert expected == {"+--", "-+-", "--+", "---"}
+    assert report.verdict == "singular"
+    assert {m for c in report.candidates for m in c.singular_modes} == expected
+    # with ρ ≥ 1/10 only +++ (ρ = 2X) is feasible; its det A is 16·x·y·z·(stuff) ≠ 0
+    x, y, z = sympy.symbols("x y z")
+    rows = [[2 * (v - (2 * v if i == j else 0)) for j, v in enumerate((x, y, z))]
+            for i in range(3)]
+    assert sympy.factor(sympy.Matrix(rows).det()) == 32 * x * y * z
+    free = certify(orthoglide("1/10"), circle)
+    assert [m.label for m in free.modes if m.feasible] == ["+++"]
+    assert free.verdict == "singularity-free"
+
+
+# -- paths mixing t with cos t ---------------------------------------------------------
+
+
+def test_mixed_path_through_a_tangency_at_zero_takes_seconds():
+    # x = t/3, y = 0, z = 1 + cos t: at t = 0 the pose (0, 0, 2) is on the sphere, both
+    # branches of ρ1 (and of ρ2) meet (D = 4 - y² - z² = 0) and ρ3 = 4 is the limit
+    start = time.perf_counter()
+    report = certify(orthoglide(), trajectory("-1/2", "1/2", x="t/3", y="0", z="1 + cos(t)"))
+    assert time.perf_counter() - start < 20
+    # independent: D1(t) = 4 - (1 + cos t)² is 0 at t = 0 and > 0 elsewhere in the range
+    assert 4 - (1 + 1) ** 2 == 0
+    assert report.verdict == "infeasible"
+    assert "rho1 meet at t ≈ 0" in report.reason
+    [candidate] = report.candidates
+    assert candidate.t.contains(0) and candidate.t.rad() == 0
+    # at (0, 0, 2) with ρ1 = ρ2 = 0 rows 1 and 2 of A are equal: every mode is singular
+    for rho3 in (Fraction(4), Fraction(0)):
+        assert orthoglide_det_a((0, 0, Fraction(2)), (0, 0, rho3)) == 0
+    assert all(m.status == "singular" for m in candidate.modes)
+
+
+def test_mixed_path_touching_the_sphere_at_zero_from_outside_is_singular():
+    # scale 1 + t²/16 + (1 - cos t)/8 ≥ 1, = 1 only at t = 0: a tangency of order 2
+    report = certify(orthoglide(), trajectory(
+        "-1/2", "1/2", **along(X0_TEXT, "1 + t^2/16 + (1 - cos(t))/8")))
+    assert report.root_method == "interval branch-and-bound"
+    assert report.verdict == "singular"
+    at_zero = [c for c in report.candidates if c.t.contains(0)]
+    assert len(at_zero) == 1
+    assert set(at_zero[0].singular_modes) == modes_singular_on_sphere(X0)
+    assert at_zero[0].root.multiplicity % 2 == 0  # even: a tangency
+    assert not report.undecided
+
+
+
+def test_a_root_exactly_at_an_irrational_range_end_is_kept():
+    # y = cos(2t)/2 + 1/4 is 0 exactly at t = π/3, the range end (u = tan(π/6) = 1/√3);
+    # det A = 4·y·(q - p) vanishes there in every mode
+    report = certify(BIGLIDE, trajectory("0", "pi/3", x="cos(t)/2", y="cos(2*t)/2 + 1/4"))
+    mpmath.mp.dps = 50
+    assert abs(mpmath.cos(2 * mpmath.pi / 3) / 2 + mpmath.mpf(1) / 4) < mpmath.mpf("1e-45")
+    assert report.verdict == "singular"
+    [candidate] = report.candidates
+    assert abs(float(candidate.t.mid()) - float(mpmath.pi / 3)) < 1e-9
+    assert all(m.status == "singular" for m in candidate.modes)
+    assert not report.undecided

@@ -153,14 +153,6 @@ def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Ro
     stack = _without(lo0, hi0, [(za, zb) for _, _, za, zb in exact_zeros])[::-1]
     found: list[tuple[fmpq, fmpq]] = []
     exact_points: list[fmpq] = []
-    zero = fmpq(0)
-    if lo0 < zero < hi0:
-        # t = 0 is the one rational time where sin and cos are exact: a root there (even a
-        # double one, with no sign change) is proven by an exact 0 and always reported
-        at_zero = _point(p, zero)
-        if at_zero.is_exact() and at_zero == 0:
-            exact_points.append(zero)
-        stack = [(zero, hi0), (lo0, zero)]
     ambiguous: list[tuple[fmpq, fmpq, str]] = []
     boxes = 0
     while stack:

@@ -525,6 +525,8 @@ def test_mu_size_bound_holds_for_a_composed_path(orthoglide_projection):
     (ORTHO, {"x": "3*sin(t) + cos(256*t)", "y": "0", "z": "1"}, "0, 1"),
     (BIGLIDE, {"x": "sin(100*t)", "y": "t"}, "0, 1"),
     (ORTHO, {"x": "sin(t)", "y": "cos(t)", "z": "t/20"}, "-1000000, 1000000"),
+    # found by the fuzz campaign: 10^5 periods of the half-angle roots ran 286 s
+    (str(ROBOTS / "skew-biglide.yaml"), {"x": "-sin(t)", "y": "-sin(t)"}, "-27/2, 1000000"),
 ])
 def test_costly_paths_stop_at_the_time_limit(tmp_path, cache_env, robot, pose, rng):
     from singcheck import api

@@ -182,6 +182,8 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
     roots, undecided = [], []
     for index, (base, exact, mult, time) in enumerate(bases):
         for k in _periods(base(tolerance), interval):
+            checkpoint()  # a range of 10^6 holds 10^5 periods: each costs a ball map
+
             def make(tol: float, base=base, k=k) -> arb:
                 with working_precision(bits_for(tol)):
                     return base(tol) + 2 * k * arb.pi()

@@ -360,12 +360,13 @@ def _forked(robot, trajectories, options, jobs: int, ordered: bool) -> Iterator[
             finished, _ = wait(pending, return_when=FIRST_COMPLETED)
             pending = [f for f in pending if f not in finished]
             for future in finished:
+                chunk = futures.pop(future)  # a done future holds its results: let go
                 try:
                     results = future.result()
                 except Exception as e:  # the worker process died (killed, out of memory)
                     reason = f"the worker process failed: {type(e).__name__}: {e}"
                     results = [(i, error_json(trajectories[i], "internal", reason))
-                               for i in futures[future]]
+                               for i in chunk]
                 if not ordered:
                     for _, doc in results:
                         yield doc

@@ -64,42 +64,64 @@ def check_on_cluster(address: str, robot: Robot, trajectories: list[TrajectorySp
 
     register()
     client = _client(address)
-    futures = []
     try:
         notify(f"dask scheduler {address}: {len(client.scheduler_info()['workers'])} "
                "worker(s)")
         options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit)
-        if regions and not prepare_regions(robot, trajectories, time_limit, notify):
+        if regions and robot.model.polynomial and not prepare_regions(
+                robot, trajectories, time_limit, notify):
             options["regions"] = False
         shipped = client.scatter(replace(robot, region_cache=None), broadcast=True)
-        batch = uuid.uuid4().hex[:12]
-        futures = [client.submit(_remote_check, shipped, spec, options,
-                                 robot.region_cache is not None,
-                                 key=f"singcheck-{batch}-{i}", pure=False)
-                   for i, spec in enumerate(trajectories)]
-        yield from _results(client, futures, trajectories, ordered)
+        window = max(64, 16 * len(client.scheduler_info()["workers"]))
+        yield from _results(client, _Submitter(client, shipped, trajectories, options,
+                                               robot.region_cache is not None, window),
+                            trajectories, ordered)
     finally:
-        if futures:
-            client.cancel(futures)
-        client.close()
+        client.close()  # the tasks still queued or running are cancelled with it
 
 
-def _results(client, futures, trajectories, ordered: bool) -> Iterator[dict]:
-    from distributed import as_completed
+class _Submitter:
+    """Submits the tasks a window at a time (``window`` in flight), so that neither this
+    process nor the scheduler holds a task per trajectory of a long batch at once."""
 
+    def __init__(self, client, shipped, trajectories, options, region_cache: bool,
+                 window: int) -> None:
+        from distributed import as_completed
+
+        self.client, self.shipped, self.options = client, shipped, options
+        self.region_cache = region_cache
+        self.pending = iter(enumerate(trajectories))
+        self.batch = uuid.uuid4().hex[:12]
+        self.index: dict[str, int] = {}
+        self.completed = as_completed(loop=client.loop)
+        for _ in range(window):
+            self.next()
+
+    def next(self) -> None:
+        """Submit the next trajectory's task, if any is left."""
+        for i, spec in self.pending:
+            future = self.client.submit(_remote_check, self.shipped, spec, self.options,
+                                        self.region_cache, key=f"singcheck-{self.batch}-{i}",
+                                        pure=False)
+            self.index[future.key] = i
+            self.completed.add(future)
+            return
+
+
+def _results(client, tasks: _Submitter, trajectories, ordered: bool) -> Iterator[dict]:
     from singcheck.report.trajectory import error_json
 
-    index = {f.key: i for i, f in enumerate(futures)}
     done: dict[int, dict] = {}
     next_out = 0
-    for future in as_completed(futures, loop=client.loop):
-        i = index[future.key]
+    for future in tasks.completed:
+        i = tasks.index.pop(future.key)
         try:
             doc = future.result()
         except Exception as e:  # the task was lost (a worker died) or could not run
             doc = error_json(trajectories[i], "internal",
                              f"the Dask task failed: {type(e).__name__}: {e}")
         future.release()
+        tasks.next()
         if not ordered:
             yield doc
             continue

@@ -8,10 +8,12 @@ import pytest
 from click.testing import CliRunner
 
 from singcheck.cli import commands as cli
+from tests.conftest import ROBOTS, TRAJECTORIES
 from tests.test_cas import _backend
 from tests.test_cli import ORTHO, singcheck, traj
 
 ALL = [traj(n) for n in ("heart1", "heart2", "helix")]
+DATA_ROBOTS = ROBOTS.parent / "tests" / "data" / "robots"
 
 
 def _summary(doc: dict) -> list:
@@ -71,3 +73,47 @@ def test_backends_command_lists_all_four():
     assert infos["sympy"]["found"] is True
     missing = singcheck("backends", env={"PATH": "/nonexistent"})
     assert "missing" in missing.stdout and "apt-get install singular" in missing.stdout
+
+
+# Issue 12: a robot with revolute actuators (the 5-bar, bundled) and one with an
+# orientation whose ξ needs an elimination (a small bar robot: the bundled 3-RPR and
+# Gough–Stewart need none, and the 3-PRR's ξ of degree 32 takes Singular more than ten
+# minutes).  Each backend agrees with FLINT's answer, or refuses in one line that names a
+# backend that can; the refusals known today are listed, any other one fails.
+ANGLES = {
+    "five-bar": (ROBOTS / "five-bar.yaml", TRAJECTORIES / "five-bar-cross.yaml"),
+    "2-prr-bar": (DATA_ROBOTS / "2-prr-bar.yaml", DATA_ROBOTS / "2-prr-bar-turn.yaml"),
+}
+KNOWN_REFUSALS = {("sympy", "five-bar")}  # its Gröbner basis does not finish on the angles
+
+
+@pytest.fixture(scope="module")
+def angle_references():
+    out = {}
+    for case, (robot, path) in ANGLES.items():
+        run = singcheck("run", str(robot), str(path), "--backend", "flint", "--no-cache",
+                        "--format", "json")
+        assert run.returncode == 1, run.stderr  # both paths cross a singularity
+        out[case] = json.loads(run.stdout)
+    return out
+
+
+@pytest.mark.parametrize("case", sorted(ANGLES))
+@pytest.mark.parametrize("name", ["singular", "macaulay2", "sympy"])
+def test_backends_agree_on_a_revolute_robot_and_one_with_orientation(name, case,
+                                                                     angle_references):
+    if name != "sympy":
+        _backend(name)
+    robot, path = ANGLES[case]
+    out = singcheck("run", str(robot), str(path), "--backend", name, "--no-cache", "--format",
+                    "json")
+    if (name, case) in KNOWN_REFUSALS:
+        assert out.returncode == 4, out.stderr
+        (line,) = [x for x in out.stderr.splitlines() if "error" in x]  # one line
+        assert "cannot eliminate" in line and "flint" in line, line
+        return
+    assert out.returncode == 1, out.stderr
+    doc = json.loads(out.stdout)
+    assert doc["backend"] == name
+    assert _summary(doc) == _summary(angle_references[case])
+    assert any(c["status"] == "real" for c in doc["trajectories"][0]["candidates"])

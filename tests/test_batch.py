@@ -368,9 +368,10 @@ def test_a_signal_leaves_no_output_file(tmp_path):
 @pytest.fixture(scope="module")
 def local_cluster():
     """A dask.distributed cluster of two worker processes, on loopback only."""
-    distributed = pytest.importorskip("distributed")
+    import distributed  # the dask extra (make setup installs it)
+
     cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                       host="127.0.0.1", dashboard_address=None)
+                                       host="127.0.0.1", dashboard_address="127.0.0.1:0")
     yield cluster
     cluster.close()
 

@@ -433,3 +433,35 @@ def test_a_crossing_exactly_at_a_join_is_counted_once():
     # independently: 4 − y² = 0 only at y = 2, i.e. t = 1 exactly, on both pieces
     at_join = [c for c in crossings if c["t_interval"][0] <= 1 <= c["t_interval"][1]]
     assert len(at_join) == 1 and "serial singularity of leg p" in at_join[0]["surfaces"]
+
+
+def test_pieces_compose_with_multi_document_files(orthoglide_projection, robot_spec):
+    from singcheck.spec.files import parse_trajectories
+
+    text = LINEAR_YAML.format(kind="linear") + "---\n" + SEGMENTS_YAML
+    specs = list(parse_trajectories(text, "two.yaml", robot_spec))
+    assert [len(s.pieces) for s in specs] == [2, 2]
+    reports = [certify_trajectory(orthoglide_projection, s) for s in specs]
+    expected = singular_times(_linear_pieces())
+    for report in reports:  # the same path, written two ways
+        _assert_matches(report, expected)
+    jump = text.replace("19/10 - 4/5*t", "2 - 4/5*t")
+    with pytest.raises(SpecError, match=r"two.yaml:\d+: y: the pose jumps .*\(document 2\)"):
+        list(parse_trajectories(jump, "two.yaml", robot_spec))
+
+
+def test_project_prints_one_piece_in_its_own_time(tmp_path):
+    path = tmp_path / "w.yaml"
+    path.write_text(LINEAR_YAML.format(kind="cubic"))
+    robot = str(ROBOTS / "orthoglide.yaml")
+    out = singcheck("project", robot, str(path), "--no-epsilon", "--backend", "sympy")
+    assert out.returncode == 2 and "--segment" in out.stderr
+    out = singcheck("project", robot, str(path), "--no-epsilon", "--backend", "sympy",
+                    "--segment", "2")
+    assert out.returncode == 0, out.stderr
+    assert "u = t - 1" in out.stderr
+    line = next(x for x in out.stdout.splitlines() if x.startswith("x(t) = "))
+    t, u = sympy.symbols("t u")
+    t0, _, coords = _cubic_pieces()[1]
+    printed = sympy.sympify(line.split("=", 1)[1].replace("^", "**"), locals={"t": u})
+    assert sympy.expand(printed - coords[0].subs(t, u + t0)) == 0

@@ -310,3 +310,47 @@ def test_project_writes_the_revolute_branches_the_test_computes():
                       for sigma in (1, -1)}
             for ref in _five_bar_ik(t)[i]:
                 assert any(abs(mpmath.sin((ref - x) / 2)) < 1e-30 for x in angles)
+
+
+def test_an_angle_path_that_is_not_k_t_is_certified_by_branch_and_bound():
+    """phi: t^2 makes the path non-algebraic in sin t, cos t: μ mixes t with cos(t²),
+    sin(t²) and its roots come from interval branch-and-bound (never sampling); the test
+    finds det A's sign changes itself."""
+    robot = _robot(RPR)
+    text = ROTATING.replace("phi: t", "phi: t^2").replace("[0, 2*pi]", "[0, 2]")
+    report = _report(robot, text)
+    assert report.certificate.root_method == "interval branch-and-bound"
+
+    def det(t):
+        x, y, phi = 2 + mpmath.cos(t) / 5, 1 + mpmath.sin(t) / 5, t * t
+        rows = []
+        for (bx, by), a in zip(BASES, OFFSETS, strict=True):
+            c, s = mpmath.cos(phi + a), mpmath.sin(phi + a)
+            dx, dy = x + c - bx, y + s - by
+            rows.append([dx, dy, dx * -s + dy * c])
+        return mpmath.det(mpmath.matrix(rows))
+
+    expected = _sign_changes(det, mpmath.mpf(0), mpmath.mpf(2))
+    got = [c.t for c in report.candidates if c.status == "real"]
+    assert expected and len(got) == len(expected)
+    for ball, root in zip(got, expected, strict=True):
+        assert abs(mpmath.mpf(ball.mid().str(30, radius=False)) - root) < 1e-8
+    assert not report.certificate.undecided
+
+
+ORIENTED = """\
+name: oriented
+joints: [r1, r2]
+pose: [y, phi]
+constraints:
+  - (cos(phi) - r1)^2 + (y + sin(phi))^2 - 4
+  - (cos(phi + pi) - r2)^2 + (y + sin(phi + pi) - 1)^2 - 4
+"""
+
+
+@pytest.mark.parametrize("backend", ["singular", "macaulay2", "sympy"])
+def test_backends_agree_on_a_robot_with_orientation(backend):
+    """A pose angle (cos φ, sin φ kept, not eliminated) with prismatic legs whose det A
+    involves the joints: every backend eliminates the same ξ."""
+    assert _robot(ORIENTED, backend).singularity_surface == \
+        _robot(ORIENTED).singularity_surface

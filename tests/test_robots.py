@@ -82,8 +82,8 @@ def test_bundled_path_agrees_with_the_independent_oracle(name, robots):
 def test_designed_crossings_are_where_the_geometry_says():
     """The oracles themselves, against closed forms: the 5-bar path meets y = √3 (the
     distal links aligned: P the midpoint of B1 B2) at t = (3 - √3)/2; the
-    Gough–Stewart platform turned by π/2 about z is singular (its geometry is symmetric
-    under y ↦ -y and the sway sin(t)/4 is then along its mirror)."""
+    Gough–Stewart path is singular at t = π/2 (observed to 40 digits, quoted in the
+    README)."""
     (t,) = oracles.solve(PATHS["five-bar-cross"]).singular_times
     assert abs(t - (3 - mp.sqrt(3)) / 2) < mp.mpf(10) ** -40
     (t,) = oracles.solve(PATHS["gough-stewart-rotate"]).singular_times

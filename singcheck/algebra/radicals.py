@@ -345,12 +345,33 @@ def expand_trig(coefficients: dict[str, int], pi_part: Fraction,
     return reduce_relations(re_), reduce_relations(im)
 
 
-def path_ring(primes) -> fmpq_mpoly_ctx:
-    """Q[t, s, c] with a ``sqrt(p)`` variable per prime (``TRIG`` itself for none)."""
+#: the angle functions of the path rings: name of the expression -> (P, q), the angle
+#: being P(t, sin t, cos t) + q·π (a path whose angle is not k·t + qπ)
+_ANGLE_FUNCTIONS: dict[str, tuple[fmpq_mpoly, Fraction]] = {}
+
+
+def angle_function(p: fmpq_mpoly, q: Fraction) -> tuple[str, str]:
+    """The path ring variables ``(cos(g), sin(g))`` standing for cos and sin of the angle
+    g(t) = p(t, sin t, cos t) + q·π along a path (p a ``TRIG`` polynomial)."""
+    q = Fraction(q)
+    text = str(p) + (f" + {q}*pi" if q else "")
+    _ANGLE_FUNCTIONS[text] = (p, q)
+    return angle_names(text)
+
+
+def _angle_function_of(name: str) -> tuple[fmpq_mpoly, Fraction] | None:
+    return _ANGLE_FUNCTIONS.get(name[4:-1]) if name.startswith(("cos(", "sin(")) else None
+
+
+def path_ring(primes, functions=()) -> fmpq_mpoly_ctx:
+    """Q[t, s, c] with a ``sqrt(p)`` variable per prime and the (cos, sin) variables of
+    each angle function (``TRIG`` itself for none)."""
     primes = sorted(set(primes))
-    if not primes:
+    if not primes and not functions:
         return TRIG
-    return fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
+    names = ("t", "s", "c", *(radical_name(p) for p in primes),
+             *(n for pair in functions for n in pair))
+    return fmpq_mpoly_ctx.get(names, "lex")
 
 
 def into_ring(p: fmpq_mpoly, ring: fmpq_mpoly_ctx) -> fmpq_mpoly:
@@ -387,14 +408,33 @@ def _parts(p: fmpq_mpoly) -> list[tuple[tuple[int, ...], fmpq_mpoly]]:
     return parts
 
 
+def _extra_balls(ctx: fmpq_mpoly_ctx, t: arb, signs) -> list:
+    """Balls of the variables after t, s, c: ±√q, or cos/sin of an angle function."""
+    signs = signs or {}
+    out = []
+    cache: dict[str, arb] = {}
+    for name in ctx.names()[3:]:
+        q = radical_prime(name)
+        if q is not None:
+            out.append(arb(q).sqrt() * signs.get(q, 1))
+            continue
+        p, k = _angle_function_of(name)
+        key = name[4:-1]
+        if key not in cache:
+            cache[key] = evaluate_trig(p, t) + arb.pi() * arb(fmpq(k.numerator, k.denominator))
+        out.append(cache[key].cos() if name.startswith("cos(") else cache[key].sin())
+    return out
+
+
 def evaluate_path(p: fmpq_mpoly, t: arb, signs: dict[int, int] | None = None,
                   tight: bool = False) -> arb:
     """Rigorous enclosure of a path polynomial (in a :func:`path_ring`) for every t in
-    the ball ``t``, each ``sqrt(q)`` at its value √q (or -√q where ``signs[q] = -1``);
-    ``tight`` as for :func:`~singcheck.algebra.trig.evaluate_trig`."""
+    the ball ``t``, each ``sqrt(q)`` at its value √q (or -√q where ``signs[q] = -1``) and
+    each angle function's cos/sin at the ball of its angle over ``t``; ``tight`` as for
+    :func:`~singcheck.algebra.trig.evaluate_trig`."""
     if p.context() is TRIG:
         return evaluate_trig(p, t, tight)
-    values = [b for _, b in sorted(radical_balls(p.context(), signs).items())]
+    values = _extra_balls(p.context(), t, signs)
     total = arb(0)
     for exps, part in _parts(p):
         term = evaluate_trig(part, t, tight)
@@ -403,6 +443,29 @@ def evaluate_path(p: fmpq_mpoly, t: arb, signs: dict[int, int] | None = None,
                 term *= v ** e
         total += term
     return total
+
+
+def path_derivative(p: fmpq_mpoly) -> fmpq_mpoly:
+    """d/dt of a path polynomial: ∂/∂t + c·∂/∂s - s·∂/∂c, plus g'(t)·(-sin g·∂/∂cos g +
+    cos g·∂/∂sin g) for each angle function g (reduced)."""
+    from singcheck.algebra.trig import derivative
+
+    ctx = p.context()
+    if ctx is TRIG:
+        return derivative(p)
+    gens = dict(zip(ctx.names(), ctx.gens(), strict=True))
+    out = p.derivative("t") + gens["c"] * p.derivative("s") - gens["s"] * p.derivative("c")
+    for name in ctx.names()[3:]:
+        if name.startswith("cos(") and _angle_function_of(name) is not None:
+            g, _ = _angle_function_of(name)
+            sin_name = "sin(" + name[4:]
+            dg = into_ring(derivative(g), ctx)
+            out += dg * (gens[name] * p.derivative(sin_name) - gens[sin_name] * p.derivative(name))
+    return reduce_relations(out)
+
+
+def has_angle_functions(ctx: fmpq_mpoly_ctx) -> bool:
+    return any(_angle_function_of(n) is not None for n in ctx.names()[3:])
 
 
 def conjugates(p: fmpq_mpoly) -> list[dict[int, int]]:

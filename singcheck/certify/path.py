@@ -27,6 +27,7 @@ from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 from singcheck.algebra.intervals import evaluate, fraction_ball
 from singcheck.algebra.polynomials import restrict
 from singcheck.algebra.radicals import (
+    angle_function,
     cos_pi,
     evaluate_path,
     into_ring,
@@ -347,21 +348,28 @@ class PathModel:
         return out
 
 
-def _angle_coordinates(v: str, p: fmpq_mpoly, q, ring, where) -> tuple[fmpq_mpoly, fmpq_mpoly]:
-    """(cos, sin) of the angle k·t + qπ along the path, exactly."""
+def _angle_k(p: fmpq_mpoly, q) -> int | None:
+    """k when the angle p + qπ is k·t + qπ with k an integer and 12q an integer."""
+    if cos_pi(q) is None:
+        return None
     terms = dict(p.terms())
-    k = None
     if not terms:
-        k = 0
-    elif len(terms) == 1:
+        return 0
+    if len(terms) == 1:
         (exps, coeff), = terms.items()
         if exps[0] == 1 and not any(exps[1:]) and coeff.q == 1:
-            k = int(coeff.p)
-    if k is None or cos_pi(q) is None:
-        raise UnsupportedRobotError(
-            f"the angle {v} must follow k*t + a multiple of pi/12 along the path (k an "
-            "integer, e.g. 2*t - pi/6) for an exact certificate; other angle paths are not "
-            "supported yet", **where)
+            return int(coeff.p)
+    return None
+
+
+def _angle_coordinates(p: fmpq_mpoly, q, ring) -> tuple[fmpq_mpoly, fmpq_mpoly]:
+    """(cos, sin) of the angle p + qπ along the path: exact polynomials in s, c when it is
+    k·t + qπ, else the ring's angle-function variables (certified by branch-and-bound)."""
+    k = _angle_k(p, q)
+    if k is None:
+        gens = dict(zip(ring.names(), ring.gens(), strict=True))
+        c, s = angle_function(p, q)
+        return gens[c], gens[s]
     ck, sk = into_ring(cos_multiple(k), ring), into_ring(sin_multiple(k), ring)
     cq, sq = surd_polynomial(cos_pi(q), ring), surd_polynomial(sin_pi(q), ring)
     return _reduce(ck * cq - sk * sq), _reduce(sk * cq + ck * sq)
@@ -402,8 +410,8 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
         coordinates = tuple(restrict(x, TRIG) for x in coordinates)
     else:
         raise UnsupportedRobotError(
-            "ξ(X) was not expanded and this path has square roots of its own (sqrt, or an "
-            "angle offset like pi/6): eliminating along it is not supported yet",
+            "ξ(X) was not expanded and this path has square roots or an angle that is not "
+            "k*t + q*pi of its own: eliminating along it is not supported yet",
             **(where or {}))
     eliminated = model.eliminated
     ring = fmpq_mpoly_ctx.get((*eliminated, "t", "s", "c"), "lex")
@@ -414,7 +422,27 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
             for v in model.context.names()]
     det_a = model.det_A.compose(*args, ctx=ring)
     legs = [(v, f.compose(*args, ctx=ring)) for v, f in norm_legs(model)]
-    return reduce_trig(restrict(norm_chain(det_a, legs), TRIG))
+    return reduce_trig(restrict(norm_chain(det_a, legs, reduce=_on_circle), TRIG))
+
+
+def _on_circle(p: fmpq_mpoly) -> fmpq_mpoly:
+    """``p`` (in a ring with the path's s = sin t, c = cos t) with s² replaced by 1 - c²:
+    degree ≤ 1 in s, the same function of t.  Keeps path-wise norms small."""
+    ctx = p.context()
+    names = ctx.names()
+    si = names.index("s")
+    if p.degrees()[si] < 2:
+        return p
+    one_minus_c2 = 1 - ctx.gens()[names.index("c")] ** 2
+    groups: dict[int, dict] = {}
+    for exps, coeff in p.terms():
+        e = list(exps)
+        half, e[si] = divmod(e[si], 2)
+        groups.setdefault(half, {})[tuple(e)] = coeff
+    out = ctx.from_dict({})
+    for half, terms in groups.items():
+        out += ctx.from_dict(terms) * one_minus_c2 ** half
+    return out
 
 
 _LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}
@@ -454,12 +482,20 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
                         e.message, path=spec.path, line=spec.lines.get("joint_limits"),
                         key=f"joint_limits.{leg.joint}") from None
                 primes |= cos_l.primes() | sin_l.primes()
-    ring = path_ring(primes)
+    functions = []
+    for v, x in zip(model.pose, phi, strict=True):
+        if v in model.angles and _angle_k(x, offsets.get(v, 0)) is None:
+            if x.context() is not TRIG:
+                raise UnsupportedRobotError(
+                    f"the angle {v} is neither k*t plus a multiple of pi/12 nor free of square "
+                    "roots: not supported", **where)
+            functions.append(angle_function(x, offsets.get(v, 0)))
+    ring = path_ring(primes, functions)
     phi = tuple(into_ring(x, ring) for x in phi)
     coordinates = []
     for v, x in zip(model.pose, phi, strict=True):
         if v in model.angles:
-            coordinates += _angle_coordinates(v, x, offsets.get(v, 0), ring, where)
+            coordinates += _angle_coordinates(trajectory.pose[v], offsets.get(v, 0), ring)
         else:
             coordinates.append(x)
     coordinates = tuple(coordinates)

@@ -299,7 +299,10 @@ Examples:
               show_default=True)
 @click.option("--no-epsilon", is_flag=True,
               help="Skip ε(ρ) (a Gröbner elimination of the pose, slow for large robots).")
-def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
+@click.option("--segment", type=click.IntRange(min=1),
+              help="For a TRAJECTORY of several pieces (segments, waypoints, CSV): the piece "
+                   "whose formulas to print (1 = the first), in its own time.")
+def project(robot, trajectory, backend, as_latex, fmt, no_epsilon, segment) -> None:
     """Print the robot's formulas: det A, det B, ξ(X), ε(ρ), the workspace boundary and
     joint-limit surfaces; with a TRAJECTORY, φ(t) and every joint's parametrisation
     ρ(t) = P(t) ± √Q(t)/k (the paper's form, in s = sin t and c = cos t)."""
@@ -312,9 +315,16 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon) -> None:
 
         spec = load_robot(robot)
         traj = load_trajectory(trajectory, spec) if trajectory else None
-        if traj is not None and traj.segments:
-            raise SpecError(f"project prints the formulas of a one-piece trajectory; this one "
-                            f"has {len(traj.segments)} segments", path=traj.path)
+        if traj is not None and (traj.segments or segment):
+            count = len(traj.pieces)
+            if segment is None or segment > count:
+                raise SpecError(f"the trajectory has {count} piece(s): choose one with "
+                                f"--segment N (1 to {count})", path=traj.path)
+            traj = traj.pieces[segment - 1]
+        if traj is not None and (traj.time_scale is not None or traj.time_offset):
+            own = (f"tau = {traj.time_scale}*pi*{traj.parameter}" if traj.time_scale
+                   is not None else f"u = {traj.parameter} - {traj.time_offset}")
+            click.echo(f"note: t in these formulas is the piece's own time, {own}", err=True)
         engine = api.elimination_engine(backend, cache=False)
         machine = api.robot_from_spec(spec, cache=False, engine=engine)
         epsilon = None if no_epsilon or not machine.projection.expanded else \

@@ -159,7 +159,8 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
     return g0 * g0 - delta * g1 * g1
 
 
-def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]]) -> fmpq_mpoly:
+def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
+               reduce=None) -> fmpq_mpoly:
     """A polynomial with the zero set of ``Res_vn(… Res_v1(g, f_1) …, f_n)`` (FLINT).
 
     When each f_i is monic-like in its v_i (constant leading coefficient), that chain is
@@ -168,7 +169,9 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]]) -> fmpq_mpo
     :func:`revolute_norm` instead of a resultant.  Computed one irreducible factor of g
     at a time, reduced to its squarefree part after each step (the next resultant
     vanishes exactly where the previous one has a root of the next leg, so the zero set
-    is kept), which keeps factored inputs (stacked stages) small.
+    is kept), which keeps factored inputs (stacked stages) small.  ``reduce`` (optional)
+    maps each intermediate to an equivalent one modulo relations of the ring (along a
+    path: s² + c² = 1), which keeps the same zeros on the variety of those relations.
     """
     names = g.context().names()
     _, factors = g.factor()
@@ -179,9 +182,8 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]]) -> fmpq_mpo
             variables = v if isinstance(v, tuple) else (v,)
             if all(acc.degrees()[names.index(x)] <= 0 for x in variables):
                 continue  # a leg that does not touch this factor only raises its power
-            if isinstance(v, tuple):
-                acc = squarefree_part(revolute_norm(acc, v[0], v[1], f))
-            else:
-                acc = squarefree_part(acc.resultant(f, v))
+            acc = revolute_norm(acc, v[0], v[1], f) if isinstance(v, tuple) else \
+                acc.resultant(f, v)
+            acc = squarefree_part(reduce(acc) if reduce else acc)
         total *= acc
     return squarefree_part(total)

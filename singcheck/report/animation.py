@@ -165,7 +165,7 @@ def animation_figure(report: TrajectoryReport, d, title: str, samples: int = SAM
         legend={"orientation": "h", "y": 1.1, "x": 0.0, "yanchor": "bottom"})
     fig.update_xaxes(title_text=report.trajectory.parameter, row=2, col=2)
     box = drawing_box([b for b in frames_bodies if b], path_traces)
-    names = report.path.projection.model.pose
+    names = [v for v in spec.pose if v not in spec.angles]  # the pose's positions
     titles = list(names) if len(names) == dim else ["", "", ""]
     if dim == 3:
         fig.update_scenes(aspectmode="cube", **{

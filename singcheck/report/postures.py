@@ -77,9 +77,21 @@ def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:
     return [DrawnBody(body.name,
                       [np.array([point(p) for p in chain]) for chain in body.chains],
                       np.array([point(p) for p in body.points]).reshape(-1, dim),
-                      all(c.is_constant() for p in (*body.points, *sum(body.chains, ()))
-                          for c in p))
+                      not any(_moves(c, _indices(spec, (*spec.joints, *spec.pose)))
+                              for p in (*body.points, *sum(body.chains, ())) for c in p))
             for body in spec.drawing]
+
+
+def _indices(spec: RobotSpec, names) -> list[int]:
+    """The context indices of these joints or pose variables (an angle: cos and sin)."""
+    context = spec.context.names()
+    return [context.index(v) for n in names for v in spec.variables(n)]
+
+
+def _moves(c, indices: list[int]) -> bool:
+    """Whether the polynomial involves one of these variables (a parameter's sqrt(p)
+    is a variable of the context too, but it never moves)."""
+    return any(c.degrees()[i] > 0 for i in indices)  # the zero polynomial: -1
 
 
 def _on_piece(report: TrajectoryReport, index: int, t: arb):
@@ -149,13 +161,14 @@ def traced_points(report: TrajectoryReport, t: np.ndarray) -> list[np.ndarray]:
     (len(t), dim)."""
     model = report.path.projection.model
     spec = model.spec
-    joint_index = [spec.context.names().index(v) for v in spec.joint_variables]
+    joint_index = _indices(spec, spec.joints)
+    pose_index = _indices(spec, spec.pose)
     located = [(piece_index(report, float(x)), float(x)) for x in t]
     located = [(i, _on_piece(report, i, arb(x))) for i, x in located]
 
     def pose_only(p) -> bool:
-        return not any(c.degrees()[i] for c in p for i in joint_index) and \
-            not all(c.is_constant() for c in p)
+        return not any(_moves(c, joint_index) for c in p) and \
+            any(_moves(c, pose_index) for c in p)
 
     # the drawing's single points (a platform) when some move with the pose alone, else
     # every end point of a segment that does
@@ -216,7 +229,8 @@ def posture_figure(plt, report: TrajectoryReport, title: str, samples: int = 600
         return None
     spec = report.path.projection.model.spec
     dim = spec.drawing_dimension
-    axes = report.path.projection.model.pose  # named when they are the drawing's axes
+    # the axes are named when the pose's positions (its variables but angles) are they
+    axes = [v for v in spec.pose if v not in spec.angles]
     rng = report.trajectory.global_range
     lo, hi = float(rng.start), float(rng.end)
     traces = traced_points(report, np.linspace(lo, hi, samples))
@@ -244,7 +258,7 @@ def posture_figure(plt, report: TrajectoryReport, title: str, samples: int = 600
                         label=body.name if chain is body.chains[0] else None)
             if len(body.points):
                 ax.plot(*body.points.T, ls="none", marker="o", ms=6, color=colour,
-                        markeredgecolor=_SINGULAR if singular else "black",
+                        markeredgecolor=_SINGULAR if singular and not body.fixed else "black",
                         label=None if body.chains else body.name)
         what = "singular" if singular else "start"
         mode = post.mode + ("" if post.feasible else " (infeasible)")

@@ -17,6 +17,12 @@ F(t) = F⁽ᵐ⁾(ξ)(t - z)ᵐ/m!, proves z the only root in B, of multiplicity
 when m is even).  B is then taken out of the branch-and-bound, which could never prove
 a multiple root.  (By the Lindemann–Weierstrass theorem these are the only algebraic
 times where a function genuinely mixing t with sin t, cos t can vanish.)
+
+F may also be a path polynomial with angle functions cos g(t), sin g(t) (a pose angle
+that is not k·t + qπ): it is enclosed with the ball of g over the box, and F' comes from
+:func:`~singcheck.algebra.radicals.path_derivative` (the chain rule through g); a zero at
+kπ is then taken as exact only when F(kπ, 0, ±1, …) is the zero polynomial in what is
+left (t and the angle functions), true whatever their values.
 """
 
 from __future__ import annotations
@@ -27,7 +33,9 @@ from fractions import Fraction
 from flint import arb, fmpq, fmpq_mpoly
 
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
-from singcheck.algebra.trig import LinearInPi, TimeRange, derivative, evaluate_trig
+from singcheck.algebra.radicals import evaluate_path as evaluate_trig
+from singcheck.algebra.radicals import path_derivative as derivative
+from singcheck.algebra.trig import LinearInPi, TimeRange
 from singcheck.budget import checkpoint
 from singcheck.roots.enclosures import (
     BRANCH_AND_BOUND,

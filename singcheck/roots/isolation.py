@@ -15,11 +15,18 @@ a reason.  It picks one of three methods:
 
 from __future__ import annotations
 
-from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
+from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 
 from singcheck.algebra.intervals import excludes_zero, working_precision
 from singcheck.algebra.polynomials import restrict
-from singcheck.algebra.radicals import conjugates, evaluate_path, norm_radicals
+from singcheck.algebra.radicals import (
+    conjugates,
+    evaluate_path,
+    norm_radicals,
+    radical_prime,
+    radical_variables,
+    reduce_relations,
+)
 from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig, uses_t, uses_trig
 from singcheck.roots.branch_bound import branch_and_bound
 from singcheck.roots.enclosures import (
@@ -130,7 +137,12 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
     A polynomial with square roots among its coefficients (a :func:`path_ring`
     element) goes through :func:`_with_radicals`."""
     if poly.context() is not TRIG:
-        return _with_radicals(poly, interval, tolerance)
+        if radical_variables(poly.context()):
+            return _with_radicals(poly, interval, tolerance)
+        p = reduce_relations(poly)
+        if p.is_zero():
+            raise IdenticallyZeroError("the function is identically zero along the path")
+        return branch_and_bound(p, interval, tolerance)  # angle functions: t mixed with them
     p = reduce_trig(poly)
     if p.is_zero():
         raise IdenticallyZeroError("the function is identically zero along the path")
@@ -149,7 +161,10 @@ def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Root
     a conjugate only: dropped.  If every conjugate p^σ (σ ≠ id) excludes 0 on T, then
     p(τ) = 0: kept.  Otherwise T is refined (and the precision raised) a few times;
     what stays ambiguous is reported undecided, never guessed."""
-    norm = restrict(norm_radicals(p), TRIG)
+    ctx = p.context()
+    rest = [n for n in ctx.names() if radical_prime(n) is None]
+    norm = restrict(norm_radicals(p), TRIG if len(rest) == 3 else
+                    fmpq_mpoly_ctx.get(tuple(rest), "lex"))
     iso = isolate_real_roots(norm, interval, tolerance)
     sigmas = conjugates(p)
     roots, undecided = [], list(iso.undecided)

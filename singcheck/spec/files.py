@@ -218,7 +218,7 @@ def _check_depth(text: str, path: str) -> None:
     parser is a state machine; its composer, and our walks, recurse once per level)."""
     depth = 0
     try:
-        for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        for event in yaml.parse(text, Loader=_LOADER):
             if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
                 depth += 1
                 if depth > MAX_YAML_DEPTH:
@@ -240,10 +240,15 @@ def _yaml_error(e: yaml.YAMLError, path: str) -> SpecError:
     return SpecError(f"not valid YAML: {str(e).splitlines()[0]}", path=path)
 
 
+#: libyaml's safe loader when PyYAML was built with it (the same nodes and marks, parsed
+#: in C), else the pure-Python one
+_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
 def _compose(text: str, path: str):
     _check_depth(text, path)
     try:
-        node = yaml.compose(text, Loader=yaml.SafeLoader)
+        node = yaml.compose(text, Loader=_LOADER)
     except yaml.YAMLError as e:
         raise _yaml_error(e, path) from None
     if node is None:
@@ -256,7 +261,7 @@ def _compose_all(text: str, path: str) -> Iterator:
     """Every document of a YAML stream (``---`` between documents), composed one at a
     time; empty documents are skipped, a stream with none is an error."""
     _check_depth(text, path)
-    stream = yaml.compose_all(text, Loader=yaml.SafeLoader)
+    stream = yaml.compose_all(text, Loader=_LOADER)
     found = False
     while True:
         try:
@@ -375,7 +380,9 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     if not len(constraints) == len(joints) == len(pose):
         raise doc.error(top["constraints"][0], "constraints",
                         f"{len(constraints)} constraints for {len(joints)} joints and "
-                        f"{len(pose)} pose variables: the system must be square")
+                        f"{len(pose)} pose variables: the system must be square (one "
+                        "constraint per actuated joint; a passive joint must be eliminated "
+                        "first, e.g. by writing its leg as a squared distance)")
     limits: dict[str, tuple[Fraction, Fraction]] = {}
     if "joint_limits" in top:
         for jname, (knode, vnode) in doc.mapping(top["joint_limits"][1],

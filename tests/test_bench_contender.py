@@ -1,0 +1,90 @@
+"""The bench's certified contender (interval branch-and-bound on det A along each feasible
+mode, bench/contender.py), checked against det A computed independently with 50-digit
+mpmath along the paths."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import mpmath
+
+from singcheck.model.robot import build_model
+from singcheck.spec.files import load_robot, load_trajectory
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "bench"))
+
+from contender import contender  # noqa: E402
+
+mpmath.mp.dps = 50
+
+
+def _orthoglide_det_a(t):
+    """det A of the Orthoglide (legs of length 2, mode +++) along heart 1, in mpmath:
+    ρᵢ = Xᵢ + √(4 - the other two coordinates squared); A = ∂F/∂X."""
+    s, c = mpmath.sin(t), mpmath.cos(t)
+    x = mpmath.mpf(8) / 7 * s**3
+    y = (mpmath.mpf(13) / 14 * c - mpmath.mpf(5) / 14 * mpmath.cos(2 * t)
+         - mpmath.mpf(1) / 10 * mpmath.cos(3 * t) - mpmath.mpf(1) / 14 * mpmath.cos(4 * t))
+    z = mpmath.mpf(1)
+    r1 = x + mpmath.sqrt(4 - y**2 - z**2)
+    r2 = y + mpmath.sqrt(4 - x**2 - z**2)
+    r3 = z + mpmath.sqrt(4 - x**2 - y**2)
+    return mpmath.det(mpmath.matrix([[2 * (x - r1), 2 * y, 2 * z],
+                                     [2 * x, 2 * (y - r2), 2 * z],
+                                     [2 * x, 2 * y, 2 * (z - r3)]]))
+
+
+def _sign_changes(f, a, b, n=400):
+    ts = [a + (b - a) * mpmath.mpf(i) / n for i in range(n + 1)]
+    roots = []
+    for lo, hi in zip(ts, ts[1:], strict=False):
+        if f(lo) * f(hi) < 0:
+            roots.append(mpmath.findroot(f, (lo, hi), solver="anderson"))
+    return roots
+
+
+def _load(robot: str, trajectory: str):
+    model = build_model(load_robot(ROOT / "robots" / f"{robot}.yaml"))
+    return model, load_trajectory(ROOT / "trajectories" / f"{trajectory}.yaml", model.spec)
+
+
+def test_contender_finds_heart1_singularities_where_mpmath_does():
+    model, spec = _load("orthoglide", "heart1")
+    answer = contender(model, spec)
+    assert answer.verdict == "singular"
+    assert answer.feasible == ["+++"]
+    expected = _sign_changes(_orthoglide_det_a, -mpmath.pi, mpmath.pi)
+    found = sorted(answer.singular_times["+++"], key=lambda b: b.mid())
+    assert len(found) == len(expected) == 2
+    for ball, root in zip(found, expected, strict=True):
+        lo = mpmath.mpf(ball.lower().str(40, radius=False))
+        hi = mpmath.mpf(ball.upper().str(40, radius=False))
+        assert lo - mpmath.mpf(10) ** -30 <= root <= hi + mpmath.mpf(10) ** -30
+        assert hi - lo <= 1e-9
+
+
+def test_contender_says_unknown_at_a_graze_and_free_on_heart2():
+    # the biglide's path touches y = 0 (det A = 4y(q - p)) without crossing it: no sign
+    # change to prove, so branch-and-bound cannot decide; heart 2 never meets det A = 0
+    model, spec = _load("biglide", "biglide-graze")
+    assert contender(model, spec).verdict == "unknown"
+    model, spec = _load("orthoglide", "heart2")
+    answer = contender(model, spec)
+    assert answer.verdict == "singularity-free" and answer.feasible == ["+++"]
+    assert all(_orthoglide_sign(t) for t in (mpmath.mpf(i) / 10 for i in range(-31, 32)))
+
+
+def _orthoglide_sign(t) -> bool:
+    """det A along heart 2 (mode +++) is far from 0 at t: a smoke check of the free path."""
+    s, c = mpmath.sin(t), mpmath.cos(t)
+    x = mpmath.mpf(4) / 5 * s**3
+    y = (mpmath.mpf(13) / 20 * c - mpmath.mpf(1) / 4 * mpmath.cos(2 * t)
+         - mpmath.mpf(1) / 20 * mpmath.cos(3 * t) - mpmath.mpf(1) / 20 * mpmath.cos(4 * t))
+    z = mpmath.mpf(1)
+    r1 = x + mpmath.sqrt(4 - y**2 - z**2)
+    r2 = y + mpmath.sqrt(4 - x**2 - z**2)
+    r3 = z + mpmath.sqrt(4 - x**2 - y**2)
+    det = -8 * r1 * r2 * r3 + 8 * r1 * r2 * z + 8 * r1 * r3 * y + 8 * r2 * r3 * x
+    return abs(det) > mpmath.mpf(10) ** -3

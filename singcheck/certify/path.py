@@ -91,6 +91,44 @@ def joint_float(value) -> float | None:
     return None
 
 
+#: The most terms μ(t) = ξ(φ(t)) may have by the a-priori bound of :func:`mu_size_bound`
+#: (heart 1: 89, the helix: 225, the stacked heart: 201; the Orthoglide with
+#: x = (sin t + cos t + t)^16: 35,217, composed in about a second, while the power 24
+#: took 3 to 10 s and 64 ran out of memory).
+MAX_MU_TERMS = 50_000
+
+
+def mu_size_bound(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...],
+                  pose: tuple[str, ...]) -> tuple[int, int, int]:
+    """(degree in t, degree in sin/cos, terms) that ξ(φ(t)) cannot exceed, from the
+    degrees alone: each monomial of ξ becomes a product of powers of the coordinates,
+    and a reduced trig polynomial of degree a in t and b in (s, c) has at most
+    (a + 1)(2b + 1) terms.  Cheap: nothing is composed."""
+    names = xi.context().names()
+    dt = [phi[pose.index(v)].degrees()[0] if v in pose else 0 for v in names]
+    dsc = [sum(phi[pose.index(v)].degrees()[1:]) if v in pose else 0 for v in names]
+    deg_t = deg_sc = 0
+    for exps, _ in xi.terms():
+        deg_t = max(deg_t, sum(e * d for e, d in zip(exps, dt, strict=True)))
+        deg_sc = max(deg_sc, sum(e * d for e, d in zip(exps, dsc, strict=True)))
+    return deg_t, deg_sc, (deg_t + 1) * (2 * deg_sc + 1)
+
+
+def _refuse_costly(xi, phi, pose, trajectory) -> None:
+    """Refuse up front (one line, exit 2) a path whose μ would be too large to compose
+    and isolate within any reasonable budget (the composition is one FLINT call that a
+    time limit cannot interrupt)."""
+    deg_t, deg_sc, terms = mu_size_bound(xi, phi, pose)
+    if terms > MAX_MU_TERMS:
+        from singcheck.errors import SpecError
+
+        raise SpecError(
+            f"too costly: μ(t) = ξ(φ(t)) could have {terms} terms (degree {deg_t} in t and "
+            f"{deg_sc} in sin t, cos t; at most {MAX_MU_TERMS}): lower the degree of the "
+            "coordinates or the multiples of t in sin/cos", path=trajectory.path,
+            line=trajectory.lines.get("pose"), key="pose")
+
+
 @dataclass(frozen=True)
 class LegAlongPath:
     """One leg's constraint along the path: ``a ρ² + b(t) ρ + c(t)`` (or ``b ρ + c``), or
@@ -466,6 +504,7 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
     coordinates = tuple(coordinates)
     pose_vars = model.pose_variables
     if projection.expanded:
+        _refuse_costly(projection.singularity_surface, coordinates, pose_vars, trajectory)
         mu = compose_pose(projection.singularity_surface, coordinates, pose_vars)
     else:
         mu = eliminate_along_path(model, coordinates, where)

@@ -82,13 +82,8 @@ def leg_structure(request: EliminationRequest):
                if any(_is_circle(f, names.index(c), names.index(s)) for f in request.generators)}
     legs: dict[object, fmpq_mpoly] = {}
     rest = []
-    # square roots sqrt(p) (with their pseudo-legs sqrt(p)² - p) may appear in any leg:
-    # they are eliminated last, over Q, so each leg's norm is taken over Q(√…) first
-    radicals = {v for v in request.eliminate if v.startswith("sqrt(")}
     for f in request.generators:
         involved = [v for v in request.eliminate if f.degrees()[names.index(v)] > 0]
-        if set(involved) - radicals:
-            involved = [v for v in involved if v not in radicals]
         involved = [v for v in involved if v not in radicals] or involved
         pair = [c for c in pairs if set(involved) <= {c, pairs[c]}] if involved else []
         if pair and len(involved) == 2 and _is_circle(f, *(names.index(v) for v in involved)):
@@ -104,8 +99,7 @@ def leg_structure(request: EliminationRequest):
     covered = {v for key in legs for v in (key if isinstance(key, tuple) else (key,))}
     if len(rest) != 1 or covered != set(request.eliminate):
         return None
-    order = {v: i + (len(names) if v in radicals else 0)
-             for i, v in enumerate(request.eliminate)}
+    order = {v: i for i, v in enumerate(request.eliminate)}
     keys = sorted(legs, key=lambda k: order[k[0] if isinstance(k, tuple) else k])
     return rest[0], [(k, legs[k]) for k in keys]
 

@@ -349,7 +349,7 @@ def batch_rows(counts=BATCH_COUNTS) -> list[dict]:
         from distributed import LocalCluster
 
         cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                               host="127.0.0.1", dashboard_address=None)
+                               host="127.0.0.1", dashboard_address="127.0.0.1:0")
     except ImportError:  # the dask extra is missing: no cluster rows
         pass
     with tempfile.TemporaryDirectory() as tmp:
@@ -565,8 +565,8 @@ def main() -> None:
     results["command_line"] = cli = cli_rows()
     print("\ncommand line")
     for r in cli:
-        print(f"  {r['what']:66} median CPU {ms(r.get('cpu_median_s', r['median_s']))} ms,"
-              f" wall {ms(r['median_s'])} ms" +
+        cpu = f"median CPU {ms(r['cpu_median_s'])} ms, " if "cpu_median_s" in r else ""
+        print(f"  {r['what']:66} {cpu}wall {ms(r['median_s'])} ms" +
               (f"  {r['verdicts']}" if "verdicts" in r else ""))
     results["batch"] = batch = batch_rows()
     print_batch(batch)

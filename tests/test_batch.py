@@ -371,7 +371,7 @@ def local_cluster():
     import distributed  # the dask extra (make setup installs it)
 
     cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                       host="127.0.0.1", dashboard_address=None)
+                                       host="127.0.0.1", dashboard_address="127.0.0.1:0")
     yield cluster
     cluster.close()
 

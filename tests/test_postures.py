@@ -14,6 +14,8 @@ import yaml
 from singcheck import api
 from singcheck.report.postures import postures
 from tests.conftest import ROBOTS, TRAJECTORIES
+from tests.test_revolute import CIRCLE
+from tests.test_revolute import FIVE_BAR as FIVE_BAR_SPEC
 
 CASES = [("orthoglide", "heart1"), ("skew-biglide", "skew-biglide-ellipse")]
 
@@ -210,25 +212,13 @@ drawing:
                                                            abs=1e-12)
 
 
-FIVE_BAR = """\
-name: fivebar
-joints: [th1, th2]
-pose: [x, y]
-parameters: {l1: 1, l2: 2, e: 1}
-constraints:
-  - (x + e - l1*cos(th1))^2 + (y - l1*sin(th1))^2 - l2^2
-  - (x - e - l1*cos(th2))^2 + (y - l1*sin(th2))^2 - l2^2
+# test_revolute's 5-bar (l1 = 1, l2 = 2, bases at (∓1, 0)) and its circle, with a drawing
+FIVE_BAR = FIVE_BAR_SPEC + """\
 drawing:
   base: [[[-e, 0], [e, 0]]]
   cranks: [[[-e, 0], [-e + l1*cos(th1), l1*sin(th1)]], [[e, 0], [e + l1*cos(th2), l1*sin(th2)]]]
   rods: [[[-e + l1*cos(th1), l1*sin(th1)], [x, y]], [[e + l1*cos(th2), l1*sin(th2)], [x, y]]]
   platform: [[x, y]]
-"""
-CIRCLE = """\
-name: circle
-parameter: t
-range: [0, 2*pi]
-pose: {x: 1/2*cos(t), y: 2 + 1/2*sin(t)}
 """
 
 

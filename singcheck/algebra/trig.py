@@ -23,7 +23,17 @@ from collections import OrderedDict
 from dataclasses import dataclass
 from fractions import Fraction
 
-from flint import arb, arb_poly, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly, fmpz_poly
+from flint import (
+    arb,
+    arb_mat,
+    arb_poly,
+    ctx,
+    fmpq,
+    fmpq_mpoly,
+    fmpq_mpoly_ctx,
+    fmpq_poly,
+    fmpz_poly,
+)
 
 #: Q[t, s, c]; exponents are (t, s, c).
 TRIG = fmpq_mpoly_ctx.get(("t", "s", "c"), "lex")
@@ -183,8 +193,12 @@ _FOURIERS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, object]] = OrderedDict
 
 def _fourier(p: fmpq_mpoly):
     """(terms, harmonics, degree in t) with terms (i, k, a, b) for tⁱ(a cos kt + b sin kt),
-    converted exactly (Chebyshev bases: T_k(c) = cos kt, s·U_(k-1)(c) = sin kt), the
-    coefficients rounded to balls at the current precision; memoised like the split."""
+    None when p's degree in (s, c) is low; memoised like the split.
+
+    The power bases are changed to the Chebyshev ones (cᵐ = Σₖ Mₖₘ Tₖ(c) with
+    Tₖ(c) = cos kt, s·cᵐ = Σₖ Nₖₘ s·Uₖ(c) with s·Uₖ(c) = sin (k+1)t) by one ball
+    matrix product per part: the matrices are exact dyadic rationals, so each ball
+    coefficient encloses the exact one."""
     key = (id(p), ctx.prec)
     hit = _FOURIERS.get(key)
     if hit is not None and hit[0] is p:
@@ -197,24 +211,50 @@ def _fourier(p: fmpq_mpoly):
         parts: dict[tuple[int, int], dict[int, fmpq]] = {}
         for (i, j, k), a in q.terms():
             parts.setdefault((i, j), {})[k] = a
-        found: dict[tuple[int, int], list[fmpq]] = {}
+        found: dict[tuple[int, int], list] = {}
         for (i, j), part in parts.items():
-            poly = fmpq_poly([part.get(k, 0) for k in range(max(part) + 1)])
-            while not poly.is_zero():
-                n = poly.degree()
-                basis = fmpq_poly(fmpz_poly.chebyshev_t(n) if j == 0
-                                  else fmpz_poly.chebyshev_u(n))
-                coeff = poly.coeffs()[-1] / basis.coeffs()[-1]
-                poly -= coeff * basis
-                k = n if j == 0 else n + 1
-                found.setdefault((i, k), [fmpq(0), fmpq(0)])[j] += coeff
-        terms = [(i, k, arb(a) if a != 0 else None, arb(b) if b != 0 else None)
-                 for (i, k), (a, b) in sorted(found.items()) if a != 0 or b != 0]
+            n = max(part)
+            column = arb_mat(n + 1, 1, [arb(part.get(m, 0)) for m in range(n + 1)])
+            product = _chebyshev_change(n, j) * column
+            for k in range(n + 1):
+                value = product[k, 0]
+                if value != 0 or not value.is_exact():
+                    harmonic = k if j == 0 else k + 1
+                    found.setdefault((i, harmonic), [None, None])[j] = value
+        terms = [(i, k, a, b) for (i, k), (a, b) in sorted(found.items())]
         form = (terms, sorted({k for _, k, _, _ in terms if k}), dt)
     _FOURIERS[key] = (p, form)
     if len(_FOURIERS) > _SPLITS_KEPT:
         _FOURIERS.popitem(last=False)
     return form
+
+
+_CHEBYSHEV: dict[tuple[int, int, int], arb_mat] = {}
+
+
+def _chebyshev_change(n: int, part: int) -> arb_mat:
+    """The (n+1)×(n+1) matrix taking power coefficients c⁰…cⁿ to Chebyshev ones:
+    T₀…Tₙ for ``part`` 0, U₀…Uₙ for ``part`` 1 (exact, from c·Tₖ = (Tₖ₊₁ + T|ₖ₋₁|)/2
+    and c·Uₖ = (Uₖ₊₁ + Uₖ₋₁)/2 with U₋₁ = 0), as balls at the current precision."""
+    key = (n, part, ctx.prec)
+    hit = _CHEBYSHEV.get(key)
+    if hit is None:
+        columns = [[fmpq(1)] + [fmpq(0)] * n]
+        for _ in range(n):
+            prev, nxt = columns[-1], [fmpq(0)] * (n + 1)
+            for k, a in enumerate(prev):
+                if a == 0:
+                    continue
+                if k + 1 <= n:
+                    nxt[k + 1] += a / 2
+                if k >= 1:
+                    nxt[k - 1] += a / 2
+                elif part == 0:  # c·T₀ = T₁
+                    nxt[1] += a / 2
+            columns.append(nxt)
+        hit = _CHEBYSHEV[key] = arb_mat(n + 1, n + 1, [arb(columns[m][k]) for k in range(n + 1)
+                                                         for m in range(n + 1)])
+    return hit
 
 
 _SPLITS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, list]] = OrderedDict()

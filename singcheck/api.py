@@ -233,7 +233,7 @@ def check_safely(robot: Robot, trajectory: TrajectorySpec, **options) -> dict[st
     Ctrl-C (KeyboardInterrupt) still stops the batch."""
     import time
 
-    from singcheck.errors import BackendError
+    from singcheck.errors import BackendError, SpecError
     from singcheck.report.trajectory import error_json, time_limited_json
 
     start = time.perf_counter()
@@ -244,6 +244,8 @@ def check_safely(robot: Robot, trajectory: TrajectorySpec, **options) -> dict[st
         doc = time_limited_json(trajectory, f"unknown: {e}")
     except BackendError as e:
         doc = error_json(trajectory, "backend", str(e))
+    except SpecError as e:  # refused up front (a path too costly to certify)
+        doc = error_json(trajectory, "spec", str(e))
     except Exception as e:  # a bug, confined to this trajectory
         doc = error_json(trajectory, "internal", f"{type(e).__name__}: {e}")
     doc["time_s"] = round(time.perf_counter() - start, 6)

@@ -1,32 +1,39 @@
-"""Atomic file writes: readers see the old file or the whole new one, never a part."""
+"""File writes: readers see the old file or the whole new one, never a part; and a
+user's ``-o`` target that is not a regular file is written to, never replaced."""
 
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TextIO
 
+from singcheck.errors import SpecError
 
-def write_atomically(path: str | os.PathLike, text: str) -> None:
+
+def write_atomically(path: str | os.PathLike, text: str, *, make_parents: bool = False) -> None:
     """Write ``text`` to a temporary file beside ``path``, then rename it into place.
 
     On any failure (or Ctrl-C) the temporary file is removed and ``path`` is untouched.
-    Used for ``--output``, cache entries and the CAS version memo, so concurrent runs
-    and interrupted ones never leave half a file.
+    Used for cache entries and the CAS version memo (``make_parents``: create missing
+    directories), so concurrent runs and interrupted ones never leave half a file.
+    Whatever ``path`` was (a FIFO or a symlink planted in a cache, say), it is replaced
+    by a regular file.
     """
-    with atomic_file(path) as f:
+    with atomic_file(path, make_parents=make_parents) as f:
         f.write(text)
 
 
 @contextmanager
-def atomic_file(path: str | os.PathLike) -> Iterator[TextIO]:
+def atomic_file(path: str | os.PathLike, *, make_parents: bool = False) -> Iterator[TextIO]:
     """A text file to write bit by bit (a stream of results) that appears at ``path``
     whole when the block ends, and not at all if it raises (or Ctrl-C stops it)."""
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    if make_parents:
+        target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
@@ -38,12 +45,74 @@ def atomic_file(path: str | os.PathLike) -> Iterator[TextIO]:
         raise
 
 
+class _Output:
+    """The user's output file: a write error becomes a one-line SpecError naming it."""
+
+    def __init__(self, f: TextIO, name: str) -> None:
+        self._f, self.name = f, name
+
+    def write(self, text: str) -> int:
+        with _reported(self.name):
+            return self._f.write(text)
+
+    def flush(self) -> None:
+        with _reported(self.name):
+            self._f.flush()
+
+
+@contextmanager
+def _reported(name: str) -> Iterator[None]:
+    try:
+        yield
+    except OSError as e:
+        raise SpecError(f"cannot write the output: {e.strerror or e}", path=name) from None
+
+
+@contextmanager
+def output_file(path: str | os.PathLike) -> Iterator[_Output]:
+    """The user's ``-o`` target, to write bit by bit.
+
+    A regular file (or a new one) is written atomically: it appears whole when the block
+    ends, not at all if it raises.  A symlink is followed and its target written (the
+    link stays a link).  Anything else that exists — a character device such as
+    ``/dev/null`` or ``/dev/stdout``, a FIFO, a socket — is opened and written in place,
+    as a shell redirection would, never replaced.  A missing parent directory is an
+    error, not created.  Every failure (``/dev/full``: no space left) is a
+    :class:`~singcheck.errors.SpecError` naming the file and the reason (exit 2).
+    """
+    name = os.fspath(path)
+    with _reported(name):
+        real = os.path.realpath(name)
+        try:
+            mode = os.stat(real).st_mode
+        except FileNotFoundError:
+            mode = None
+        if mode is not None and stat.S_ISDIR(mode):
+            raise IsADirectoryError(21, "Is a directory")
+        in_place = mode is not None and not stat.S_ISREG(mode)
+        parent = os.path.dirname(real) or "."
+        if not in_place and not os.path.isdir(parent):
+            raise FileNotFoundError(2, f"the directory {parent} does not exist")
+        opened = open(real, "w", encoding="utf-8") if in_place else atomic_file(real)
+    with _reported(name), opened as f:
+        yield _Output(f, name)
+
+
+def write_output(path: str | os.PathLike, text: str) -> None:
+    """Write a whole result to the user's ``-o`` target (see :func:`output_file`)."""
+    with output_file(path) as f:
+        f.write(text)
+
+
 def _mode_for(target: Path) -> int:
     """Keep an existing file's mode; give a new one the usual 0666 less the umask
     (mkstemp creates 0600)."""
     try:
-        return target.stat().st_mode & 0o777
-    except FileNotFoundError:
-        umask = os.umask(0)
-        os.umask(umask)
-        return 0o666 & ~umask
+        st = target.stat()
+        if stat.S_ISREG(st.st_mode):
+            return st.st_mode & 0o777
+    except OSError:
+        pass
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask

@@ -20,13 +20,12 @@ from contender import contender  # noqa: E402
 mpmath.mp.dps = 50
 
 
-def _orthoglide_det_a(t):
-    """det A of the Orthoglide (legs of length 2, mode +++) along heart 1, in mpmath:
-    ρᵢ = Xᵢ + √(4 - the other two coordinates squared); A = ∂F/∂X."""
-    s, c = mpmath.sin(t), mpmath.cos(t)
-    x = mpmath.mpf(8) / 7 * s**3
-    y = (mpmath.mpf(13) / 14 * c - mpmath.mpf(5) / 14 * mpmath.cos(2 * t)
-         - mpmath.mpf(1) / 10 * mpmath.cos(3 * t) - mpmath.mpf(1) / 14 * mpmath.cos(4 * t))
+def _heart_det_a(t, sx, cy):
+    """det A of the Orthoglide (legs of length 2, mode +++) along the heart
+    x = sx·sin³t, y = Σ cy[k]·cos((k+1)t), z = 1, in mpmath: ρᵢ = Xᵢ + √(4 - the other
+    two coordinates squared); A = ∂F/∂X."""
+    x = sx * mpmath.sin(t) ** 3
+    y = sum(c * mpmath.cos((k + 1) * t) for k, c in enumerate(cy))
     z = mpmath.mpf(1)
     r1 = x + mpmath.sqrt(4 - y**2 - z**2)
     r2 = y + mpmath.sqrt(4 - x**2 - z**2)
@@ -34,6 +33,18 @@ def _orthoglide_det_a(t):
     return mpmath.det(mpmath.matrix([[2 * (x - r1), 2 * y, 2 * z],
                                      [2 * x, 2 * (y - r2), 2 * z],
                                      [2 * x, 2 * y, 2 * (z - r3)]]))
+
+
+def _q(a, b):
+    return mpmath.mpf(a) / b
+
+
+HEART1 = (_q(8, 7), [_q(13, 14), _q(-5, 14), _q(-1, 10), _q(-1, 14)])
+HEART2 = (_q(4, 5), [_q(13, 20), _q(-1, 4), _q(-1, 20), _q(-1, 20)])
+
+
+def _orthoglide_det_a(t):
+    return _heart_det_a(t, *HEART1)
 
 
 def _sign_changes(f, a, b, n=400):
@@ -78,13 +89,4 @@ def test_contender_says_unknown_at_a_graze_and_free_on_heart2():
 
 def _orthoglide_sign(t) -> bool:
     """det A along heart 2 (mode +++) is far from 0 at t: a smoke check of the free path."""
-    s, c = mpmath.sin(t), mpmath.cos(t)
-    x = mpmath.mpf(4) / 5 * s**3
-    y = (mpmath.mpf(13) / 20 * c - mpmath.mpf(1) / 4 * mpmath.cos(2 * t)
-         - mpmath.mpf(1) / 20 * mpmath.cos(3 * t) - mpmath.mpf(1) / 20 * mpmath.cos(4 * t))
-    z = mpmath.mpf(1)
-    r1 = x + mpmath.sqrt(4 - y**2 - z**2)
-    r2 = y + mpmath.sqrt(4 - x**2 - z**2)
-    r3 = z + mpmath.sqrt(4 - x**2 - y**2)
-    det = -8 * r1 * r2 * r3 + 8 * r1 * r2 * z + 8 * r1 * r3 * y + 8 * r2 * r3 * x
-    return abs(det) > mpmath.mpf(10) ** -3
+    return abs(_heart_det_a(t, *HEART2)) > mpmath.mpf(10) ** -3

@@ -304,8 +304,13 @@ def _classify_all(path: PathModel, modes: list[WorkingMode], roots, tolerance: f
 
 
 def _clear_undecided(path, modes, box) -> bool:
-    """True when every feasible mode's det A provably stays away from 0 on the box."""
-    _, _, values = _mode_values(path, [m for m in modes if m.status == FEASIBLE], box.t)
+    """True when there is a feasible mode and every feasible mode's det A provably stays
+    away from 0 on the box (with no feasible mode nothing clears it: the box is kept in
+    the report, not dropped)."""
+    feasible = [m for m in modes if m.status == FEASIBLE]
+    if not feasible:
+        return False
+    _, _, values = _mode_values(path, feasible, box.t)
     return all(v is not None and excludes_zero(v) for v in values.values())
 
 

@@ -52,7 +52,7 @@ from singcheck.algebra.polynomials import constant_value
 from singcheck.algebra.radicals import radical_prime
 from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig, uses_t, uses_trig
 from singcheck.budget import checkpoint
-from singcheck.certify.path import PathModel
+from singcheck.certify.path import PathModel, memo_per_object
 from singcheck.roots.enclosures import AT_POINT, IN_T, IN_U, ExactTime
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t
@@ -188,12 +188,7 @@ _EXPRESSIONS: dict[int, tuple[PathModel, ModeExpression]] = {}
 
 def mode_expression(path: PathModel) -> ModeExpression:
     """The (memoised) E(r) of a path: built once, only when an exact decision is needed."""
-    hit = _EXPRESSIONS.get(id(path))
-    if hit is None or hit[0] is not path:
-        if len(_EXPRESSIONS) > 64:
-            _EXPRESSIONS.clear()
-        hit = _EXPRESSIONS[id(path)] = (path, ModeExpression(path))
-    return hit[1]
+    return memo_per_object(_EXPRESSIONS, path, ModeExpression, keep=64)
 
 
 # ---------------------------------------------------------------------------------

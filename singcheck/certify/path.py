@@ -91,6 +91,44 @@ def joint_float(value) -> float | None:
     return None
 
 
+#: The most terms μ(t) = ξ(φ(t)) may have by the a-priori bound of :func:`mu_size_bound`
+#: (heart 1: 89, the helix: 225, the stacked heart: 201; the Orthoglide with
+#: x = (sin t + cos t + t)^16: 35,217, composed in about a second, while the power 24
+#: took 3 to 10 s and 64 ran out of memory).
+MAX_MU_TERMS = 50_000
+
+
+def mu_size_bound(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...],
+                  pose: tuple[str, ...]) -> tuple[int, int, int]:
+    """(degree in t, degree in sin/cos, terms) that ξ(φ(t)) cannot exceed, from the
+    degrees alone: each monomial of ξ becomes a product of powers of the coordinates,
+    and a reduced trig polynomial of degree a in t and b in (s, c) has at most
+    (a + 1)(2b + 1) terms.  Cheap: nothing is composed."""
+    names = xi.context().names()
+    dt = [phi[pose.index(v)].degrees()[0] if v in pose else 0 for v in names]
+    dsc = [sum(phi[pose.index(v)].degrees()[1:]) if v in pose else 0 for v in names]
+    deg_t = deg_sc = 0
+    for exps, _ in xi.terms():
+        deg_t = max(deg_t, sum(e * d for e, d in zip(exps, dt, strict=True)))
+        deg_sc = max(deg_sc, sum(e * d for e, d in zip(exps, dsc, strict=True)))
+    return deg_t, deg_sc, (deg_t + 1) * (2 * deg_sc + 1)
+
+
+def _refuse_costly(xi, phi, pose, trajectory) -> None:
+    """Refuse up front (one line, exit 2) a path whose μ would be too large to compose
+    and isolate within any reasonable budget (the composition is one FLINT call that a
+    time limit cannot interrupt)."""
+    deg_t, deg_sc, terms = mu_size_bound(xi, phi, pose)
+    if terms > MAX_MU_TERMS:
+        from singcheck.errors import SpecError
+
+        raise SpecError(
+            f"too costly: μ(t) = ξ(φ(t)) could have {terms} terms (degree {deg_t} in t and "
+            f"{deg_sc} in sin t, cos t; at most {MAX_MU_TERMS}): lower the degree of the "
+            "coordinates or the multiples of t in sin/cos", path=trajectory.path,
+            line=trajectory.lines.get("pose"), key="pose")
+
+
 @dataclass(frozen=True)
 class LegAlongPath:
     """One leg's constraint along the path: ``a ρ² + b(t) ρ + c(t)`` (or ``b ρ + c``), or
@@ -176,18 +214,26 @@ _DET_A_SPLITS: dict[int, tuple] = {}
 def _det_a_by_joints(model: RobotModel) -> list[tuple[tuple[tuple[int, int], ...], fmpq_mpoly]]:
     """det A as [(α, q_α)]: α the exponents of the joint variables (sparse pairs), q_α
     the polynomial in the other variables; once per model."""
-    hit = _DET_A_SPLITS.get(id(model))
-    if hit is None or hit[0] is not model:
+    def split(model: RobotModel) -> list:
         n_joint = len(model.joint_variables)
         groups: dict[tuple[int, ...], dict] = {}
         for exps, coeff in model.det_A.terms():
             rest = (0,) * n_joint + tuple(exps[n_joint:])
             groups.setdefault(tuple(exps[:n_joint]), {})[rest] = coeff
-        split = [(tuple((v, e) for v, e in enumerate(alpha) if e),
-                  model.context.from_dict(terms)) for alpha, terms in groups.items()]
-        if len(_DET_A_SPLITS) > 64:
-            _DET_A_SPLITS.clear()
-        hit = _DET_A_SPLITS[id(model)] = (model, split)
+        return [(tuple((v, e) for v, e in enumerate(alpha) if e),
+                 model.context.from_dict(terms)) for alpha, terms in groups.items()]
+
+    return memo_per_object(_DET_A_SPLITS, model, split)
+
+
+def memo_per_object(cache: dict, obj, compute, keep: int = 256):
+    """``compute(obj)``, once per object: the entry keeps the object, so its id is not
+    reused while it is there (the cache is emptied past ``keep`` entries)."""
+    hit = cache.get(id(obj))
+    if hit is None or hit[0] is not obj:
+        if len(cache) > keep:
+            cache.clear()
+        hit = cache[id(obj)] = (obj, compute(obj))
     return hit[1]
 
 
@@ -412,13 +458,8 @@ _LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}
 
 def _leg_coefficients(leg: Leg) -> tuple[fmpq_mpoly, ...]:
     """:func:`~singcheck.model.robot.leg_coefficients`, once per leg of a model (the same
-    legs serve every path of a batch); the entry keeps the leg, so its id is not reused."""
-    hit = _LEG_COEFFICIENTS.get(id(leg))
-    if hit is None or hit[0] is not leg:
-        if len(_LEG_COEFFICIENTS) > 256:
-            _LEG_COEFFICIENTS.clear()
-        hit = _LEG_COEFFICIENTS[id(leg)] = (leg, leg_coefficients(leg))
-    return hit[1]
+    legs serve every path of a batch)."""
+    return memo_per_object(_LEG_COEFFICIENTS, leg, leg_coefficients)
 
 
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
@@ -463,6 +504,7 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
     coordinates = tuple(coordinates)
     pose_vars = model.pose_variables
     if projection.expanded:
+        _refuse_costly(projection.singularity_surface, coordinates, pose_vars, trajectory)
         mu = compose_pose(projection.singularity_surface, coordinates, pose_vars)
     else:
         mu = eliminate_along_path(model, coordinates, where)

@@ -127,6 +127,8 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     complete.  On Ctrl-C, SIGTERM or SIGHUP the jsonl lines already written stay valid
     and -o writes nothing.
     """
+    if plot_dir:
+        require_extra("plot")
     progress = Progress(quiet)
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
@@ -138,7 +140,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
 #: a trajectory's outcome as an exit status, and how bad each is (a batch exits with
 #: the worst of its trajectories)
 _SEVERITY = [ExitCode.SINGULARITY_FREE, ExitCode.UNKNOWN, ExitCode.SINGULAR,
-             ExitCode.BACKEND, ExitCode.INTERNAL]
+             ExitCode.USAGE, ExitCode.BACKEND, ExitCode.INTERNAL]
 
 
 def _outcome(doc: dict) -> ExitCode:
@@ -148,7 +150,8 @@ def _outcome(doc: dict) -> ExitCode:
     if verdict == "singularity-free":
         return ExitCode.SINGULARITY_FREE
     if verdict == "error":
-        return ExitCode.BACKEND if doc["error"]["kind"] == "backend" else ExitCode.INTERNAL
+        return {"backend": ExitCode.BACKEND, "spec": ExitCode.USAGE}.get(
+            doc["error"]["kind"], ExitCode.INTERNAL)
     return ExitCode.UNKNOWN
 
 
@@ -227,8 +230,9 @@ class _Sink:
 
 
 def _sink(fmt: str, output, projection):
-    """A :class:`_Sink` on stdout, or on ``output`` written atomically (it appears when
-    the batch is done, and not at all when it is interrupted)."""
+    """A :class:`_Sink` on stdout, or on ``output``: a regular file written atomically (it
+    appears when the batch is done, and not at all when it is interrupted), a device or
+    FIFO written in place (:func:`singcheck.atomic.output_file`)."""
     from contextlib import contextmanager
 
     @contextmanager
@@ -236,9 +240,9 @@ def _sink(fmt: str, output, projection):
         if not output:
             yield _Sink(fmt, sys.stdout, projection)
             return
-        from singcheck.atomic import atomic_file
+        from singcheck.atomic import output_file
 
-        with atomic_file(output) as f:
+        with output_file(output) as f:
             yield _Sink(fmt, f, projection)
 
     return opened()
@@ -391,6 +395,7 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> N
     time (and, with --format html, animated along the path).
     With --regions, draw a plane of the workspace or joint space: each region filled by
     its exact number of solutions and labelled, the discriminant variety's curves."""
+    require_extra("html" if fmt == "html" else "plot")
     progress = Progress(quiet)
     with exit_codes():
         if not trajectories and not spaces:
@@ -410,6 +415,30 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> N
             return
         for path in _plot_all(machine, specs, 1e-9, out_dir, progress):
             click.echo(str(path))
+
+
+#: The optional extras: the modules each needs, and the package that provides each.
+EXTRAS = {"plot": ("numpy", "matplotlib", "skimage"), "html": ("numpy", "plotly")}
+_PACKAGES = {"skimage": "scikit-image"}
+
+
+def require_extra(extra: str) -> None:
+    """Stop up front (exit 2, one line naming the extra to install) when an optional
+    dependency is missing, before any work is done."""
+    import importlib.util
+
+    missing = []
+    for module in EXTRAS[extra]:
+        try:
+            found = importlib.util.find_spec(module) is not None
+        except (ImportError, ValueError):
+            found = False
+        if not found:
+            missing.append(_PACKAGES.get(module, module))
+    if missing:
+        fail(f"this needs the optional extra '{extra}' ({', '.join(missing)} "
+             f"{'is' if len(missing) == 1 else 'are'} not installed): "
+             f"pip install 'singcheck[{extra}]'", ExitCode.USAGE)
 
 
 def _slices_by_space(robot, spaces, slices) -> dict[str, list[str]]:

@@ -141,9 +141,9 @@ def _command(space: str, robot, slices, surfaces, no_limits, backend, timeout, n
         doc = analysis_json(analysis, left_out, int(code))
         text = _text(doc, fmt, verbose, bool(output))
         if output:
-            from singcheck.atomic import write_atomically
+            from singcheck.atomic import write_output
 
-            write_atomically(output, text)
+            write_output(output, text)
         else:
             sys.stdout.write(text)
     sys.exit(int(code))

@@ -32,6 +32,7 @@ from singcheck.algebra.radicals import (
     sin_pi,
     surd_polynomial,
 )
+from singcheck.elimination.cache import CachedBackend
 from singcheck.elimination.requests import EliminationBackend, EliminationRequest, norm_chain
 from singcheck.errors import BackendError, UnsupportedRobotError
 from singcheck.model.robot import (
@@ -288,9 +289,18 @@ def project_robot(model: RobotModel, backend: EliminationBackend,
                                    workspace_boundary(model, pose_ctx),
                                    joint_limit_surfaces(model, pose_ctx), backend.name,
                                    "eliminated along each path", reason)
-        result = backend.eliminate(singularity_surface_request(model))
+
+        def check(result) -> None:
+            recheck_singularity_surface(model, _single(result, "singularity surface"),
+                                        result.backend)
+
+        request = singularity_surface_request(model)
+        if isinstance(backend, CachedBackend):  # cache only what passes the re-check
+            result = backend.eliminate(request, check=check)
+        else:
+            result = backend.eliminate(request)
+            check(result)
         raw = _single(result, "singularity surface")
-        recheck_singularity_surface(model, raw, result.backend)
         name, method = result.backend, result.method
     xi = _without_degenerate_factors(raw, degenerate_set(model))
     return RobotProjection(model, pose_ctx, xi, raw, workspace_boundary(model, pose_ctx),

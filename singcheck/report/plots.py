@@ -452,5 +452,5 @@ def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
             first = False
     page = ("<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>singcheck figures"
             "</title></head><body>\n" + "\n".join(parts) + "\n</body></html>\n")
-    write_atomically(target, page)
+    write_atomically(target, page, make_parents=True)
     return Path(target)

@@ -79,8 +79,9 @@ def time_limited_json(spec, reason: str) -> dict[str, Any]:
 
 
 def error_json(spec, kind: str, message: str) -> dict[str, Any]:
-    """The trajectory object of a trajectory whose check failed (``kind``: backend or
-    internal): verdict ``error``, the reason, and nothing certified."""
+    """The trajectory object of a trajectory whose check failed (``kind``: backend, spec
+    — refused as too costly — or internal): verdict ``error``, the reason, and nothing
+    certified."""
     return {**time_limited_json(spec, f"error: {message}"), "verdict": "error",
             "error": {"kind": kind, "message": message}}
 

@@ -95,8 +95,8 @@ def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
     for rr, mult in real_roots_exact(fmpq_poly(deflated), nonnegative_only=k % 2 == 0):
         for q in (fmpq(0), fmpq(1), fmpq(-1)):  # u = 0, ±1 (t = 0, ±π/2) are exact
             rr.pin(q)
-        if rr.lo == rr.hi == 0:
-            out.append(_HalfAngleRoot(_atan_ball(rr, k, 1), LinearInPi(Fraction(0)), mult * k,
+        if rr.lo == rr.hi == 0:  # u = 0 exactly: t = 0 (Arb's k-th root of 0 is NaN)
+            out.append(_HalfAngleRoot(lambda tol: arb(0), LinearInPi(Fraction(0)), mult * k,
                                       ExactTime(IN_U, lambda rr=rr: rr)))
             continue
         positive = rr.lo >= 0
@@ -182,6 +182,8 @@ def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIso
     roots, undecided = [], []
     for index, (base, exact, mult, time) in enumerate(bases):
         for k in _periods(base(tolerance), interval):
+            checkpoint()  # a range of 10^6 holds 10^5 periods: each costs a ball map
+
             def make(tol: float, base=base, k=k) -> arb:
                 with working_precision(bits_for(tol)):
                     return base(tol) + 2 * k * arb.pi()

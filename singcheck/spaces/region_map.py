@@ -9,8 +9,10 @@ a point on a root lies on no open cell and is not located.
 
 The map is cached on disk beside the elimination cache (a 3-D decomposition with its
 regions takes seconds; reading it back, milliseconds).  An entry is keyed by the SHA-256
-of the variety's polynomials, the slice and :data:`REGIONS_VERSION`, and carries the
-SHA-256 of its payload: a damaged entry is ignored and recomputed, never trusted.
+of the variety's polynomials, the slice and :data:`REGIONS_VERSION`, and carries an HMAC
+of its payload under the cache's secret key (:mod:`singcheck.elimination.cache`): a
+damaged entry, or one forged by anyone who cannot read that key, is ignored and
+recomputed, never trusted.
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ from singcheck.spaces.cad import cell_index_of, fiber
 
 #: Bump when the decomposition or the joining of regions changes what a number means.
 REGIONS_VERSION = "2"
-FORMAT = "singcheck-region-map/1"
+FORMAT = "singcheck-region-map/2"
 
 
 @dataclass(frozen=True)
@@ -93,7 +95,8 @@ class RegionMapCache:
 
         try:
             return RegionMap.from_payload(read_entry(self._path(key), FORMAT, key))
-        except (OSError, ValueError, KeyError, TypeError, PolynomialSyntaxError):
+        except (OSError, ValueError, KeyError, TypeError, PolynomialSyntaxError,
+                RecursionError):
             return None
 
     def store(self, key: str, region_map: RegionMap) -> None:

@@ -51,6 +51,7 @@ TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": False, "pose": Fals
 RESERVED = {"pi", "sin", "cos", "sqrt"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
+MAX_YAML_DEPTH = 16  # lists and mappings inside one another (specs need 3)
 MAX_STREAM_BYTES = 200_000_000  # a file (or stdin) of several trajectory documents
 STDIN = "-"  # the path that reads standard input
 STDIN_NAME = "<stdin>"  # how its trajectories name their file
@@ -177,7 +178,7 @@ class _Doc:
         try:
             value = compile_constant(parse(text))
         except ExprError as e:
-            raise self.error(node, key, f"{e} in {text!r}") from None
+            raise self.error(node, key, f"{e} in {_excerpt(text)}") from None
         if value.pi_coefficient:
             raise self.error(node, key, f"must be an exact rational number, not {text!r}")
         return value.rational
@@ -198,13 +199,36 @@ class _Doc:
         try:
             return compile_(parse(text))
         except ExprError as e:
-            raise self.error(node, key, f"{e.message} in {text!r}" +
+            raise self.error(node, key, f"{e.message} in {_excerpt(text)}" +
                              (f" at column {e.column}" if e.column else "")) from None
+
+
+def _excerpt(text: str) -> str:
+    """An expression quoted in a message: the whole of a short one, the ends of a long one."""
+    return repr(text) if len(text) <= 80 else f"{text[:40]!r}…{text[-20:]!r}"
 
 
 def _kind(node) -> str:
     return {yaml.MappingNode: "a mapping", yaml.SequenceNode: "a list",
             yaml.ScalarNode: "a single value"}.get(type(node), "nothing")
+
+
+def _check_depth(text: str, path: str) -> None:
+    """Refuse YAML nested deeper than MAX_YAML_DEPTH, from the event stream (PyYAML's
+    parser is a state machine; its composer, and our walks, recurse once per level)."""
+    depth = 0
+    try:
+        for event in yaml.parse(text, Loader=_LOADER):
+            if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
+                depth += 1
+                if depth > MAX_YAML_DEPTH:
+                    raise SpecError(f"lists and mappings are nested more than "
+                                    f"{MAX_YAML_DEPTH} levels deep", path=path,
+                                    line=event.start_mark.line + 1)
+            elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
+                depth -= 1
+    except yaml.YAMLError as e:
+        raise _yaml_error(e, path) from None
 
 
 def _yaml_error(e: yaml.YAMLError, path: str) -> SpecError:
@@ -222,6 +246,7 @@ _LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
 def _compose(text: str, path: str):
+    _check_depth(text, path)
     try:
         node = yaml.compose(text, Loader=_LOADER)
     except yaml.YAMLError as e:
@@ -235,6 +260,7 @@ def _compose(text: str, path: str):
 def _compose_all(text: str, path: str) -> Iterator:
     """Every document of a YAML stream (``---`` between documents), composed one at a
     time; empty documents are skipped, a stream with none is an error."""
+    _check_depth(text, path)
     stream = yaml.compose_all(text, Loader=_LOADER)
     found = False
     while True:

@@ -41,7 +41,9 @@ MAX_EXPONENT = 64
 MAX_LENGTH = 10_000
 MAX_DEGREE = 256  # of any intermediate polynomial
 MAX_TERMS = 100_000
-MAX_BITS = 20_000  # of any intermediate rational's numerator or denominator
+MAX_BITS = 4096  # of any intermediate rational's numerator or denominator (1233 digits)
+MAX_LITERAL_BITS = 512  # of a number literal's numerator or denominator (1e154 is fine)
+MAX_NESTING = 64  # parentheses, calls and exponents inside one another
 FUNCTIONS = ("sin", "cos")  # sqrt is handled apart: it only takes constants
 
 
@@ -98,6 +100,7 @@ class _Parser:
         self.text = text
         self.toks = _tokens(text)
         self.i = 0
+        self.depth = 0
 
     def peek(self) -> tuple[str, str, int]:
         if self.i < len(self.toks):
@@ -126,33 +129,49 @@ class _Parser:
         return node
 
     def expr(self) -> Node:
-        node = self.term()
+        first = self.term()
+        rest = []
         while self.peek()[1] in ("+", "-"):
             _, op, col = self.take()
-            node = Node("add" if op == "+" else "sub", col, None, (node, self.term()))
-        return node
+            rest.append(("add" if op == "+" else "sub", col, self.term()))
+        return _chain(first, rest)
 
     def term(self) -> Node:
-        node = self.unary()
+        first = self.unary()
+        rest = []
         while self.peek()[1] in ("*", "/"):
             _, op, col = self.take()
-            node = Node("mul" if op == "*" else "div", col, None, (node, self.unary()))
-        return node
+            rest.append(("mul" if op == "*" else "div", col, self.unary()))
+        return _chain(first, rest)
 
     def unary(self) -> Node:
-        kind, v, col = self.peek()
-        if v in ("+", "-"):
-            self.take()
-            operand = self.unary()
-            return operand if v == "+" else Node("neg", col, None, (operand,))
-        return self.power()
+        # a run of signs is read in a loop (not one call per sign): "------t" is "t"
+        negative, col = False, None
+        while self.peek()[1] in ("+", "-"):
+            _, v, c = self.take()
+            if v == "-":
+                negative, col = not negative, c if col is None else col
+        operand = self.power()
+        return Node("neg", col, None, (operand,)) if negative else operand
 
     def power(self) -> Node:
         base = self.atom()
         if self.peek()[1] in ("^", "**"):
             _, _, col = self.take()
-            return Node("pow", col, None, (base, self.unary()))
+            return Node("pow", col, None, (base, self.nested(self.unary, col)))
         return base
+
+    def nested(self, parse, column: int) -> Node:
+        """``parse()`` one level deeper: refused past MAX_NESTING levels, so a hostile
+        expression ends with an error, not with Python's recursion limit."""
+        if self.depth >= MAX_NESTING:
+            raise ExprError(f"the expression is nested more than {MAX_NESTING} levels deep "
+                            "(parentheses, calls and exponents)", column)
+        self.depth += 1
+        try:
+            return parse()
+        finally:
+            self.depth -= 1
 
     def atom(self) -> Node:
         kind, v, col = self.take()
@@ -161,27 +180,93 @@ class _Parser:
         if kind == "name":
             if self.peek()[1] == "(":
                 self.take()
-                arg = self.expr()
+                arg = self.nested(self.expr, col)
                 self.expect(")")
                 return Node("call", col, v, (arg,))
             return Node("name", col, v)
         if v == "(":
-            node = self.expr()
+            node = self.nested(self.expr, col)
             self.expect(")")
             return node
         found = "the end of the expression" if kind == "end" else repr(v)
         raise ExprError(f"expected a number, a name or '(' but found {found}", col)
 
 
+def _chain(first: Node, rest: list[tuple[str, int, Node]]) -> Node:
+    """A left-associative chain ``a op b op c …`` as a tree of depth O(log n).
+
+    ``a - b + c`` is ``a + (-b) + c`` and ``a * b / c * d`` is ``(a * b * d) / c``:
+    exact rational arithmetic makes the regrouping change nothing, and a sum of
+    thousands of terms cannot exhaust the recursion of the compilers that walk the tree.
+    """
+    if not rest:
+        return first
+    additive = rest[0][0] in ("add", "sub")
+    if additive:
+        terms = [first] + [Node("neg", col, None, (n,)) if op == "sub" else n
+                           for op, col, n in rest]
+        return _balanced("add", terms, [col for _, col, _ in rest])
+    numerators = [first] + [n for op, _, n in rest if op == "mul"]
+    denominators = [n for op, _, n in rest if op == "div"]
+    cols = [col for _, col, _ in rest]
+    top = _balanced("mul", numerators, cols)
+    if not denominators:
+        return top
+    div_col = next(col for op, col, _ in rest if op == "div")
+    return Node("div", div_col, None, (top, _balanced("mul", denominators, cols)))
+
+
+def _balanced(kind: str, nodes: list[Node], cols: list[int]) -> Node:
+    if len(nodes) == 1:
+        return nodes[0]
+    half = len(nodes) // 2
+    return Node(kind, cols[min(half, len(cols)) - 1], None,
+                (_balanced(kind, nodes[:half], cols), _balanced(kind, nodes[half:], cols)))
+
+
+_LITERAL = re.compile(r"(\d*)\.?(\d*)(?:[eE]([+-]?\d+))?\Z")
+_LOG2_10 = 3.3219280948873626
+
+
 def _exact_number(text: str, column: int) -> Fraction:
-    mantissa, _, exponent = text.lower().partition("e")
-    if exponent and abs(int(exponent)) > MAX_BITS // 4:  # 10^e would need ~3.3·e bits
-        raise ExprError(f"the number {text!r} is too large (exponent beyond "
-                        f"±{MAX_BITS // 4})", column)
+    """The exact value of a literal, refused *before* it is built when its numerator or
+    denominator would exceed MAX_LITERAL_BITS (``1e999999999`` costs nothing)."""
+    m = _LITERAL.match(text)
+    if not m:
+        raise ExprError(f"bad number {text!r}", column)
+    whole, frac, exp = m.groups()
+    if exp is not None and len(exp.lstrip("+-").lstrip("0")) > 6:
+        raise ExprError(f"the number {_short(text)} is too large (at most "
+                        f"{MAX_LITERAL_BITS} bits)", column)
+    e = int(exp) if exp is not None else 0
+    digits = (whole + frac).lstrip("0")
+    # value = int(digits) * 10^(e - len(frac)): bound the digits of both sides
+    shift = e - len(frac)
+    numerator = len(digits) + max(shift, 0)
+    denominator = max(-shift, 0)
+    if max(numerator, denominator) * _LOG2_10 > MAX_LITERAL_BITS + 4 and digits:
+        raise ExprError(f"the number {_short(text)} is too large (at most "
+                        f"{MAX_LITERAL_BITS} bits)", column)
     try:
-        return Fraction(text)  # exact decimal: Fraction("0.1") == 1/10
+        value = Fraction(text)  # exact decimal: Fraction("0.1") == 1/10
     except (ValueError, ZeroDivisionError):
         raise ExprError(f"bad number {text!r}", column) from None
+    if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) > \
+            MAX_LITERAL_BITS:
+        raise ExprError(f"the number {_short(text)} is too large (at most "
+                        f"{MAX_LITERAL_BITS} bits)", column)
+    return value
+
+
+def _short(text: str) -> str:
+    """A number's text for a message: never thousands of digits."""
+    return text if len(text) <= 24 else f"{text[:10]}…{text[-6:]} ({len(text)} characters)"
+
+
+def _describe(q: Fraction) -> str:
+    """A rational for a message, without converting a huge one to decimal."""
+    bits = max(abs(q.numerator).bit_length(), q.denominator.bit_length())
+    return _short(str(q)) if bits <= 256 else f"(a {bits}-bit number)"
 
 
 def parse(text: str) -> Node:
@@ -213,7 +298,8 @@ def _exponent(node: Node, value) -> int:
     if not isinstance(value, Fraction) or value.denominator != 1 or value < 0:
         raise ExprError("exponents must be non-negative integers", node.column)
     if value > MAX_EXPONENT:
-        raise ExprError(f"exponent {value} is larger than {MAX_EXPONENT}", node.column)
+        raise ExprError(f"exponent {_describe(value)} is larger than {MAX_EXPONENT}",
+                        node.column)
     return int(value)
 
 
@@ -368,7 +454,7 @@ def _check_power(base, e: int, node: Node) -> None:
     if isinstance(base, Fraction):
         bits = max(abs(base.numerator).bit_length(), base.denominator.bit_length())
         if bits * e > MAX_BITS:
-            raise ExprError(f"the number {base}^{e} is too large", node.column)
+            raise ExprError(f"the number {_describe(base)}^{e} is too large", node.column)
     elif base.total_degree() * e > MAX_DEGREE:
         raise ExprError(f"the expression's degree exceeds {MAX_DEGREE}", node.column)
     elif len(base) > 1 and e > 1:

@@ -91,22 +91,22 @@ def cas_version(cas: ExternalCAS, executable: str) -> str:
     warm run starts no CAS process at all."""
     import json
 
-    from singcheck.elimination.cache import cache_dir
+    from singcheck.elimination.cache import cache_dir, read_bounded
 
     memo = cache_dir() / "versions.json"
     ident = _binary_identity(executable)
     try:
-        known = json.loads(memo.read_text(encoding="utf-8"))
+        known = json.loads(read_bounded(memo, 2**20).decode("utf-8"))
         if isinstance(known.get(ident), str):
             return known[ident]
-    except (OSError, ValueError, AttributeError):
+    except (OSError, ValueError, AttributeError, RecursionError):
         known = {}
     version = _ask_version(cas, executable)
     try:
         from singcheck.atomic import write_atomically
 
         write_atomically(memo, json.dumps({**(known if isinstance(known, dict) else {}),
-                                           ident: version}))
+                                           ident: version}), make_parents=True)
     except OSError:
         pass
     return version

@@ -21,9 +21,14 @@ from __future__ import annotations
 
 import re
 
-from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
+from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
 
-_TOKEN = re.compile(r"\s*(?:(\d+)|(v)(\d+)|([-+*/^()]))")
+_TOKEN = re.compile(r"\s*(?:([0-9]+)|(v)([0-9]+)|([-+*/^()]))")
+#: Bounds on what a CAS may print (its output is untrusted): the digits of one integer
+#: in a coefficient, and an exponent.  Real results are far below both (the stacked
+#: Orthoglide's ξ: 9 digits, degree 32).
+MAX_DIGITS = 10_000
+MAX_EXPONENT = 10_000
 
 
 class PolynomialSyntaxError(ValueError):
@@ -57,10 +62,16 @@ def _tokens(text: str):
                 return
             raise PolynomialSyntaxError(f"unexpected {text[pos:pos + 20]!r} at column {pos + 1}")
         pos = m.end()
+        digits = m.group(1) if m.group(1) is not None else m.group(3)
+        if digits is not None and len(digits) > MAX_DIGITS:
+            raise PolynomialSyntaxError(f"a number of {len(digits)} digits (at most "
+                                        f"{MAX_DIGITS}) at column {m.start(1) + 1}")
         if m.group(1) is not None:
-            yield "num", int(m.group(1))
+            yield "num", fmpz(digits) if len(digits) > 1000 else int(digits)
         elif m.group(2):
-            yield "var", int(m.group(3))
+            if len(digits) > 6:
+                raise PolynomialSyntaxError(f"unknown variable v{digits[:6]}…")
+            yield "var", int(digits)
         else:
             yield m.group(4), None
 
@@ -107,6 +118,9 @@ def parse_polynomial(text: str, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
                 kind, power = peek()
                 if kind != "num":
                     raise PolynomialSyntaxError("expected an exponent after ^")
+                if power > MAX_EXPONENT:
+                    raise PolynomialSyntaxError(f"an exponent larger than {MAX_EXPONENT}")
+                power = int(power)
                 i += 1
             exps[value - 1] += power
             expect_factor = False

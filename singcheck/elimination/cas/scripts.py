@@ -96,7 +96,8 @@ def parse_result(cas: str, stdout: str, stderr: str,
                            f"the output ends with: {tail}")
     b, e = begins[0], ends[0]
     head = lines[b].split()
-    if len(head) != 3 or head[1] != label or not head[2].isdigit() or e < b:
+    if len(head) != 3 or head[1] != label or not re.fullmatch(r"[0-9]{1,6}", head[2]) \
+            or e < b:
         raise BackendError(f"{cas} output has a malformed marker: {_short(lines[b])}")
     stray = [s for s in lines[:b] + lines[e + 1:] if s.strip()]
     if stray:

@@ -1,0 +1,363 @@
+"""Property-based fuzzing of robot and trajectory specs (hypothesis).
+
+Three kinds of hostile specs, all grown from the bundled ones: *structure* (a trajectory
+built key by key, keys dropped, added or nested), *grammar* (expressions generated from
+singcheck's grammar, hostile literals, deep nesting, large multiples and exponents) and
+*bytes* (the bundled files with bytes flipped, inserted, deleted or repeated).  The
+property: every case ends with an exit status 0–3 (free, singular, bad spec, unknown)
+within its time budget, never with another exception (what the command line reports as
+exit 70) — the spec is untrusted input, and the README's "Security model" says what
+each stage may cost.
+
+The cases run in-process through the API and the command line's own exit-code mapping
+(fast); :func:`test_fuzzed_specs_through_the_command_line` runs a sample through the real
+``singcheck`` process and checks there is no traceback on stderr.
+
+``SINGCHECK_FUZZ_EXAMPLES=N`` scales the number of cases (the CI default keeps the run
+near a minute); ``SINGCHECK_FUZZ_REPORT=FILE`` writes the counts of exit statuses as it
+goes (``SINGCHECK_FUZZ_REGIONS=0`` leaves out the region statement, for speed), and
+with ``SINGCHECK_FUZZ_KEEP_GOING=1`` (a long campaign) a failing case is
+appended to ``FILE.failures`` (JSON lines: the two specs and the error) instead of
+stopping the run.
+"""
+
+from __future__ import annotations
+
+import atexit
+import json
+import os
+import subprocess
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+hypothesis = pytest.importorskip("hypothesis")  # the `test` extra installs it
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from tests.conftest import ROBOTS, ROOT, TRAJECTORIES  # noqa: E402
+
+EXAMPLES = int(os.environ.get("SINGCHECK_FUZZ_EXAMPLES", "30"))
+BUDGET = 2.0  # seconds of certification per case (api.check's time_limit)
+SLACK = 20.0  # what a check may run past it: one uninterruptible step (composing the
+#   stacked Orthoglide's ξ of 57,855 terms with a path takes 5-12 s on a loaded machine)
+REGIONS = os.environ.get("SINGCHECK_FUZZ_REGIONS", "1") != "0"  # the region statement too
+ROBOT_BUDGET = 60.0  # reading and projecting a (mutated) robot, memoised per text
+ROBOT_FILES = sorted(ROBOTS.glob("*.yaml"))
+TRAJECTORY_FILES = sorted(TRAJECTORIES.glob("*.yaml"))
+COUNTS: Counter = Counter()
+
+
+def _report() -> None:
+    target = os.environ.get("SINGCHECK_FUZZ_REPORT")
+    if target and COUNTS:
+        Path(target).write_text(json.dumps(dict(sorted(COUNTS.items())), indent=1) + "\n")
+
+
+atexit.register(_report)
+
+FUZZ = settings(max_examples=EXAMPLES, deadline=None, database=None, derandomize=False,
+                suppress_health_check=list(HealthCheck), print_blob=True)
+
+
+# -- running one case --------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module", autouse=True)
+def private_cache(tmp_path_factory):
+    """One cache for the whole run: robots that differ only in bytes that do not matter
+    (a comment, a space) share their projection and region maps, as on disk for users."""
+    directory = tmp_path_factory.mktemp("fuzz-cache")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SINGCHECK_CACHE_DIR", str(directory / "cache"))
+        mp.setenv("XDG_CONFIG_HOME", str(directory / "config"))
+        yield
+
+
+
+_ROBOTS: dict = {}
+
+
+def _robot(text: str, path: str):
+    """The robot (projection with the in-process FLINT backend), memoised by its text."""
+    from singcheck import api
+    from singcheck.budget import deadline
+    from singcheck.spec.files import parse_robot
+
+    if text not in _ROBOTS:
+        if len(_ROBOTS) > 64:
+            _ROBOTS.clear()
+        try:
+            with deadline(BUDGET * 2):
+                _ROBOTS[text] = ("ok", api.robot_from_spec(parse_robot(text, path),
+                                                           backend="flint", cache=True))
+        except Exception as e:  # replayed below, inside the exit-code mapping
+            _ROBOTS[text] = ("error", e)
+    kind, value = _ROBOTS[text]
+    if kind == "error":
+        raise value
+    return value
+
+
+def outcome(robot_text: str, trajectory_text: str) -> int:
+    """The exit status ``singcheck run`` gives for this robot and trajectory, computed
+    in-process: any exception the CLI would report as an internal error propagates (or,
+    in a campaign, is recorded)."""
+    try:
+        return _outcome(robot_text, trajectory_text)
+    except Exception as e:
+        if not os.environ.get("SINGCHECK_FUZZ_KEEP_GOING"):
+            raise
+        import traceback
+
+        COUNTS["failures"] += 1
+        where = traceback.extract_tb(e.__traceback__)[-1]
+        with open(os.environ["SINGCHECK_FUZZ_REPORT"] + ".failures", "a") as f:
+            f.write(json.dumps({"error": f"{type(e).__name__}: {str(e)[:500]}",
+                                "at": f"{where.filename}:{where.lineno}",
+                                "robot": robot_text, "trajectory": trajectory_text}) + "\n")
+        return -1
+
+
+def _outcome(robot_text: str, trajectory_text: str) -> int:
+    from singcheck import api
+    from singcheck.cli.commands import _outcome as exit_of
+    from singcheck.cli.exitcodes import exit_codes
+    from singcheck.report.trajectory import to_json
+    from singcheck.spec.files import parse_trajectory
+
+    start = time.monotonic()
+    loaded = None
+    code = None
+    try:
+        with exit_codes():
+            machine = _robot(robot_text, "robot.yaml")
+            loaded = time.monotonic()
+            spec = parse_trajectory(trajectory_text, "trajectory.yaml", machine.spec)
+            report = api.check(machine, spec, time_limit=BUDGET, regions=REGIONS)
+            doc = report.to_dict()
+            to_json(doc)  # the report renders
+            code = int(exit_of(doc))
+    except SystemExit as e:
+        code = int(e.code)
+    end = time.monotonic()
+    COUNTS[f"exit {code}"] += 1
+    COUNTS["cases"] += 1
+    if COUNTS["cases"] % 25 == 0:
+        _report()
+    assert code in (0, 1, 2, 3), code
+    loaded = loaded or end
+    assert loaded - start < ROBOT_BUDGET, f"robot: {loaded - start:.1f} s"
+    assert end - loaded < BUDGET + SLACK, f"trajectory: {end - loaded:.1f} s"
+    return code
+
+
+# -- strategies ----------------------------------------------------------------------------
+
+HOSTILE_LITERALS = ["0", "1", "0.5", "1e400", "1e-400", "1.0e+308", "9" * 200,
+                    "0." + "0" * 90 + "1", "2147483648", "1e5000", "00012", "3.", ".5",
+                    "1e999999999"]
+
+
+def numbers() -> st.SearchStrategy[str]:
+    return st.one_of(st.integers(-1000, 1000).map(str),
+                     st.tuples(st.integers(-99, 99), st.integers(1, 99)).map(
+                         lambda q: f"{q[0]}/{q[1]}"),
+                     st.decimals(-100, 100, places=3, allow_nan=False).map(str),
+                     st.sampled_from(HOSTILE_LITERALS))
+
+
+def expressions(names: list[str], parameter: str = "t") -> st.SearchStrategy[str]:
+    """Expressions of singcheck's grammar over ``names`` (and some that are not)."""
+    calls = st.tuples(st.sampled_from(["sin", "cos", "sqrt", "tan", "sin", "cos"]),
+                      st.one_of(st.integers(-4, 4), st.integers(-300, 300))).map(
+        lambda c: f"{c[0]}({c[1]}*{parameter})" if c[1] != 1 else f"{c[0]}({parameter})")
+    usual = st.one_of(st.integers(-5, 5).map(str), st.sampled_from(["1/2", "3/7", "0.25"]),
+                      st.sampled_from(names or ["x"]), calls)
+    atoms = st.one_of(usual, usual, usual, usual, numbers(),
+                      st.sampled_from(["pi", "pi/2", "sqrt(2)", "x_unknown"]))
+
+    def grow(inner):
+        return st.one_of(
+            st.tuples(inner, st.sampled_from(["+", "-", "*", "/"]), inner).map(
+                lambda a: f"{a[0]} {a[1]} {a[2]}"),
+            inner.map(lambda a: f"({a})"),
+            inner.map(lambda a: f"-{a}"),
+            st.tuples(inner, st.one_of(st.integers(0, 70).map(str),
+                                       st.sampled_from(["1e5", "-1", "1/2", parameter]))).map(
+                lambda a: f"({a[0]})^{a[1]}"),
+            st.tuples(st.sampled_from(["sin", "cos"]), inner).map(lambda a: f"{a[0]}({a[1]})"),
+        )
+
+    plain = st.recursive(atoms, grow, max_leaves=8)
+    deep = st.tuples(st.integers(1, 400), st.sampled_from(["(", "-", "sin(", "["])).map(
+        lambda d: d[1] * d[0] + parameter + {"(": ")", "-": "", "sin(": ")", "[": "]"}[d[1]]
+        * d[0])
+    return st.one_of(plain, plain, plain, deep)
+
+
+def path_coordinates(parameter: str = "t") -> st.SearchStrategy[str]:
+    """Coordinates like the bundled ones: a few terms c·sin(kt), c·cos(kt), c·tⁿ."""
+    term = st.tuples(st.sampled_from(["1", "-1", "1/2", "3/7", "2", "-5/14", "0.1"]),
+                     st.sampled_from([f"sin({parameter})", f"cos({parameter})",
+                                      f"sin(2*{parameter})", f"cos(3*{parameter})",
+                                      f"sin({parameter})^3", parameter, f"{parameter}^2",
+                                      "1"])).map(lambda c: f"{c[0]}*{c[1]}")
+    return st.lists(term, min_size=1, max_size=4).map(" + ".join)
+
+
+def _yaml_scalar(text: str) -> str:
+    return json.dumps(text, ensure_ascii=False)  # a JSON string is a YAML scalar
+
+
+def _robot_pose(robot_text: str) -> list[str]:
+    import yaml
+
+    try:
+        return [str(v) for v in yaml.safe_load(robot_text)["pose"]]
+    except Exception:
+        return ["x", "y", "z"]
+
+
+@st.composite
+def structured_trajectories(draw, pose: list[str]) -> str:
+    """A trajectory built key by key: generated coordinates and ranges, sometimes a key
+    missing, an extra one, or a value of the wrong shape."""
+    parameter = draw(st.sampled_from(["t"] * 12 + ["s", "x", "pi", "sin"]))
+    names = [parameter]
+    ends = st.one_of(st.sampled_from(["-pi", "pi", "0", "1", "-1", "2*pi", "-1000000",
+                                      "1000000", "1e300", "pi/3", "-1/2", "0"]), numbers())
+    doc = {"name": draw(st.sampled_from(["t1", "x", "", "a b", "path"])),
+           "parameter": parameter,
+           "range": f"[{draw(ends)}, {draw(ends)}]",
+           "pose": {v: draw(st.one_of(path_coordinates(parameter),
+                                      path_coordinates(parameter),
+                                      expressions(names, parameter))) for v in pose}}
+    if draw(st.integers(0, 9)) == 0:
+        doc.pop(draw(st.sampled_from(sorted(doc))))
+    if draw(st.integers(0, 9)) == 0:
+        doc["extra"] = "1"
+    lines = []
+    for key, value in doc.items():
+        if key == "pose":
+            lines.append("pose:")
+            lines += [f"  {k}: {_yaml_scalar(v)}" for k, v in value.items()]
+        elif key == "range":
+            lines.append(f"range: {value}")
+        else:
+            lines.append(f"{key}: {_yaml_scalar(value)}")
+    if draw(st.integers(0, 19)) == 0:
+        lines.insert(draw(st.integers(0, len(lines))), "  " + "[" * draw(st.integers(1, 60)))
+    return "\n".join(lines) + "\n"
+
+
+@st.composite
+def mutated_robots(draw) -> str:
+    """A bundled robot, sometimes with a parameter, a limit or a constraint changed."""
+    text = draw(st.sampled_from(ROBOT_FILES)).read_text()
+    kind = draw(st.integers(0, 5))
+    if kind == 0:  # a parameter or a number changed
+        for old in ("l: 2", "l1: 2", "9/4", "[0, 4]", "[-4, 4]", "[-1, 4]"):
+            if old in text:
+                new = draw(st.sampled_from(["l: 0", "l: -1", "l: 10^100", "9/4000000",
+                                            "[0, 1e100]", "[4, 4]", "[1/3, 1/2]",
+                                            "(2147483648-364349)^8"]))
+                return text.replace(old, new, 1)
+    if kind == 1:  # a constraint replaced by a generated polynomial
+        lines = text.splitlines()
+        index = [i for i, line in enumerate(lines) if line.strip().startswith("- (")]
+        if index:
+            names = ["x", "y", "z", "rho1", "rho2", "rho3", "p", "q", "l", "l1", "l2"]
+            lines[draw(st.sampled_from(index))] = \
+                "  - " + _yaml_scalar(draw(expressions(names, "x")))
+            return "\n".join(lines) + "\n"
+    return text
+
+
+@st.composite
+def byte_mutations(draw, text: str) -> str:
+    """A spec with bytes flipped, inserted, deleted or a slice repeated (decoded as
+    UTF-8 with replacement, as a hostile file would be read)."""
+    data = bytearray(text.encode())
+    for _ in range(draw(st.integers(1, 6))):
+        op = draw(st.integers(0, 3))
+        if not data:
+            break
+        at = draw(st.integers(0, len(data) - 1))
+        if op == 0:
+            data[at] = draw(st.integers(0, 255))
+        elif op == 1:
+            data[at:at] = draw(st.sampled_from([b"[", b"(", b"-", b"^99", b"e999", b"*t",
+                                                b"\n", b": ", b"&a ", b"*a", b"!!python",
+                                                b"\t", b"9" * 50, b"\x00"]))
+        elif op == 2:
+            del data[at:at + draw(st.integers(1, 20))]
+        else:
+            end = min(len(data), at + draw(st.integers(1, 40)))
+            data[at:at] = bytes(data[at:end]) * draw(st.integers(2, 30))
+    return data.decode("utf-8", errors="replace")
+
+
+# -- the properties -----------------------------------------------------------------------
+
+
+@pytest.mark.slow
+@FUZZ
+@given(st.data())
+def test_structured_and_grammar_trajectories_end_with_exit_0_to_3(data):
+    robot_text = data.draw(mutated_robots())
+    trajectory_text = data.draw(structured_trajectories(_robot_pose(robot_text)))
+    outcome(robot_text, trajectory_text)
+
+
+@pytest.mark.slow
+@FUZZ
+@given(st.data())
+def test_byte_mutated_specs_end_with_exit_0_to_3(data):
+    # (the stacked Orthoglide's projection takes seconds: not once per mutated byte)
+    robot_file = data.draw(st.sampled_from([p for p in ROBOT_FILES if "stacked" not in
+                                            p.name]))
+    robot_text = robot_file.read_text()
+    fitting = [p for p in TRAJECTORY_FILES if (p.name.startswith("skew") ==
+                                               robot_file.name.startswith("skew")
+                                               and p.name.startswith("biglide") ==
+                                               robot_file.name.startswith("biglide")
+                                               and p.name.startswith("stacked") ==
+                                               robot_file.name.startswith("stacked"))]
+    trajectory_text = data.draw(st.sampled_from(fitting or TRAJECTORY_FILES)).read_text()
+    if data.draw(st.booleans()):
+        trajectory_text = data.draw(byte_mutations(trajectory_text))
+    else:
+        robot_text = data.draw(byte_mutations(robot_text))
+    outcome(robot_text, trajectory_text)
+
+
+CLI_SAMPLE = [
+    # (robot file, trajectory text): hostile shapes from each finding class
+    ("orthoglide", "name: a\nparameter: t\nrange: [0, 1]\npose:\n  x: " + "(" * 300 + "t"
+     + ")" * 300 + "\n  y: 0\n  z: 1\n"),
+    ("orthoglide", "name: a\nparameter: t\nrange: [0, 1]\npose:\n  x: 1e999999999\n  y: 0\n"
+     "  z: 1\n"),
+    ("orthoglide", "name: a\nparameter: t\nrange: [0, 1]\npose: " + "[" * 1000 + "\n"),
+    ("orthoglide", "name: a\nparameter: t\nrange: [-pi, pi]\npose:\n  x: 8/7*sin(t)^3\n"
+     "  y: 13/14*cos(t) - 5/14*cos(2*t)\n  z: 1\n"),
+    ("skew-biglide", "name: b\nparameter: t\nrange: [0, 1]\npose:\n  x: (t+1)^2\n  y: -t\n"),
+]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("robot, text", CLI_SAMPLE)
+def test_fuzzed_specs_through_the_command_line(tmp_path, robot, text):
+    spec = tmp_path / "t.yaml"
+    spec.write_text(text)
+    out = subprocess.run([sys.executable, "-m", "singcheck", "run", str(ROBOTS / f"{robot}.yaml"),
+                          str(spec), "--backend", "flint", "--no-cache"], capture_output=True,
+                         text=True, cwd=ROOT, timeout=120,
+                         env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert out.returncode in (0, 1, 2, 3), out.stderr
+    assert "Traceback" not in out.stderr
+    if out.returncode == 2:
+        assert out.stderr.count("\n") == 1

@@ -1,0 +1,620 @@
+"""Hostile input never crashes, hangs or lies: one regression test per finding of the
+hostile run (issue 16) — deep nesting, huge numbers, costly small specs, huge CAS
+output, planted cache files, forged cache entries, signals, ``-o`` targets, missing
+extras, undecided boxes."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import stat
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+
+from tests.conftest import ROBOTS, ROOT, TRAJECTORIES
+
+ORTHO = str(ROBOTS / "orthoglide.yaml")
+BIGLIDE = str(ROBOTS / "biglide.yaml")
+
+
+def run_cli(monkeypatch, capsys, *args: str) -> tuple[int, str, str]:
+    """The console entry point in-process: (exit status, stdout, stderr)."""
+    from singcheck.cli.commands import main
+
+    monkeypatch.setattr(sys, "argv", ["singcheck", *args])
+    monkeypatch.delenv("SINGCHECK_DEBUG", raising=False)
+    with pytest.raises(SystemExit) as exit_:
+        main()
+    out = capsys.readouterr()
+    return int(exit_.value.code or 0), out.out, out.err
+
+
+def trajectory(tmp_path: Path, pose: dict[str, str], rng: str = "0, 1",
+               name: str = "t") -> str:
+    path = tmp_path / f"{name}.yaml"
+    lines = [f"name: {name}", "parameter: t", f"range: [{rng}]", "pose:"]
+    lines += [f"  {k}: {v}" for k, v in pose.items()]
+    path.write_text("\n".join(lines) + "\n")
+    return str(path)
+
+
+@pytest.fixture
+def cache_env(tmp_path, monkeypatch):
+    """A private cache and cache key for the test."""
+    monkeypatch.setenv("SINGCHECK_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))
+    from singcheck.elimination import cache
+
+    cache._KEYS.clear()
+    yield tmp_path / "cache"
+    cache._KEYS.clear()
+
+
+def one_line_error(code: int, err: str, expected_code: int, phrase: str) -> None:
+    assert code == expected_code, err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert phrase in err, err
+
+
+# -- 1. deep nesting ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("pose_x, phrase", [
+    ("[" * 1000, "nested more than 16 levels"),
+    ("(" * 300 + "t" + ")" * 300, "nested more than 64 levels"),
+    ("t" + "^t" * 200, "nested more than 64 levels"),
+    ("sin(" * 100 + "t" + ")" * 100, "nested more than 64 levels"),
+])
+def test_deep_nesting_is_a_one_line_spec_error(tmp_path, monkeypatch, capsys, cache_env,
+                                               pose_x, phrase):
+    spec = trajectory(tmp_path, {"x": pose_x, "y": "0", "z": "1"})
+    code, _, err = run_cli(monkeypatch, capsys, "run", ORTHO, spec, "-q", "--backend", "flint")
+    one_line_error(code, err, 2, phrase)
+
+
+def test_long_sign_runs_and_sums_parse_without_recursion():
+    """1000 signs are one sign; a sum of 900 terms and a product of 1000 factors are
+    regrouped into shallow trees — checked against exact arithmetic done here."""
+    from singcheck.spec.grammar import compile_constant, parse
+
+    assert compile_constant(parse("-" * 1001 + "7")).rational == -7
+    assert compile_constant(parse("-" * 1000 + "7")).rational == 7
+    terms = [Fraction(k, k + 1) * (-1) ** k for k in range(1, 900)]
+    text = "".join(f"{'-' if q < 0 else '+'}{abs(q.numerator)}/{q.denominator}"
+                   for q in terms)
+    assert compile_constant(parse(text)).rational == sum(terms)
+    text = "*".join(["3/2"] * 500) + "/" + "/".join(["3"] * 500)
+    assert compile_constant(parse("1*" + text)).rational == Fraction(1, 2 ** 500)
+    # a - b + c and a / b * c keep their left-to-right meaning
+    assert compile_constant(parse("10 - 4 + 3 - 2")).rational == 7
+    assert compile_constant(parse("12 / 4 * 3 / 9 * 2")).rational == 2
+
+
+# -- 2. numbers -------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("pose, phrase", [
+    ({"x": "t^1e5000", "y": "0", "z": "1"}, "the number 1e5000 is too large"),
+    ({"x": "1e999999999", "y": "0", "z": "1"}, "the number 1e999999999 is too large"),
+    ({"x": "sin(t)", "y": "cos(t)", "z": "1.0e+308"}, "the number 1.0e+308 is too large"),
+    ({"x": "0." + "0" * 200 + "1", "y": "0", "z": "1"}, "is too large"),
+    ({"x": "7" * 5000, "y": "0", "z": "1"}, "(5000 characters) is too large"),
+    ({"x": "t^" + "9" * 5000, "y": "0", "z": "1"}, "is too large"),
+])
+def test_huge_number_literals_are_refused_up_front(tmp_path, monkeypatch, capsys, cache_env,
+                                                    pose, phrase):
+    spec = trajectory(tmp_path, pose)
+    start = time.monotonic()
+    code, _, err = run_cli(monkeypatch, capsys, "run", ORTHO, spec, "-q", "--backend", "flint")
+    one_line_error(code, err, 2, phrase)
+    assert time.monotonic() - start < 10
+    assert len(err) < 400
+
+
+def test_number_literals_within_the_bound_stay_exact():
+    from singcheck.spec.grammar import MAX_LITERAL_BITS, compile_constant, parse
+
+    assert compile_constant(parse("1e150")).rational == 10 ** 150
+    assert compile_constant(parse("2.5e-3")).rational == Fraction(1, 400)
+    assert compile_constant(parse("0.000")).rational == 0
+    big = str(2 ** MAX_LITERAL_BITS - 1)
+    assert compile_constant(parse(big)).rational == 2 ** MAX_LITERAL_BITS - 1
+    from singcheck.spec.grammar import ExprError
+
+    with pytest.raises(ExprError, match="too large"):
+        parse(str(2 ** MAX_LITERAL_BITS))
+
+
+# -- 4. CAS output --------------------------------------------------------------------
+
+
+def test_a_huge_coefficient_between_valid_markers_is_a_backend_error(orthoglide):
+    from singcheck.elimination.cas.scripts import BEGIN, END, parse_result
+    from singcheck.elimination.projection import singularity_surface_request
+    from singcheck.errors import BackendError
+
+    request = singularity_surface_request(orthoglide)
+    label = request.label
+    stdout = f"{BEGIN} {label} 1\n{'7' * 3_000_000}*v4^2+1\n{END} {label}\n"
+    start = time.monotonic()
+    with pytest.raises(BackendError, match="3000000 digits"):
+        parse_result("Singular", stdout, "", request)
+    assert time.monotonic() - start < 5
+    for bad_count in ("²", "9" * 5000):
+        with pytest.raises(BackendError, match="malformed marker"):
+            parse_result("Singular", f"{BEGIN} {label} {bad_count}\n1\n{END} {label}\n", "",
+                         request)
+    with pytest.raises(BackendError, match="exponent"):
+        parse_result("Singular", f"{BEGIN} {label} 1\nv4^99999999999\n{END} {label}\n", "",
+                     request)
+
+
+def fake_cas(tmp_path: Path, body: str) -> Path:
+    """A directory holding a fake ``Singular`` (a Python script) for PATH."""
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir(exist_ok=True)
+    exe = bin_dir / "Singular"
+    exe.write_text(f"#!{sys.executable}\n" + textwrap.dedent(body))
+    exe.chmod(0o755)
+    return bin_dir
+
+
+VERSION = """\
+import sys
+if "--version" in sys.argv:
+    print("Singular for x86_64-Linux version 4.3.1 (fake)")
+    sys.exit(0)
+"""
+
+
+def test_a_cas_printing_without_end_is_stopped_at_the_output_bound(tmp_path, monkeypatch):
+    from singcheck.elimination.cas import process
+    from singcheck.errors import BackendError
+
+    monkeypatch.setattr(process, "MAX_OUTPUT_BYTES", 2**20)
+    start = time.monotonic()
+    with pytest.raises(BackendError, match="printed more than"):
+        process.run_program([sys.executable, "-c", "import sys\nwhile True: "
+                             "sys.stdout.write('7' * 65536)"], timeout=60)
+    assert time.monotonic() - start < 30
+
+
+# -- 5. cache files ---------------------------------------------------------------------
+
+
+def _entries(cache_dir: Path) -> list[Path]:
+    return sorted(p for p in cache_dir.glob("*/*.json"))
+
+
+@pytest.mark.parametrize("fault", ["fifo", "dev-zero", "nested", "huge", "directory"])
+def test_a_planted_cache_entry_is_a_miss_and_is_replaced(tmp_path, monkeypatch, capsys,
+                                                         cache_env, fault):
+    args = ("run", ORTHO, str(TRAJECTORIES / "heart2.yaml"), "-q", "--backend", "sympy",
+            "--format", "json")
+    code, out, err = run_cli(monkeypatch, capsys, *args)
+    assert code == 0, err
+    expected = json.loads(out)["singularity_surface_degree"]
+    (entry,) = [p for p in _entries(cache_env)
+                if "singularity_surface" in p.read_text()]
+    entry.unlink()
+    if fault == "fifo":
+        os.mkfifo(entry)
+    elif fault == "dev-zero":
+        entry.symlink_to("/dev/zero")
+    elif fault == "nested":
+        entry.write_text("[" * 100_000 + "]" * 100_000)
+    elif fault == "huge":
+        with open(entry, "wb") as f:
+            f.truncate(65 * 2**20)  # sparse: past the bound without using the disk
+    else:
+        entry.mkdir()
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, *args)
+    assert code == 0 and "Traceback" not in err, err
+    assert json.loads(out)["singularity_surface_degree"] == expected
+    assert time.monotonic() - start < 60
+    if fault != "directory":  # replaced by a good regular entry, read on the next run
+        assert stat.S_ISREG(os.lstat(entry).st_mode)
+        from singcheck.elimination.cache import FORMAT, read_entry
+
+        assert read_entry(entry, FORMAT, entry.stem)["label"] == "singularity_surface"
+
+
+# -- 6. cache poisoning -------------------------------------------------------------------
+
+
+class WrongBackend:
+    """Answers every request with x (a wrong ξ), counting its calls."""
+
+    name = "wrong"
+
+    def __init__(self):
+        self.calls = 0
+
+    def version(self) -> str:
+        return "1"
+
+    def eliminate(self, request):
+        from singcheck.elimination.requests import EliminationResult
+
+        self.calls += 1
+        x = request.kept_context().gens()[0]
+        return EliminationResult(request, (x,), "wrong", self.name)
+
+
+def test_a_wrong_answer_is_never_cached(orthoglide, cache_env):
+    from singcheck.elimination.cache import CachedBackend, EliminationCache
+    from singcheck.elimination.cas import get_backend
+    from singcheck.elimination.projection import project_robot, singularity_surface_request
+    from singcheck.errors import BackendError
+
+    cache = EliminationCache(cache_env)
+    wrong = WrongBackend()
+    for _ in range(2):
+        with pytest.raises(BackendError, match="re-check"):
+            project_robot(orthoglide, CachedBackend(wrong, cache))
+    assert wrong.calls == 2 and _entries(cache_env) == []  # asked again: nothing stored
+    # a wrong entry that is in the cache anyway (written with the key) is a miss, then
+    # replaced by the right answer
+    request = singularity_surface_request(orthoglide)
+    key = cache.key(CachedBackend(wrong, cache)._identity(request), "flint",
+                    get_backend("flint").version())
+    cache.store(key, wrong.eliminate(request))
+    projection = project_robot(orthoglide, CachedBackend(get_backend("flint"), cache))
+    assert cache.stats.corrupted == 1
+    # the right ξ: degree 16, vanishing on the sphere x² + y² + z² = 4 (all legs aligned)
+    xi = projection.singularity_surface
+    assert xi.total_degree() == 16
+    assert xi(2, 0, 0) == 0 and xi(0, 0, 2) == 0 and xi(0, 0, 0) != 0
+    again = CachedBackend(get_backend("flint"), EliminationCache(cache_env))
+    project_robot(orthoglide, again)
+    assert again.cache.stats.hits == 1 and again.cache.stats.corrupted == 0
+
+
+def test_a_forged_region_map_is_recomputed(tmp_path, monkeypatch, capsys, cache_env):
+    """heart 2 lies in R9 of the plane z = 1 (README); an entry whose numbers were
+    changed, with a checksum recomputed by the forger, is not believed."""
+    args = ("run", ORTHO, str(TRAJECTORIES / "heart2.yaml"), "-q", "--backend", "flint",
+            "--format", "json")
+    code, out, err = run_cli(monkeypatch, capsys, *args)
+    assert code == 0, err
+    assert json.loads(out)["trajectories"][0]["workspace"]["region"].startswith("R9 ")
+    (entry,) = (cache_env / "regions").glob("*.json")
+    doc = json.loads(entry.read_text())
+    doc["payload"]["cells"] = [[index, 10 if n == 9 else n]
+                               for index, n in doc["payload"]["cells"]]
+    import hashlib
+    import hmac
+
+    forged_key = b"0" * 64  # the forger does not have the user's key
+    doc["hmac"] = hmac.new(forged_key, json.dumps(doc["payload"], sort_keys=True).encode(),
+                           hashlib.sha256).hexdigest()
+    entry.write_text(json.dumps(doc))
+    from singcheck.spaces import path_regions
+
+    path_regions._SUBSPACES.clear()
+    code, out, err = run_cli(monkeypatch, capsys, *args)
+    assert code == 0, err
+    assert json.loads(out)["trajectories"][0]["workspace"]["region"].startswith("R9 ")
+
+
+# -- 7. signals ---------------------------------------------------------------------------
+
+SETSID_CAS = VERSION + """\
+import os, subprocess, sys, time
+pids = os.environ["FAKE_PIDS"]
+child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(300)"],
+                         start_new_session=True)  # setsid(): out of the CAS's group
+with open(pids, "w") as f:
+    f.write(f"{os.getpid()} {child.pid}\\n")
+if os.environ.get("FAKE_HANG"):
+    time.sleep(300)
+sys.exit(3)
+"""
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def _fake_env(tmp_path: Path, hang: bool) -> dict:
+    bin_dir = fake_cas(tmp_path, SETSID_CAS)
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    return {**os.environ, "PATH": f"{bin_dir}:{os.environ['PATH']}", "TMPDIR": str(tmp),
+            "FAKE_PIDS": str(tmp_path / "pids"), "SINGCHECK_CACHE_DIR": str(tmp_path / "c"),
+            "XDG_CONFIG_HOME": str(tmp_path / "config"), "PYTHONPATH": str(ROOT),
+            **({"FAKE_HANG": "1"} if hang else {})}
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_and_sighup_kill_the_cas_and_its_setsid_grandchild(tmp_path, sig):
+    env = _fake_env(tmp_path, hang=True)
+    proc = subprocess.Popen([sys.executable, "-m", "singcheck", "run", ORTHO,
+                             str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular",
+                             "-q"], env=env, cwd=ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    pids_file = tmp_path / "pids"
+    deadline = time.monotonic() + 60
+    while not (pids_file.exists() and pids_file.read_text().endswith("\n")):
+        assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
+        time.sleep(0.05)
+    cas, grandchild = map(int, pids_file.read_text().split())
+    assert _alive(cas) and _alive(grandchild)
+    assert os.getsid(grandchild) == grandchild != os.getpgid(cas)  # escaped the group
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "interrupted" in err
+    time.sleep(0.2)
+    assert not _alive(cas) and not _alive(grandchild)
+    assert list((tmp_path / "tmp").iterdir()) == []  # no /tmp/singcheck-* left
+
+
+def test_a_setsid_grandchild_does_not_outlive_a_finished_cas(tmp_path):
+    env = _fake_env(tmp_path, hang=False)
+    out = subprocess.run([sys.executable, "-m", "singcheck", "run", ORTHO,
+                          str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular", "-q"],
+                         env=env, cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 4, out.stderr  # the fake printed no result
+    cas, grandchild = map(int, (tmp_path / "pids").read_text().split())
+    time.sleep(0.2)
+    assert not _alive(cas) and not _alive(grandchild)
+    assert list((tmp_path / "tmp").iterdir()) == []
+
+
+# -- 8. -o targets ------------------------------------------------------------------------
+
+
+def _run_to(monkeypatch, capsys, target: str) -> tuple[int, str, str]:
+    return run_cli(monkeypatch, capsys, "run", ORTHO, str(TRAJECTORIES / "heart2.yaml"),
+                   "-q", "--backend", "flint", "--format", "json", "-o", target)
+
+
+def test_output_to_a_fifo_is_written_in_place(tmp_path, monkeypatch, capsys, cache_env):
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    got = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()))
+    reader.start()
+    code, _, err = _run_to(monkeypatch, capsys, str(fifo))
+    reader.join(timeout=60)
+    assert code == 0, err
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    assert json.loads(got[0])["trajectories"][0]["verdict"] == "singularity-free"
+
+
+def test_output_through_a_symlink_writes_its_target(tmp_path, monkeypatch, capsys, cache_env):
+    real = tmp_path / "real.json"
+    real.write_text("old")
+    link = tmp_path / "link.json"
+    link.symlink_to(real)
+    code, _, err = _run_to(monkeypatch, capsys, str(link))
+    assert code == 0, err
+    assert link.is_symlink() and json.loads(real.read_text())["exit_code"] == 0
+
+
+def test_output_to_a_character_device_is_not_replaced(tmp_path, monkeypatch, capsys,
+                                                      cache_env):
+    if os.geteuid() == 0:  # a private copy of /dev/null, so a bug cannot harm the system's
+        device = tmp_path / "null"
+        os.mknod(device, stat.S_IFCHR | 0o666, os.stat("/dev/null").st_rdev)
+    else:  # without root, /dev/null itself cannot be replaced anyway
+        device = Path("/dev/null")
+    code, out, err = _run_to(monkeypatch, capsys, str(device))
+    assert code == 0, err
+    assert stat.S_ISCHR(os.lstat(device).st_mode) and out == ""
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".null")] == []
+
+
+def test_output_to_dev_full_reports_the_write_error(monkeypatch, capsys, cache_env):
+    code, _, err = _run_to(monkeypatch, capsys, "/dev/full")
+    one_line_error(code, err, 2, "No space left on device")
+    assert stat.S_ISCHR(os.lstat("/dev/full").st_mode)
+
+
+def test_output_into_a_missing_directory_is_an_error(tmp_path, monkeypatch, capsys, cache_env):
+    target = tmp_path / "missing" / "out.json"
+    code, _, err = _run_to(monkeypatch, capsys, str(target))
+    one_line_error(code, err, 2, "does not exist")
+    assert not (tmp_path / "missing").exists()
+
+
+# -- 9. missing extras --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("args, extra", [
+    (("plot", ORTHO, str(TRAJECTORIES / "heart1.yaml"), "--out", "figs"), "plot"),
+    (("plot", str(ROBOTS / "skew-biglide.yaml"), "--regions", "workspace", "--out", "f"),
+     "plot"),
+    (("plot", ORTHO, str(TRAJECTORIES / "heart1.yaml"), "--format", "html", "--out", "f"),
+     "html"),
+    (("run", ORTHO, str(TRAJECTORIES / "heart1.yaml"), "--plot", "figs"), "plot"),
+])
+def test_plot_without_its_extra_names_the_extra(tmp_path, monkeypatch, capsys, args, extra):
+    import importlib.util
+
+    real = importlib.util.find_spec
+
+    def find_spec(name, *a, **k):
+        if name.split(".")[0] in ("matplotlib", "skimage", "plotly"):
+            return None
+        return real(name, *a, **k)
+
+    monkeypatch.setattr(importlib.util, "find_spec", find_spec)
+    monkeypatch.chdir(tmp_path)
+    code, _, err = run_cli(monkeypatch, capsys, *args)
+    one_line_error(code, err, 2, f"pip install 'singcheck[{extra}]'")
+    assert not (tmp_path / "figs").exists()
+
+
+# -- 10. undecided boxes when no mode is feasible -----------------------------------------
+
+
+def test_undecided_boxes_and_a_known_root_are_kept_when_no_mode_is_feasible(
+        tmp_path, monkeypatch, capsys, cache_env):
+    """On the biglide (ξ vanishes where y = 0) the path y = t·sin t touches y = 0 at t = 0
+    without crossing, and x = 10 puts it outside every joint's limits: μ has a double
+    root at t = 0, exactly known.  It must be reported, not dropped with the boxes around
+    it because no working mode is feasible."""
+    spec = trajectory(tmp_path, {"x": "10", "y": "t*sin(t)"}, "-1, 1")
+    code, out, err = run_cli(monkeypatch, capsys, "run", BIGLIDE, spec, "-q", "--backend",
+                             "flint", "--format", "json")
+    assert code == 1, err
+    (doc,) = json.loads(out)["trajectories"]
+    assert doc["verdict"] == "infeasible"
+    assert [c["t_interval"] for c in doc["candidates"]] == [[0.0, 0.0]]
+    assert all(lo <= 0 <= hi for lo, hi in (u["t_interval"] for u in doc["undecided"]))
+    # an undecided box is kept when no mode is feasible (all([]) is true: it was dropped)
+    from types import SimpleNamespace
+
+    from singcheck.certify.classification import _clear_undecided
+    from singcheck.certify.working_modes import INFEASIBLE
+
+    modes = [SimpleNamespace(status=INFEASIBLE, label=label) for label in ("++", "+-")]
+    assert _clear_undecided(None, modes, SimpleNamespace(t=None)) is False
+
+
+# -- 3. costly small specs: refused up front, or stopped at the time limit --------------
+
+
+def test_a_path_whose_mu_would_explode_is_refused_up_front(tmp_path, monkeypatch, capsys,
+                                                           cache_env):
+    """Refused before composing; in a batch that is this trajectory's result (verdict
+    error, kind spec), the others still complete, and the exit status is 2."""
+    spec = trajectory(tmp_path, {"x": "(sin(t)+cos(t)+t)^64", "y": "0", "z": "1"})
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, "run", ORTHO, spec,
+                             str(TRAJECTORIES / "heart2.yaml"), "-q", "--backend", "flint",
+                             "--format", "json")
+    assert code == 2 and "Traceback" not in err, err
+    costly, heart2 = json.loads(out)["trajectories"]
+    assert costly["verdict"] == "error" and costly["error"]["kind"] == "spec"
+    assert "too costly" in costly["reason"] and heart2["verdict"] == "singularity-free"
+    assert time.monotonic() - start < 30
+
+
+def test_mu_size_bound_holds_for_a_composed_path(orthoglide_projection):
+    """The a-priori bound is an upper bound of what composition gives (checked on a path
+    mixing t, sin and cos, composed here)."""
+    from singcheck.certify.path import compose_pose, mu_size_bound
+    from singcheck.spec.grammar import compile_trajectory_coordinate, parse
+
+    phi = tuple(compile_trajectory_coordinate(parse(text), "t", {}) for text in
+                ("(sin(t) + cos(t) + t)^3", "t^2 - sin(2*t)", "1"))
+    xi = orthoglide_projection.singularity_surface
+    deg_t, deg_sc, terms = mu_size_bound(xi, phi, ("x", "y", "z"))
+    mu = compose_pose(xi, phi, ("x", "y", "z"))
+    assert len(mu) <= terms
+    assert mu.degrees()[0] <= deg_t and mu.degrees()[1] + mu.degrees()[2] <= deg_sc
+
+
+@pytest.mark.parametrize("robot, pose, rng", [
+    (ORTHO, {"x": "3*sin(t) + cos(256*t)", "y": "0", "z": "1"}, "0, 1"),
+    (BIGLIDE, {"x": "sin(100*t)", "y": "t"}, "0, 1"),
+    (ORTHO, {"x": "sin(t)", "y": "cos(t)", "z": "t/20"}, "-1000000, 1000000"),
+    # found by the fuzz campaign: 10^5 periods of the half-angle roots ran 286 s
+    (str(ROBOTS / "skew-biglide.yaml"), {"x": "-sin(t)", "y": "-sin(t)"}, "-27/2, 1000000"),
+])
+def test_costly_paths_stop_at_the_time_limit(tmp_path, cache_env, robot, pose, rng):
+    from singcheck import api
+
+    machine = api.load_robot(robot, backend="flint")
+    spec = api.load_trajectory(trajectory(tmp_path, pose, rng), machine)
+    start = time.monotonic()
+    report = api.check(machine, spec, time_limit=3)
+    elapsed = time.monotonic() - start
+    assert elapsed < 3 + 10, elapsed
+    if report.verdict == "unknown":
+        assert "time limit" in report.reason
+    else:  # finished in time: then it must be a proven answer
+        assert report.certificate is not None
+
+
+@pytest.mark.parametrize("robot, pose", [
+    (ORTHO, {"x": "3*sin(t) + cos(256*t)", "y": "0", "z": "1"}),
+    (BIGLIDE, {"x": "sin(100*t)", "y": "t"}),
+    (BIGLIDE, {"x": "sin(100*t)", "y": "t + 1/1000"}),
+])
+def test_costly_paths_end_unknown_at_the_command_lines_time_limit(
+        tmp_path, monkeypatch, capsys, cache_env, robot, pose):
+    spec = trajectory(tmp_path, pose)
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, "run", robot, spec, "-q", "--backend",
+                             "flint", "--time-limit", "3", "--format", "json")
+    assert code in (0, 1, 3), err
+    assert "Traceback" not in err
+    (doc,) = json.loads(out)["trajectories"]
+    if code == 3:  # stopped; or decided in time (the biglide meets y = 0 at t = 0 exactly)
+        assert doc["verdict"] == "unknown" and "time limit" in doc["reason"]
+    assert time.monotonic() - start < 3 + 15
+
+
+def test_near_double_roots_of_huge_size_are_separated():
+    """x² + Bx + C with roots a and a + 2⁻¹⁰, a = -2²⁴⁵ (what the workspace decomposition
+    of a robot with the constant (2147483648-364349)^8 meets): the isolating intervals
+    are halved until they are apart, however many rounds that takes (it took more than
+    the former cap of 200)."""
+    from flint import fmpq, fmpq_poly
+
+    from singcheck.spaces.cad import separated_roots
+
+    a = fmpq(-(2 ** 245))
+    b = a + fmpq(1, 2 ** 10)
+    roots = separated_roots(fmpq_poly([a * b, -(a + b), 1]))
+    assert len(roots) == 2 and roots[0].hi < roots[1].lo
+    assert roots[0].lo <= a <= roots[0].hi and roots[1].lo <= b <= roots[1].hi
+
+
+def test_a_robot_with_a_huge_constant_is_decided(tmp_path, monkeypatch, capsys, cache_env):
+    robot = tmp_path / "big.yaml"
+    robot.write_text(textwrap.dedent("""\
+        name: big
+        joints: [p, q]
+        pose: [x, y]
+        constraints:
+          - (x - p)^2 + y^2 - 4
+          - (x - q)^2 + y^2 - (2147483648-364349)^8
+        joint_limits: {p: [-4, 4], q: [-4, 4]}
+        """))
+    spec = trajectory(tmp_path, {"x": "t", "y": "1/2 + t/4"})
+    code, out, err = run_cli(monkeypatch, capsys, "run", str(robot), spec, "-q", "--backend",
+                             "flint", "--format", "json")
+    assert code == 1 and "Traceback" not in err, err
+    (doc,) = json.loads(out)["trajectories"]
+    # q = x ± √(C - y²) with C ≈ 2^247: far outside [-4, 4] from the start
+    assert doc["verdict"] == "infeasible" and "q is outside [-4, 4]" in doc["reason"]
+
+
+# -- found by the fuzz campaign -------------------------------------------------------------
+
+
+def test_a_triple_root_at_t_0_of_the_half_angle_polynomial(tmp_path, monkeypatch, capsys,
+                                                           cache_env):
+    """On the biglide (ξ vanishes where y = 0), y = (9/14)·sin(t)³ gives M(u) = c·u³,
+    which deflates to a root v = 0 of N(v) = c·v: Arb's cube root of 0 is NaN, which gave
+    exit 70.  The roots are t = kπ, exactly: here 0, π and 2π."""
+    import math
+
+    spec = trajectory(tmp_path, {"x": "2*sin(2*t) + cos(t)", "y": "sin(t)^3 - 5/14*sin(t)^3"},
+                      "-45/54, 2*pi")
+    code, out, err = run_cli(monkeypatch, capsys, "run", BIGLIDE, spec, "-q", "--backend",
+                             "flint", "--format", "json")
+    assert code in (0, 1, 3) and "Traceback" not in err, err
+    (doc,) = json.loads(out)["trajectories"]
+    intervals = [c["t_interval"] for c in doc["candidates"]]
+    assert len(intervals) == 3
+    for (lo, hi), root in zip(intervals, (0.0, math.pi, 2 * math.pi), strict=True):
+        assert lo <= root <= hi and hi - lo < 1e-8

@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from flint import acb, arb, fmpq
+from flint import acb, arb
 
 from singcheck.algebra.intervals import evaluate
 from singcheck.algebra.radicals import angle_names, radical_prime
@@ -100,13 +100,7 @@ def _on_piece(report: TrajectoryReport, index: int, t: arb):
     on a rescaled piece, u = t − t₀ on an interpolated one)."""
     if not report.pieces:
         return report.path, t
-    spec = report.trajectory.pieces[index]
-    path = report.pieces[index].path
-    if spec.time_scale is not None:
-        g = spec.time_scale
-        return path, t * arb.pi() * arb(fmpq(g.numerator, g.denominator))
-    d = spec.time_offset
-    return path, t - arb(fmpq(d.numerator, d.denominator)) if d else t
+    return report.pieces[index].path, report.trajectory.pieces[index].to_local(t)
 
 
 def piece_index(report: TrajectoryReport, t: float) -> int:

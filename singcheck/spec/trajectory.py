@@ -86,6 +86,19 @@ class TrajectorySpec:
             return t + arb(fmpq(d.numerator, d.denominator))
         return t
 
+    def to_local(self, t):
+        """The inverse of :meth:`to_global`: a ball in t mapped to a ball in this piece's
+        own time (τ = g·π·t, or u = t − t₀), rigorous."""
+        from flint import arb, fmpq
+
+        if self.time_scale is not None:
+            g = self.time_scale
+            return t * arb.pi() * arb(fmpq(g.numerator, g.denominator))
+        if self.time_offset:
+            d = self.time_offset
+            return t - arb(fmpq(d.numerator, d.denominator))
+        return t
+
 
 def exactly_less(a: LinearInPi, b: LinearInPi) -> bool:
     """Exactly a < b (π is irrational, so unequal values separate at some precision)."""

@@ -86,3 +86,52 @@ def test_a_composition_beyond_the_work_bound_is_refused_up_front(stacked, tmp_pa
     assert f"at most {MAX_COMPOSE_WORK:.3g}" in message
     estimate = float(re.search(r"would cost ([0-9.e+]+)", message).group(1))
     assert estimate > MAX_COMPOSE_WORK
+
+
+# -- workspace and joint space ------------------------------------------------------------
+
+BIG_CONSTANT = """\
+name: big
+joints: [p, q]
+pose: [x, y]
+constraints:
+  - (x - p)^2 + y^2 - 4
+  - (x - q)^2 + y^2 - (2147483648-364349)^8
+joint_limits: {p: [-4, 4], q: [-4, 4]}
+"""
+
+
+@pytest.mark.parametrize("space, robot", [("workspace", "orthoglide"),
+                                          ("jointspace", "big-constant")])
+def test_space_analyses_stop_at_the_time_limit_and_write_nothing(
+        tmp_path, monkeypatch, capsys, cache_env, space, robot):  # noqa: F811
+    """Both take 2-7 s without a limit (the decomposition); with --time-limit 1 they end
+    with exit 3, one line naming the limit, and no -o file."""
+    if robot == "big-constant":
+        path = tmp_path / "big.yaml"
+        path.write_text(BIG_CONSTANT)
+    else:
+        path = ROBOTS / f"{robot}.yaml"
+    target = tmp_path / "out.json"
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, space, str(path), "--backend", "flint",
+                             "-q", "--time-limit", "1", "--format", "json", "-o", str(target))
+    elapsed = time.monotonic() - start
+    assert code == 3, err
+    assert err.count("\n") == 1 and "unknown: time limit (1 s)" in err, err
+    assert not target.exists() and out == ""
+    assert elapsed < 4, elapsed
+
+
+def test_space_commands_state_their_time_limit():
+    from click.testing import CliRunner
+
+    from singcheck.cli.spaces import jointspace, workspace
+
+    for command in (workspace, jointspace):
+        result = CliRunner().invoke(command, ["--help"])
+        assert result.exit_code == 0
+        text = " ".join(result.output.split())
+        option = text[text.index("--time-limit FLOAT"):text.index("--format [")]
+        assert "past it the command ends with exit 3" in option
+        assert option.endswith("[default: 300; x>0] ")

@@ -46,8 +46,17 @@ def radical_name(p: int) -> str:
 
 def radical_prime(name: str) -> int | None:
     """p when ``name`` is the variable of √p, else None."""
-    m = _RADICAL.match(name)
-    return int(m.group(1)) if m else None
+    hit = _RADICAL_PRIMES.get(name, _MISSING)
+    if hit is _MISSING:
+        m = _RADICAL.match(name)
+        hit = int(m.group(1)) if m else None
+        if len(_RADICAL_PRIMES) < 4096:  # names of variables: few, asked for per path
+            _RADICAL_PRIMES[name] = hit
+    return hit
+
+
+_RADICAL_PRIMES: dict[str, int | None] = {}
+_MISSING = object()
 
 
 def angle_names(v: str) -> tuple[str, str]:

@@ -242,14 +242,12 @@ _LIMIT_BALLS: dict = {}
 
 def _limit_balls(limits) -> tuple[arb, arb]:
     """The balls of a prismatic joint's rational limits (exact when dyadic), once per
-    limits and working precision: feasibility proofs compare against them thousands of
-    times."""
-    key = (tuple(limits), ctx.prec)
-    hit = _LIMIT_BALLS.get(key)
+    limits object and working precision: feasibility proofs compare against them
+    thousands of times (keyed by the object, not by hashing its Fractions each time)."""
+    per_prec = memo_per_object(_LIMIT_BALLS, limits, lambda _: {})
+    hit = per_prec.get(ctx.prec)
     if hit is None:
-        if len(_LIMIT_BALLS) > 256:
-            _LIMIT_BALLS.clear()
-        hit = _LIMIT_BALLS[key] = tuple(fraction_ball(v) for v in limits)
+        hit = per_prec[ctx.prec] = tuple(fraction_ball(v) for v in limits)
     return hit
 
 

@@ -24,6 +24,7 @@ from collections.abc import Callable
 
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
+from singcheck.algebra.polynomials import memo_per_object
 from singcheck.budget import checkpoint
 
 #: The most work (:func:`term_costs`) one FLINT composition call may get.  On the
@@ -56,50 +57,109 @@ def _bits(p: fmpq_mpoly) -> int:
                default=0)
 
 
-def term_costs(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> tuple[list[int], int, int]:
-    """(per term of ``p`` the a-priori cost of its image ``c·Π argᵢ^eᵢ``, the largest
-    degree a in the first variable (t) and b in the others of an image).  Nothing is
-    composed: a reduced trig polynomial of degree a in t and b in (s, c) has at most
-    (a + 1)(2b + 1) terms; the cost is that times the 64-bit words of its coefficients
-    times the terms of the largest argument it is multiplied by.  An estimate for
-    cutting and refusing work; no answer's correctness rests on it."""
-    deg_t = [max(int(a.degrees()[0]), 0) for a in args]
-    deg_rest = [max(sum(int(d) for d in a.degrees()[1:]), 0) for a in args]
-    bits = [_bits(a) for a in args]
-    sizes = [len(a) for a in args]
+_WEIGHTS: dict = {}
+_BITS: dict = {}
+
+
+def _weight(a: fmpq_mpoly) -> tuple[int, int, int]:
+    """An argument's degree in the first variable (t), its total degree in the others,
+    and the bits of its coefficients (0, 0, 0 for zero), once per argument object."""
+    def compute(a: fmpq_mpoly) -> tuple[int, int, int]:
+        degrees = [max(0, int(d)) for d in a.degrees()]
+        return degrees[0], sum(degrees[1:]), _bits(a)
+
+    return memo_per_object(_WEIGHTS, a, compute, keep=1024)
+
+
+def _weights(args: list[fmpq_mpoly]) -> list[tuple[int, int, int]]:
+    return [_weight(a) for a in args]
+
+
+def _cost(a: int, b: int, bits: int, widest: int) -> int:
+    """The estimated cost of one image of degree a in t and b in the rest, of ``bits``."""
+    return (a + 1) * (2 * b + 1) * (1 + bits // 64) * widest
+
+
+_ONES: dict = {}
+_ABW = fmpq_mpoly_ctx.get(("a", "b", "w"), "lex")
+
+
+def composition_work(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> tuple[int, int, int]:
+    """(the a-priori work of ``p(args)``, the largest degree in the first variable (t)
+    and in the others of an image of a term).  Nothing is composed and no Python loop
+    runs over ``p``'s terms: ``p`` with every coefficient 1 (once per ``p``), composed
+    with xᵢ = aᵈᵗ·bᵈʳ·wᵇⁱᵗˢ, cannot cancel, and counts the terms per (a, b, bits).
+
+    Per term, a reduced trig polynomial of degree a in t and b in (s, c) has at most
+    (a + 1)(2b + 1) terms; the work is that times the 64-bit words of its coefficients
+    (the argument's bits times their exponents, plus ``p``'s largest coefficient) and
+    the terms of the longest argument.  An estimate for cutting and refusing work; no
+    answer's correctness rests on it."""
+    if p.is_zero():
+        return 0, 0, 0
+    ones, top_bits = memo_per_object(_ONES, p, lambda q: (q.context().from_dict(
+        {exps: 1 for exps in q.monoms()}), _bits(q)))
+    degrees = p.degrees()
+    used = [a for a, d in zip(args, degrees, strict=True) if d > 0]
+    widest = max([len(a) for a in used] or [1])
+    a, b, w = _ABW.gens()
+    images = ones.compose(*[a**dt * b**dr * w**bits for dt, dr, bits in _weights(args)],
+                          ctx=_ABW)
+    work = sum(int(n) * _cost(int(e[0]), int(e[1]), int(e[2]) + top_bits, widest)
+               for e, n in zip(images.monoms(), images.coeffs(), strict=True))
+    top = images.degrees()
+    return work, max(0, int(top[0])), max(0, int(top[1]))
+
+
+def term_costs(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> list[int]:
+    """Per term of ``p``, its part of :func:`composition_work` (the coefficient's own
+    bits counted exactly): a Python loop, run only on compositions cut into pieces."""
+    weights = _weights(args)
+    widest = max([len(x) for x, d in zip(args, p.degrees(), strict=True) if d > 0] or [1])
     costs = []
-    top_t = top_rest = 0
     for exps, coeff in zip(p.monoms(), p.coeffs(), strict=True):
-        a = b = words = 0
-        widest = 1
-        for e, dt, dr, bt, n in zip(exps, deg_t, deg_rest, bits, sizes, strict=True):
+        a = b = bits = 0
+        for e, (dt, dr, bt) in zip(exps, weights, strict=True):
             if e:
                 e = int(e)
-                a += e * dt
-                b += e * dr
-                words += e * bt
-                widest = max(widest, n)
-        words = 1 + (words + max(coeff.numer().bit_length(), coeff.denom().bit_length())) // 64
-        costs.append((a + 1) * (2 * b + 1) * words * widest)
-        top_t, top_rest = max(top_t, a), max(top_rest, b)
-    return costs, top_t, top_rest
+                a, b, bits = a + e * dt, b + e * dr, bits + e * bt
+        bits += max(coeff.numer().bit_length(), coeff.denom().bit_length())
+        costs.append(_cost(a, b, bits, widest))
+    return costs
+
+
+def _small(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> bool:
+    """Whether a crude bound (every term costing what the largest exponents together
+    would) already keeps the whole composition within :data:`PIECE_WORK`: a leg's
+    coefficient, a small robot's ξ."""
+    a = b = bits = 0
+    widest = 1
+    for d, x in zip(p.degrees(), args, strict=True):
+        if d > 0:
+            d = int(d)
+            dt, dr, bt = _weight(x)
+            a, b, bits = a + d * dt, b + d * dr, bits + d * bt
+            widest = max(widest, len(x))
+    bits += memo_per_object(_BITS, p, _bits, keep=1024)
+    return len(p) * _cost(a, b, bits, widest) <= PIECE_WORK
 
 
 def compose_in_pieces(p: fmpq_mpoly, args: list[fmpq_mpoly], ring: fmpq_mpoly_ctx,
                       reduce: Callable[[fmpq_mpoly], fmpq_mpoly],
-                      costs: list[int] | None = None) -> fmpq_mpoly:
+                      work: int | None = None) -> fmpq_mpoly:
     """``reduce(p(args))`` in ``ring``, refused or cut into pieces by its estimated
-    cost (``costs``: :func:`term_costs`' first part, when already known)."""
-    if costs is None:
-        costs, deg_t, deg_rest = term_costs(p, args)
+    cost (``work``: :func:`composition_work`'s, when already known)."""
+    if work is None:
+        if _small(p, args):
+            return reduce(p.compose(*args, ctx=ring))
+        work, deg_t, deg_rest = composition_work(p, args)
     else:
         deg_t = deg_rest = -1
-    total = sum(costs)
-    if total > MAX_COMPOSE_WORK:
-        raise CompositionTooCostly(total, deg_t, deg_rest)
-    if total <= PIECE_WORK:
+    if work > MAX_COMPOSE_WORK:
+        raise CompositionTooCostly(work, deg_t, deg_rest)
+    if work <= PIECE_WORK:
         return reduce(p.compose(*args, ctx=ring))
-    items = list(zip(p.monoms(), p.coeffs(), costs, strict=True))
+    items = list(zip(p.monoms(), p.coeffs(), term_costs(p, args), strict=True))
     return _horner(items, 0, p.context(), args, ring, reduce)
 
 
@@ -110,7 +170,8 @@ def _horner(items: list, var: int, source: fmpq_mpoly_ctx, args: list[fmpq_mpoly
     if var == len(args) or sum(cost for *_, cost in items) <= PIECE_WORK:
         lead = (0,) * var
         checkpoint()
-        piece = source.from_dict({lead + tuple(exps[var:]): c for exps, c, _ in items})
+        piece = source.from_dict({lead + tuple(int(e) for e in exps[var:]): c
+                                  for exps, c, _ in items})
         return reduce(piece.compose(*args, ctx=ring))
     groups: dict[int, list] = {}
     for item in items:

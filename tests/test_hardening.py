@@ -5,6 +5,7 @@ extras, undecided boxes."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -373,6 +374,118 @@ def test_a_setsid_grandchild_does_not_outlive_a_finished_cas(tmp_path):
     time.sleep(0.2)
     assert not _alive(cas) and not _alive(grandchild)
     assert list((tmp_path / "tmp").iterdir()) == []
+
+
+# the fake CAS forks a helper in its group and a grandchild that leaves it with setsid,
+# each carrying a marker in its command line, then hangs
+MARKED_CAS = VERSION + """\
+import os, subprocess, sys, time
+marker = os.environ["FAKE_MARKER"]
+sleep = [sys.executable, "-c", "import time; time.sleep(300)", marker]
+subprocess.Popen(sleep)
+setsid = subprocess.Popen(sleep, start_new_session=True)
+with open(os.environ["FAKE_PIDS"], "w") as f:
+    f.write(f"{os.getpid()} {setsid.pid}\\n")
+time.sleep(300)
+"""
+
+# run_program from a worker thread (as a Dask worker or an API user's thread would)
+THREAD_DRIVER = """\
+import sys, threading
+from singcheck.elimination.cas.process import run_program
+worker = threading.Thread(target=run_program, args=(sys.argv[1:], 600))
+worker.start()
+worker.join()
+"""
+
+
+def _marked(marker: str) -> list[int]:
+    """The live processes whose command line holds ``marker`` (scanning /proc)."""
+    out = []
+    for name in os.listdir("/proc"):
+        if name.isdigit() and _alive(int(name)):
+            try:
+                with open(f"/proc/{name}/cmdline", "rb") as f:
+                    if marker.encode() in f.read():
+                        out.append(int(name))
+            except OSError:
+                pass
+    return out
+
+
+@pytest.mark.parametrize("caller", ["cli", "thread"])
+def test_a_sigkilled_singcheck_leaves_no_cas_process(tmp_path, caller):
+    """SIGKILL of singcheck cannot be handled; the guard the kernel signals
+    (PR_SET_PDEATHSIG) kills the CAS, its helper and its setsid'd grandchild."""
+    marker = str(tmp_path)  # in the guard's, the fake's and its children's command lines
+    env = {**_fake_env(tmp_path, hang=True), "FAKE_MARKER": marker}
+    fake_cas(tmp_path, MARKED_CAS)
+    if caller == "cli":
+        argv = [sys.executable, "-m", "singcheck", "run", ORTHO,
+                str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular", "-q"]
+    else:
+        argv = [sys.executable, "-c", THREAD_DRIVER, str(tmp_path / "bin" / "Singular")]
+    proc = subprocess.Popen(argv, env=env, cwd=ROOT, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE)
+    try:
+        pids_file = tmp_path / "pids"
+        deadline = time.monotonic() + 60
+        while not (pids_file.exists() and pids_file.read_text().endswith("\n")):
+            assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
+            time.sleep(0.05)
+        cas, grandchild = map(int, pids_file.read_text().split())
+        deadline = time.monotonic() + 10
+        while len(_marked(marker)) < 4:  # the guard, the fake, its helper, its grandchild
+            assert time.monotonic() < deadline, _marked(marker)
+            time.sleep(0.05)
+        assert os.getsid(grandchild) == grandchild != os.getsid(cas)
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 5
+        while _marked(marker):
+            assert time.monotonic() < deadline, f"survived SIGKILL: {_marked(marker)}"
+            time.sleep(0.05)
+    finally:  # never leave a process behind, even when the test fails
+        proc.kill()
+        proc.wait()
+        for pid in _marked(marker):
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
+
+
+# -- memory: each CAS process runs under an address-space bound ---------------------------
+
+# asks for 8 GiB of address space (malloc, untouched: it costs no memory when granted)
+GREEDY_CAS = VERSION + """\
+import ctypes, sys
+malloc = ctypes.CDLL(None).malloc
+malloc.restype = ctypes.c_void_p
+if not malloc(ctypes.c_size_t(8 << 30)):
+    sys.exit("   ? error: no more memory")  # what Singular prints
+print("granted")
+"""
+
+
+@pytest.mark.parametrize("limit, code, phrase", [
+    ("256M", 4, "Singular ran out of memory under the bound of 256 MiB per CAS process"),
+    ("none", 4, "0 'begin' markers"),  # no bound: granted, then no result
+])
+def test_a_cas_over_its_memory_bound_is_a_one_line_backend_error(tmp_path, limit, code,
+                                                                 phrase):
+    env = {**_fake_env(tmp_path, hang=False), "SINGCHECK_MEMORY_LIMIT": limit}
+    fake_cas(tmp_path, GREEDY_CAS)
+    out = subprocess.run([sys.executable, "-m", "singcheck", "run", ORTHO,
+                          str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular", "-q"],
+                         env=env, cwd=ROOT, capture_output=True, text=True, timeout=120)
+    one_line_error(out.returncode, out.stderr, code, phrase)
+
+
+def test_a_bad_memory_bound_is_a_usage_error(tmp_path):
+    env = {**_fake_env(tmp_path, hang=False), "SINGCHECK_MEMORY_LIMIT": "lots"}
+    out = subprocess.run([sys.executable, "-m", "singcheck", "run", ORTHO,
+                          str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular", "-q"],
+                         env=env, cwd=ROOT, capture_output=True, text=True, timeout=120)
+    one_line_error(out.returncode, out.stderr, 2, "SINGCHECK_MEMORY_LIMIT='lots'")
 
 
 # -- 8. -o targets ------------------------------------------------------------------------

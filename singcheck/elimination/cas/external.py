@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import glob
 import os
+import re
 import shutil
+import signal
 import sys
 import sysconfig
 import tempfile
@@ -19,7 +21,7 @@ from dataclasses import dataclass
 from functools import cache
 from importlib import resources
 
-from singcheck.elimination.cas.process import run_program
+from singcheck.elimination.cas.process import ProgramRun, describe_limit, run_program
 from singcheck.elimination.cas.scripts import macaulay2_script, parse_result, singular_script
 from singcheck.elimination.requests import EliminationRequest, EliminationResult
 from singcheck.errors import BackendError
@@ -123,6 +125,25 @@ def _ask_version(cas: ExternalCAS, executable: str) -> str:
     return first.strip()
 
 
+#: what Singular ("error: no more memory"), Macaulay2 (its GC, pthread_create, abort)
+#: and C++ or GMP allocators print when an allocation fails
+_OUT_OF_MEMORY = re.compile(r"no more memory|out of memory|cannot allocate memory|"
+                            r"bad_alloc|memory exhausted|unable to allocate", re.IGNORECASE)
+
+
+def out_of_memory(run: ProgramRun) -> str:
+    """How a failed run met its address-space bound ("" when it did not seem to): its
+    last 4 KiB of output says an allocation failed, or it died of SIGABRT or SIGKILL,
+    the ways allocators, garbage collectors (and the kernel's OOM killer) end it."""
+    tail = run.stdout[-4096:] + "\n" + run.stderr[-4096:]
+    if _OUT_OF_MEMORY.search(tail):
+        return "ran out of memory"
+    if run.returncode in (-signal.SIGABRT, -signal.SIGKILL):
+        return (f"died of {signal.Signals(-run.returncode).name} (most likely out of "
+                "memory)")
+    return ""
+
+
 class ExternalBackend:
     """An elimination backend that runs a CAS program once per request."""
 
@@ -157,6 +178,13 @@ class ExternalBackend:
             with open(path, "w", encoding="utf-8") as f:
                 f.write(script)
             run = run_program(self.cas.argv(self.executable, path), self.timeout, cwd=tmp)
+        if run.returncode != 0 and run.memory_limit:
+            memory = out_of_memory(run)
+            if memory:
+                raise BackendError(
+                    f"{self.cas.program} {memory} under the bound of "
+                    f"{describe_limit(run.memory_limit)} per CAS process; raise "
+                    "SINGCHECK_MEMORY_LIMIT (or set it to none) if the robot needs more")
         polys = parse_result(self.cas.program, run.stdout, run.stderr, request)
         if run.returncode != 0:
             raise BackendError(f"{self.cas.program} exited with status {run.returncode}")

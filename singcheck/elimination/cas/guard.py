@@ -32,6 +32,8 @@ import os
 import signal
 import sys
 
+#: this file, run as a script by run_program
+SCRIPT = os.path.abspath(__file__)
 PR_SET_PDEATHSIG = 1
 PR_SET_CHILD_SUBREAPER = 36
 #: the exit status and first bytes on stderr of a guard whose CAS could not be started

@@ -36,11 +36,12 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-from singcheck.elimination.cas import guard
 from singcheck.elimination.cas.guard import (
     EXEC_FAILED,
     EXEC_FAILED_MARK,
     PR_SET_CHILD_SUBREAPER,
+    SCRIPT,
+    children,
     prctl,
     reap_children,
 )
@@ -139,7 +140,7 @@ def _guarded(argv: list[str] | tuple[str, ...], limit: int) -> list[str]:
     ``argv`` itself where no interpreter path is known."""
     if not sys.executable:
         return list(argv)
-    return [sys.executable, "-I", "-S", guard.__file__, str(os.getpid()), str(limit), "--",
+    return [sys.executable, "-I", "-S", SCRIPT, str(os.getpid()), str(limit), "--",
             *argv]
 
 
@@ -189,7 +190,7 @@ def run_program(argv: list[str] | tuple[str, ...], timeout: float, *,
     start = time.monotonic()
     name = os.path.basename(argv[0])
     reaper = _become_subreaper()
-    known = guard.children() if reaper else set()
+    known = children() if reaper else set()
     limit = memory_limit()
     with _terminate_as_interrupt(), tempfile.TemporaryFile() as out, \
             tempfile.TemporaryFile() as err:

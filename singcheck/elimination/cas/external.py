@@ -21,12 +21,15 @@ from dataclasses import dataclass
 from functools import cache
 from importlib import resources
 
-from singcheck.elimination.cas.process import ProgramRun, describe_limit, run_program
+from singcheck.elimination.cas.process import (
+    DEFAULT_TIMEOUT,
+    ProgramRun,
+    describe_limit,
+    run_program,
+)
 from singcheck.elimination.cas.scripts import macaulay2_script, parse_result, singular_script
 from singcheck.elimination.requests import EliminationRequest, EliminationResult
 from singcheck.errors import BackendError
-
-DEFAULT_TIMEOUT = 600.0
 
 
 def library_path(filename: str) -> str:

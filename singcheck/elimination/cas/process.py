@@ -47,6 +47,8 @@ from singcheck.elimination.cas.guard import (
 )
 from singcheck.errors import BackendError, SpecError
 
+#: the default wall-clock bound of one elimination (``--timeout``), in seconds
+DEFAULT_TIMEOUT = 600.0
 #: What a program may print on stdout and on stderr (each); beyond it, it is stopped.
 MAX_OUTPUT_BYTES = 64 * 2**20
 

@@ -31,7 +31,6 @@ from singcheck.elimination.cas.polytext import (
     format_polynomial,
     parse_polynomial,
 )
-from singcheck.spaces.cad import cell_index_of, fiber
 
 #: Bump when the decomposition or the joining of regions changes what a number means.
 REGIONS_VERSION = "2"
@@ -53,6 +52,8 @@ class RegionMap:
 
     def region_at(self, point: list[Fraction]) -> int | None:
         """The region of the open cell holding a rational point (None on a root)."""
+        from singcheck.spaces.cad import cell_index_of, fiber  # (not for runs that never ask)
+
         index = cell_index_of(lambda p: fiber(self.levels, self.variables, p), tuple(point))
         return None if index is None else self.numbers.get(index)
 

@@ -42,7 +42,7 @@ def get_backend(name: str = "auto", *, timeout: float | None = None) -> Eliminat
             if _external(candidate).find() is not None:
                 return get_backend(candidate, timeout=timeout)
         return get_backend("sympy", timeout=timeout)
-    from singcheck.elimination.cas.process import DEFAULT_TIMEOUT
+    from singcheck.elimination.cas.external import DEFAULT_TIMEOUT
 
     if name in ("sympy", "flint"):  # in a forked child, with a time and a memory bound
         from singcheck.elimination.cas.isolated import Isolated

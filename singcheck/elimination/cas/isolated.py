@@ -9,7 +9,7 @@ libraries; nothing is re-imported), which sends its pickled result back through 
 (FLINT polynomials cross it through :mod:`singcheck.algebra.pickling`).  The child
 
 * runs under an address-space bound of what the parent had at the fork plus
-  :func:`~singcheck.elimination.cas.process.memory_limit` (``RLIMIT_AS``): past it,
+  :func:`~singcheck.elimination.cas.limits.memory_limit` (``RLIMIT_AS``): past it,
   Python raises ``MemoryError`` or GMP/FLINT abort the child, and singcheck reports a
   backend error (exit 4) in one line;
 * is killed after ``timeout`` seconds (``--timeout``, as for a CAS): ``unknown: time
@@ -29,12 +29,11 @@ import os
 import pickle
 import select
 import signal
-import tempfile
 import time
 
 from singcheck.budget import TimeLimitExceeded
 from singcheck.elimination.cas.guard import PR_SET_PDEATHSIG, prctl
-from singcheck.elimination.cas.process import describe_limit, memory_limit
+from singcheck.elimination.cas.limits import describe_limit, memory_limit
 from singcheck.elimination.requests import EliminationRequest, EliminationResult
 from singcheck.errors import BackendError
 
@@ -92,6 +91,8 @@ def _child(fn, argument, write: int, err: int, parent: int, limit: int) -> None:
 def run_forked(fn, argument, timeout: float, what: str):
     """``fn(argument)`` computed in a forked child, within ``timeout`` seconds and the
     memory bound; its exceptions are re-raised here."""
+    import tempfile
+
     limit = memory_limit()
     read, write = os.pipe()
     parent = os.getpid()

@@ -18,8 +18,9 @@ signals when the thread of singcheck that started it exits (``PR_SET_PDEATHSIG``
 thread is the one waiting here, in the main thread as in a worker thread), and that
 then kills the program, its group and its setsid'd descendants (it is their subreaper
 too).  The guard also bounds the program's address space (``RLIMIT_AS``,
-:func:`memory_limit`), so that a Gröbner basis that blows up ends with an allocation
-failure, reported as a backend error, instead of waking the kernel's OOM killer.
+:func:`~singcheck.elimination.cas.limits.memory_limit`), so that a Gröbner basis that
+blows up ends with an allocation failure, reported as a backend error, instead of
+waking the kernel's OOM killer.
 Building the argv is the callers' job (pure functions in each adapter).
 """
 
@@ -45,10 +46,9 @@ from singcheck.elimination.cas.guard import (
     prctl,
     reap_children,
 )
-from singcheck.errors import BackendError, SpecError
+from singcheck.elimination.cas.limits import memory_limit
+from singcheck.errors import BackendError
 
-#: the default wall-clock bound of one elimination (``--timeout``), in seconds
-DEFAULT_TIMEOUT = 600.0
 #: What a program may print on stdout and on stderr (each); beyond it, it is stopped.
 MAX_OUTPUT_BYTES = 64 * 2**20
 
@@ -99,41 +99,6 @@ def _reap_strays(known: set[int]) -> None:
             return True  # gone already
 
     reap_children(keep)
-
-
-#: the default bound on a CAS process's address space: half the machine's memory, at
-#: least 2 GiB (Macaulay2 alone reserves about 1 GiB of address space to start)
-def default_memory_limit() -> int:
-    try:
-        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (ValueError, OSError, AttributeError):
-        total = 0
-    return max(2 * 2**30, total // 2)
-
-
-_UNITS = {"": 2**20, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
-
-
-def memory_limit() -> int:
-    """The bound on each CAS process's address space, in bytes (0: none): the
-    environment's ``SINGCHECK_MEMORY_LIMIT`` (``4G``, ``512M``, a number of MiB, or
-    ``none``), else :func:`default_memory_limit`."""
-    text = os.environ.get("SINGCHECK_MEMORY_LIMIT", "").strip().upper().removesuffix("B")
-    text = text.removesuffix("I")  # 4GiB, 4GB and 4G alike
-    if not text:
-        return default_memory_limit()
-    if text in ("NONE", "0"):
-        return 0
-    number, unit = (text[:-1], text[-1]) if text[-1] in _UNITS else (text, "")
-    if not number.isdigit() or len(number) > 12 or int(number) == 0:
-        raise SpecError(f"SINGCHECK_MEMORY_LIMIT={os.environ['SINGCHECK_MEMORY_LIMIT']!r}: "
-                        "expected a size such as 4G or 512M (a number alone is MiB), or "
-                        "none")
-    return int(number) * _UNITS[unit]
-
-
-def describe_limit(limit: int) -> str:
-    return f"{limit / 2**30:g} GiB" if limit % 2**30 == 0 else f"{limit // 2**20} MiB"
 
 
 def _guarded(argv: list[str] | tuple[str, ...], limit: int) -> list[str]:

@@ -26,8 +26,6 @@ this process.
 from __future__ import annotations
 
 import os
-import pickle
-import select
 import signal
 import time
 
@@ -49,6 +47,8 @@ def _address_space() -> int:
 
 def _child(fn, argument, write: int, err: int, parent: int, limit: int) -> None:
     """In the forked child: bound, compute, send ``(status, value)`` pickled, exit."""
+    import pickle
+
     try:
         prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
         if os.getppid() != parent:
@@ -91,6 +91,8 @@ def _child(fn, argument, write: int, err: int, parent: int, limit: int) -> None:
 def run_forked(fn, argument, timeout: float, what: str):
     """``fn(argument)`` computed in a forked child, within ``timeout`` seconds and the
     memory bound; its exceptions are re-raised here."""
+    import pickle  # noqa: F401 - loaded once here, not in the child
+    import select
     import tempfile
 
     limit = memory_limit()
@@ -133,6 +135,8 @@ def run_forked(fn, argument, timeout: float, what: str):
 
 
 def _outcome(message: bytes, status: int, said: str, limit: int, what: str):
+    import pickle
+
     bound = f"the bound of {describe_limit(limit)} (SINGCHECK_MEMORY_LIMIT)"
     try:
         kind, value = pickle.loads(message) if message else (None, None)

@@ -647,6 +647,44 @@ def test_in_process_projection_is_bounded_in_time_and_memory(
     assert time.monotonic() - start < 20
 
 
+FORKED_DRIVER = """\
+import os, sys, time
+from singcheck.elimination.cas.isolated import run_forked
+
+def hang(path):
+    with open(path, "w") as f:
+        f.write(f"{os.getpid()}\\n")
+    time.sleep(300)
+
+run_forked(hang, sys.argv[1], 600, "hang")
+"""
+
+
+def test_the_forked_child_dies_with_a_sigkilled_singcheck(tmp_path):
+    pid_file = tmp_path / "pid"
+    proc = subprocess.Popen([sys.executable, "-c", FORKED_DRIVER, str(pid_file)], cwd=ROOT,
+                            env={**os.environ, "PYTHONPATH": str(ROOT)})
+    child = None
+    try:
+        deadline = time.monotonic() + 60
+        while not (pid_file.exists() and pid_file.read_text().endswith("\n")):
+            assert time.monotonic() < deadline and proc.poll() is None
+            time.sleep(0.05)
+        child = int(pid_file.read_text())
+        assert _alive(child)
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 5
+        while _alive(child):
+            assert time.monotonic() < deadline, "the forked child survived SIGKILL"
+            time.sleep(0.05)
+    finally:
+        proc.kill()
+        proc.wait()
+        if child and _alive(child):
+            os.kill(child, signal.SIGKILL)
+
+
 def test_without_a_memory_bound_the_greedy_child_gets_its_memory(monkeypatch):
     """The other side of the test above: the 8 GiB are granted without the bound (so it
     is the bound that refused them), and the child then runs into the time limit."""

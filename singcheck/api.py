@@ -287,11 +287,14 @@ def _worker_signals() -> None:
     worker silently.  So no worker prints a KeyboardInterrupt traceback.  A worker dies
     with the parent's thread that forked it (the main thread: a fork-context pool starts
     every worker at once), even when the parent is SIGKILLed."""
+    import os
     import signal
 
     from singcheck.elimination.cas.guard import PR_SET_PDEATHSIG, prctl
 
     prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+    if os.getppid() != _WORKER.get("parent"):  # the parent died before the request
+        os._exit(1)
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
@@ -354,7 +357,10 @@ def _forked(robot, trajectories, options, jobs: int, ordered: bool) -> Iterator[
     n = len(trajectories)
     size = max(1, min(64, n // (jobs * 16)))
     chunks = [list(range(i, min(n, i + size))) for i in range(0, n, size)]
-    _WORKER.update(robot=robot, trajectories=trajectories, options=options)
+    import os
+
+    _WORKER.update(robot=robot, trajectories=trajectories, options=options,
+                   parent=os.getpid())
     pool = ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
                                initializer=_worker_signals)
     try:

@@ -287,18 +287,13 @@ def _worker_signals() -> None:
     worker silently.  So no worker prints a KeyboardInterrupt traceback.  A worker dies
     with the parent's thread that forked it (the main thread: a fork-context pool starts
     every worker at once), even when the parent is SIGKILLed."""
-    import os
     import signal
 
-    from singcheck.elimination.cas.guard import PR_SET_PDEATHSIG, prctl
+    from singcheck.elimination.cas.guard import die_with_parent
 
-    prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
-    if os.getppid() != _WORKER.get("parent"):  # the parent died before the request
-        os._exit(1)
-
+    die_with_parent(_WORKER["parent"])  # SIGTERM: the default action
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _check_indices(indices: list[int]) -> list[tuple[int, dict]]:

@@ -440,6 +440,15 @@ def _alive(pid: int) -> bool:
         return False
 
 
+def _pids_written(path: Path, proc: subprocess.Popen) -> list[int]:
+    """The pids a fake wrote to ``path`` (one line), waiting for it while ``proc`` runs."""
+    deadline = time.monotonic() + 60
+    while not (path.exists() and path.read_text().endswith("\n")):
+        assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
+        time.sleep(0.05)
+    return [int(pid) for pid in path.read_text().split()]
+
+
 def _fake_env(tmp_path: Path, hang: bool) -> dict:
     bin_dir = fake_cas(tmp_path, SETSID_CAS)
     tmp = tmp_path / "tmp"
@@ -457,12 +466,7 @@ def test_sigterm_and_sighup_kill_the_cas_and_its_setsid_grandchild(tmp_path, sig
                              str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular",
                              "-q"], env=env, cwd=ROOT, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
-    pids_file = tmp_path / "pids"
-    deadline = time.monotonic() + 60
-    while not (pids_file.exists() and pids_file.read_text().endswith("\n")):
-        assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
-        time.sleep(0.05)
-    cas, grandchild = map(int, pids_file.read_text().split())
+    cas, grandchild = _pids_written(tmp_path / "pids", proc)
     assert _alive(cas) and _alive(grandchild)
     assert os.getsid(grandchild) == grandchild != os.getpgid(cas)  # escaped the group
     proc.send_signal(sig)
@@ -538,12 +542,7 @@ def test_a_sigkilled_singcheck_leaves_no_cas_process(tmp_path, caller):
     proc = subprocess.Popen(argv, env=env, cwd=ROOT, stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE)
     try:
-        pids_file = tmp_path / "pids"
-        deadline = time.monotonic() + 60
-        while not (pids_file.exists() and pids_file.read_text().endswith("\n")):
-            assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
-            time.sleep(0.05)
-        cas, grandchild = map(int, pids_file.read_text().split())
+        cas, grandchild = _pids_written(tmp_path / "pids", proc)
         deadline = time.monotonic() + 10
         while len(_marked(marker)) < 4:  # the guard, the fake, its helper, its grandchild
             assert time.monotonic() < deadline, _marked(marker)
@@ -666,11 +665,7 @@ def test_the_forked_child_dies_with_a_sigkilled_singcheck(tmp_path):
                             env={**os.environ, "PYTHONPATH": str(ROOT)})
     child = None
     try:
-        deadline = time.monotonic() + 60
-        while not (pid_file.exists() and pid_file.read_text().endswith("\n")):
-            assert time.monotonic() < deadline and proc.poll() is None
-            time.sleep(0.05)
-        child = int(pid_file.read_text())
+        (child,) = _pids_written(pid_file, proc)
         assert _alive(child)
         proc.kill()
         proc.wait()

@@ -222,3 +222,17 @@ def test_live_script_that_never_ends_is_killed(name, monkeypatch):
     with pytest.raises(BackendTimeout):
         backend.eliminate(XI)
     assert time.monotonic() - start < 15
+
+
+def test_live_singular_over_its_memory_bound_is_a_backend_error(monkeypatch):
+    """A product that needs far more than 200 MiB: Singular's allocator fails under the
+    bound (``error: no more memory``) instead of the kernel's OOM killer stepping in."""
+    backend = _backend("singular")
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "200M")
+    monkeypatch.setattr(backend, "script", lambda request: (
+        "ring r=0,(x,y,z,w,u,v),dp;\npoly p = (x+y+z+w+u+v+1)^60;\np = p*p;\n"))
+    start = time.monotonic()
+    with pytest.raises(BackendError, match="Singular ran out of memory under the bound of "
+                                           "200 MiB"):
+        backend.eliminate(XI)
+    assert time.monotonic() - start < 60

@@ -576,12 +576,35 @@ def _fewer_collections() -> None:
     gc.set_threshold(max(threshold, 50_000), *older)
 
 
+def _exit_quickly(code) -> None:
+    """End the process now with ``code``, skipping the interpreter's teardown (freeing
+    every module and object: several milliseconds of a warm run), when that teardown
+    has nothing else to do: no atexit handler registered (coverage, temporary
+    directories' finalizers, dask, …), no thread or process pool left.  Standard output
+    and error are flushed first; if that fails (a closed pipe), the ordinary exit
+    handles it.  Otherwise it returns and the ordinary exit follows."""
+    import atexit
+
+    threading = sys.modules.get("threading")
+    if not isinstance(code, int) or getattr(atexit, "_ncallbacks", lambda: 1)() or \
+            (threading is not None and threading.active_count() > 1) or \
+            "concurrent.futures" in sys.modules or "multiprocessing" in sys.modules:
+        return
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        return
+    os._exit(code)
+
+
 def main() -> None:
     """Console-script entry point: never lets a traceback reach the user."""
     _fewer_collections()
     _interrupt_on_signals()
     try:
         cli.main(standalone_mode=False)
+        _exit_quickly(0)
     except click.exceptions.Abort:
         fail("interrupted", ExitCode.INTERRUPTED)
     except click.ClickException as e:
@@ -589,7 +612,8 @@ def main() -> None:
         sys.exit(int(ExitCode.USAGE))
     except KeyboardInterrupt:
         fail("interrupted", ExitCode.INTERRUPTED)
-    except SystemExit:
+    except SystemExit as e:
+        _exit_quickly(e.code)
         raise
     except Exception as e:  # a bug: say so in one line, keep the traceback for --debug users
         if os.environ.get("SINGCHECK_DEBUG"):

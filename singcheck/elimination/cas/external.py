@@ -146,6 +146,25 @@ def _ask_version(cas: ExternalCAS, executable: str) -> str:
     return first.strip()
 
 
+def out_of_memory(run) -> str:
+    """How a failed :class:`~singcheck.elimination.cas.process.ProgramRun` met its
+    address-space bound ("" when it did not seem to): its last 4 KiB of output says an
+    allocation failed (Singular: "error: no more memory"; Macaulay2: "out of memory";
+    C++ and GMP allocators alike), or it died of SIGABRT or SIGKILL, the ways
+    allocators, garbage collectors (and the kernel's OOM killer) end it."""
+    import re
+    import signal
+
+    tail = run.stdout[-4096:] + "\n" + run.stderr[-4096:]
+    if re.search(r"no more memory|out of memory|cannot allocate memory|bad_alloc|"
+                 r"memory exhausted|unable to allocate", tail, re.IGNORECASE):
+        return "ran out of memory"
+    if run.returncode in (-signal.SIGABRT, -signal.SIGKILL):
+        return (f"died of {signal.Signals(-run.returncode).name} (most likely out of "
+                "memory)")
+    return ""
+
+
 class ExternalBackend:
     """An elimination backend that runs a CAS program once per request."""
 
@@ -175,6 +194,7 @@ class ExternalBackend:
     def eliminate(self, request: EliminationRequest) -> EliminationResult:
         import tempfile
 
+        from singcheck.elimination.cas.limits import describe_limit
         from singcheck.elimination.cas.process import run_program
 
         script = self.script(request)
@@ -184,6 +204,13 @@ class ExternalBackend:
             with open(path, "w", encoding="utf-8") as f:
                 f.write(script)
             run = run_program(self.cas.argv(self.executable, path), self.timeout, cwd=tmp)
+        if run.returncode != 0 and run.memory_limit:
+            memory = out_of_memory(run)
+            if memory:
+                raise BackendError(
+                    f"{self.cas.program} {memory} under the bound of "
+                    f"{describe_limit(run.memory_limit)} per CAS process; raise "
+                    "SINGCHECK_MEMORY_LIMIT (or set it to none) if the robot needs more")
         polys = parse_result(self.cas.program, run.stdout, run.stderr, request)
         if run.returncode != 0:
             raise BackendError(f"{self.cas.program} exited with status {run.returncode}")

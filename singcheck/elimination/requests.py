@@ -16,6 +16,7 @@ from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import coefficient_in, squarefree_part
 from singcheck.algebra.radicals import radical_prime
+from singcheck.budget import checkpoint
 
 
 @dataclass(frozen=True)
@@ -114,7 +115,7 @@ def _constant_lead(f: fmpq_mpoly, names, v: str) -> bool:
     return all(sum(e) == d for e, _ in f.terms() if e[i] == d)
 
 
-def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
+def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly, reduce=None) -> fmpq_mpoly:
     """The norm of ``g`` over the two points of ``f = a·c + b·s + d = 0`` on the circle
     ``c² + s² = 1``, free of c and s.
 
@@ -124,7 +125,10 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
     the product over both branches is ``G₀² - Δ·G₁²``.  Where W ≠ 0 it vanishes exactly
     when g vanishes at one of the two (complex) points; on W = 0 (the leg does not
     depend on its angle) it may vanish too: the degenerate set, handled by the caller.
+    ``reduce`` (optional) is applied to every product, as in :func:`norm_chain`; a
+    :func:`~singcheck.budget.checkpoint` is reached before each.
     """
+    reduce = reduce or (lambda p: p)
     ctx = g.context()
     names = ctx.names()
     ci, si = names.index(c), names.index(s)
@@ -136,7 +140,9 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
     delta = w - d * d
 
     def mul(x, y):
-        return x[0] * y[0] + delta * x[1] * y[1], x[0] * y[1] + x[1] * y[0]
+        checkpoint()
+        return (reduce(x[0] * y[0] + reduce(delta * x[1]) * y[1]),
+                reduce(x[0] * y[1] + x[1] * y[0]))
 
     groups: dict[tuple[int, int], dict] = {}
     for exps, coeff in g.terms():
@@ -146,17 +152,20 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
         groups.setdefault(key, {})[tuple(e)] = coeff
     k = max(i + j for i, j in groups)
     cpow, spow, wpow = [(one, zero)], [(one, zero)], [one]
+    p, q = reduce(-a * d), reduce(-b * d)
     for _ in range(k):
-        cpow.append(mul(cpow[-1], (-a * d, b)))
-        spow.append(mul(spow[-1], (-b * d, -a)))
-        wpow.append(wpow[-1] * w)
+        cpow.append(mul(cpow[-1], (p, b)))
+        spow.append(mul(spow[-1], (q, -a)))
+        wpow.append(reduce(wpow[-1] * w))
     g0, g1 = zero, zero
     for (i, j), terms in groups.items():
-        coefficient = ctx.from_dict(terms) * wpow[k - i - j]
+        coefficient = reduce(ctx.from_dict(terms) * wpow[k - i - j])
         x = mul(cpow[i], spow[j])
-        g0 += coefficient * x[0]
-        g1 += coefficient * x[1]
-    return g0 * g0 - delta * g1 * g1
+        checkpoint()
+        g0 += reduce(coefficient * x[0])
+        g1 += reduce(coefficient * x[1])
+    checkpoint()
+    return reduce(g0 * g0) - reduce(delta * reduce(g1 * g1))
 
 
 def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
@@ -182,7 +191,8 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
             variables = v if isinstance(v, tuple) else (v,)
             if all(acc.degrees()[names.index(x)] <= 0 for x in variables):
                 continue  # a leg that does not touch this factor only raises its power
-            acc = revolute_norm(acc, v[0], v[1], f) if isinstance(v, tuple) else \
+            checkpoint()
+            acc = revolute_norm(acc, v[0], v[1], f, reduce) if isinstance(v, tuple) else \
                 acc.resultant(f, v)
             acc = squarefree_part(reduce(acc) if reduce else acc)
         total *= acc

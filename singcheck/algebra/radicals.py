@@ -303,6 +303,20 @@ def reduce_relations(p: fmpq_mpoly) -> fmpq_mpoly:
     return out
 
 
+def modulo_circles(p: fmpq_mpoly) -> fmpq_mpoly:
+    """``p`` modulo ``cos(v)² + sin(v)² - 1`` of each angle pair of its ring: the same
+    function wherever the angles are real, often with far fewer terms.  FLINT's division
+    with remainder, one circle after the other (their leading monomials are coprime, so
+    they form a Gröbner basis and an earlier reduction is not undone): a representative
+    of degree ≤ 1 in the leading variable of each circle in the ring's order, not
+    necessarily :func:`reduce_relations`'s (which works term by term in Python)."""
+    gens = p.context().gens()
+    for c, s in angle_variables(p.context()):
+        if p.degrees()[c] >= 2 or p.degrees()[s] >= 2:
+            p = divmod(p, gens[c] ** 2 + gens[s] ** 2 - 1)[1]
+    return p
+
+
 def norm_radicals(p: fmpq_mpoly) -> fmpq_mpoly:
     """∏ of ``p`` over both signs of every ``sqrt(q)`` it involves (resultants with
     ``sqrt(q)² - q``), reduced: a polynomial free of radicals whose zero set is the
@@ -375,18 +389,13 @@ def path_ring(primes, functions=()) -> fmpq_mpoly_ctx:
 
 
 def into_ring(p: fmpq_mpoly, ring: fmpq_mpoly_ctx) -> fmpq_mpoly:
-    """``p`` in a ring that has all of its variables (matched by name)."""
+    """``p`` in a ring that has all of its variables (matched by name; moved by FLINT)."""
     if p.context() is ring:
         return p
-    names = ring.names()
-    where = [names.index(v) for v in p.context().names()]
-    out = {}
-    for exps, coeff in p.terms():
-        e = [0] * ring.nvars()
-        for i, k in zip(where, exps, strict=True):
-            e[i] = k
-        out[tuple(e)] = coeff
-    return ring.from_dict(out)
+    missing = set(p.context().names()) - set(ring.names())
+    if missing:
+        raise ValueError(f"{', '.join(sorted(missing))} not in the ring")
+    return p.project_to_context(ring)
 
 
 _PARTS: dict[int, tuple[fmpq_mpoly, list]] = {}

@@ -107,10 +107,13 @@ def mu_size_bound(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...],
     names = xi.context().names()
     dt = [phi[pose.index(v)].degrees()[0] if v in pose else 0 for v in names]
     dsc = [sum(phi[pose.index(v)].degrees()[1:]) if v in pose else 0 for v in names]
-    deg_t = deg_sc = 0
-    for exps, _ in xi.terms():
-        deg_t = max(deg_t, sum(e * d for e, d in zip(exps, dt, strict=True)))
-        deg_sc = max(deg_sc, sum(e * d for e, d in zip(exps, dsc, strict=True)))
+    monoms = xi.monoms()
+
+    def weighted_degree(weights: list[int]) -> int:
+        used = [(i, w) for i, w in enumerate(weights) if w > 0]
+        return max((sum(m[i] * w for i, w in used) for m in monoms), default=0)
+
+    deg_t, deg_sc = weighted_degree(dt), weighted_degree(dsc)
     return deg_t, deg_sc, (deg_t + 1) * (2 * deg_sc + 1)
 
 
@@ -504,8 +507,9 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
     coordinates = tuple(coordinates)
     pose_vars = model.pose_variables
     if projection.expanded:
-        _refuse_costly(projection.singularity_surface, coordinates, pose_vars, trajectory)
-        mu = compose_pose(projection.singularity_surface, coordinates, pose_vars)
+        xi = projection.surface_on_circles  # μ is the same: φ's (cos, sin) are on circles
+        _refuse_costly(xi, coordinates, pose_vars, trajectory)
+        mu = compose_pose(xi, coordinates, pose_vars)
     else:
         mu = eliminate_along_path(model, coordinates, where)
     legs = []

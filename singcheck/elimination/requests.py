@@ -177,13 +177,15 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
     _, factors = g.factor()
     total = g.context().from_dict({(0,) * g.context().nvars(): 1})
     for factor, _mult in factors:
-        acc = factor
+        acc, reduced = factor, False
         for v, f in legs:
             variables = v if isinstance(v, tuple) else (v,)
             if all(acc.degrees()[names.index(x)] <= 0 for x in variables):
                 continue  # a leg that does not touch this factor only raises its power
             acc = revolute_norm(acc, v[0], v[1], f) if isinstance(v, tuple) else \
                 acc.resultant(f, v)
-            acc = squarefree_part(reduce(acc) if reduce else acc)
+            acc, reduced = squarefree_part(reduce(acc) if reduce else acc), True
+        if len(factors) == 1 and reduced:
+            return acc  # squarefree and monic already: the one factor's norm
         total *= acc
     return squarefree_part(total)

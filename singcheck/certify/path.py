@@ -437,23 +437,18 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
 
 
 def _on_circle(p: fmpq_mpoly) -> fmpq_mpoly:
-    """``p`` (in a ring with the path's s = sin t, c = cos t) with s² replaced by 1 - c²:
-    degree ≤ 1 in s, the same function of t.  Keeps path-wise norms small."""
+    """``p`` (in a ring with the path's s = sin t, c = cos t, s before c) with s² replaced
+    by 1 - c²: degree ≤ 1 in s, the same function of t.  Keeps path-wise norms small.
+    FLINT's remainder modulo s² + c² - 1 (s² is its leading monomial), in C."""
     ctx = p.context()
     names = ctx.names()
-    si = names.index("s")
+    si, ci = names.index("s"), names.index("c")
     if p.degrees()[si] < 2:
         return p
-    one_minus_c2 = 1 - ctx.gens()[names.index("c")] ** 2
-    groups: dict[int, dict] = {}
-    for exps, coeff in p.terms():
-        e = list(exps)
-        half, e[si] = divmod(e[si], 2)
-        groups.setdefault(half, {})[tuple(e)] = coeff
-    out = ctx.from_dict({})
-    for half, terms in groups.items():
-        out += ctx.from_dict(terms) * one_minus_c2 ** half
-    return out
+    if ci < si:
+        raise ValueError("the ring must order s before c")
+    s, c = ctx.gens()[si], ctx.gens()[ci]
+    return divmod(p, s * s + c * c - 1)[1]
 
 
 _LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}

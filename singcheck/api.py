@@ -284,8 +284,14 @@ _WORKER: dict = {}
 def _worker_signals() -> None:
     """In a forked worker: Ctrl-C and a hangup reach the whole process group, but it is
     the parent that stops the batch (and then terminates the workers); SIGTERM ends a
-    worker silently.  So no worker prints a KeyboardInterrupt traceback."""
+    worker silently.  So no worker prints a KeyboardInterrupt traceback.  A worker dies
+    with the parent's thread that forked it (the main thread: a fork-context pool starts
+    every worker at once), even when the parent is SIGKILLed."""
     import signal
+
+    from singcheck.elimination.cas.guard import PR_SET_PDEATHSIG, prctl
+
+    prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)

@@ -261,6 +261,31 @@ def surd_polynomial(value: Surd, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
     return out
 
 
+def constant_surd(p: fmpq_mpoly) -> Surd | None:
+    """The exact number a polynomial in the ``sqrt(q)`` variables alone stands for (its
+    terms Σ c·√q₁·…·√qₖ summed in the multiquadratic field), or None when it involves any
+    other variable.  Inverse of :func:`surd_polynomial`.
+
+    >>> ctx = fmpq_mpoly_ctx.get(("x", "sqrt(2)", "sqrt(3)"), "lex")
+    >>> _, r2, r3 = ctx.gens()
+    >>> str(constant_surd(r2 * r3 / 2 + r3 ** 2))
+    '3 + 1/2*sqrt(6)'
+    >>> constant_surd(ctx.gens()[0] + r2) is None
+    True
+    """
+    primes = {i: q for i, q in radical_variables(p.context())}
+    total = Surd()
+    for exps, coeff in p.terms():
+        if any(e and i not in primes for i, e in enumerate(exps)):
+            return None
+        term = Surd.rational(Fraction(int(coeff.p), int(coeff.q)))
+        for i, e in enumerate(exps):
+            if e:
+                term = term * Surd.sqrt(Fraction(primes[i])) ** e
+        total = total + term
+    return total
+
+
 def radical_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
     """[(index, p)] for every ``sqrt(p)`` variable of ``ctx``."""
     out = []

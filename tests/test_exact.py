@@ -342,3 +342,192 @@ def test_exact_decisions_with_a_square_root_in_the_robot_agree_with_50_digits():
             eps = mpmath.mpf("1e-7")
             crosses = det_a(t - eps, m.mode) * det_a(t + eps, m.mode) < 0
             assert det_a_vanishes_at(path, point, m.mode) == crosses, (float(t), m.mode)
+
+
+# -- revolute legs: the 5-bar and the rotary Delta ----------------------------------------
+
+
+def _bundled(robot: str):
+    from pathlib import Path
+
+    from singcheck.spec.files import load_robot
+
+    root = Path(__file__).resolve().parent.parent
+    if robot not in _PROJECTIONS:
+        model = build_model(load_robot(root / f"robots/{robot}.yaml"))
+        _PROJECTIONS[robot] = project_robot(model, get_backend("flint"))
+    return _PROJECTIONS[robot]
+
+
+def _revolute_path(robot: str, text: str):
+    projection = _bundled(robot)
+    return build_path(projection, parse_trajectory(text, "t.yaml", projection.model.spec))
+
+
+def _oracle_modes(path, oracle, pose_at, t0) -> dict[str, tuple[int, ...]]:
+    """Our mode label → the oracle's branch indices, matched by the joint angles at the
+    rational time t0 (the oracle's IK is its own closed form, at 50 digits)."""
+    from flint import arb
+
+    ours = [leg.branches(arb(float(t0))) for leg in path.legs]
+    theirs = [leg.branches(pose_at(mpmath.mpf(t0.numerator) / t0.denominator))
+              for leg in oracle.legs]
+    out = {}
+    for label in ("".join(s) for s in product("+-", repeat=len(path.legs))):
+        indices = []
+        for sign, branch, both in zip(label, ours, theirs, strict=True):
+            c, s = branch[sign]
+            angle = mpmath.atan2(float(s.mid()), float(c.mid()))
+            [k] = [k for k in (0, 1) if abs(mpmath.sin((angle - both[k]) / 2)) < 1e-6]
+            indices.append(k)
+        out[label] = tuple(indices)
+    return out
+
+
+def _revolute_zero_modes(oracle, modes, pose, tiny="1e-30", big="1e-8") -> set[str]:
+    """The modes whose 50-digit det A is 0 at the pose (each value must be clearly 0 or
+    clearly not)."""
+    out = set()
+    for label, indices in modes.items():
+        joints = oracle.joints(indices, pose)
+        value = abs(oracle.det_A(joints, pose))
+        assert value < mpmath.mpf(tiny) or value > mpmath.mpf(big), (label, value)
+        if value < mpmath.mpf(tiny):
+            out.add(label)
+    return out
+
+
+FIVE_BAR_TOUCH = trajectory("3/2", "2", x="t*t - 3", y="sqrt(3)")
+
+
+def test_five_bar_line_tangent_where_the_distal_links_align_is_singular_at_sqrt_3():
+    from tests.robot_oracles import five_bar
+
+    # y = √3 is tangent to the elbows-out singular curve at (0, √3) (it is symmetric in
+    # x); x = t² - 3 reaches x = 0 at the quadratic irrational t = √3
+    path = _revolute_path("five-bar", FIVE_BAR_TOUCH)
+    report = certify_path(path)
+    mpmath.mp.dps = 50
+    oracle = five_bar()
+
+    def pose_at(t):
+        return [t * t - 3, mpmath.sqrt(3)]
+
+    modes = _oracle_modes(path, oracle, pose_at, Fraction(7, 4))
+    t0 = mpmath.sqrt(3)
+    expected = _revolute_zero_modes(oracle, modes, pose_at(t0))
+    assert expected == {"+-"}
+    indices = modes["+-"]
+
+    def det(t):
+        return oracle.det_A(oracle.joints(indices, pose_at(t)), pose_at(t))
+
+    eps = mpmath.mpf("1e-4")
+    assert det(t0 - eps) * det(t0 + eps) > 0  # a tangency: no sign change
+    assert report.verdict == "singular"
+    [candidate] = report.candidates
+    assert candidate.t.contains(float(t0)) or abs(float(candidate.t.mid()) - float(t0)) < 1e-9
+    assert set(candidate.singular_modes) == expected
+    assert all(m.status != "unknown" for m in candidate.modes)
+
+
+def _mp(q: str):
+    return mpmath.mpf(Fraction(q).numerator) / Fraction(q).denominator
+
+
+@pytest.mark.parametrize("robot, text, oracle_name, pose_at", [
+    ("five-bar", FIVE_BAR_TOUCH, "five_bar", lambda t: [t * t - 3, mpmath.sqrt(3)]),
+    ("five-bar", "trajectories/five-bar-cross.yaml", "five_bar", lambda t: [0, 3 - 2 * t]),
+    ("rotary-delta", "trajectories/rotary-delta-cross.yaml", "rotary_delta",
+     lambda t: [_mp("7/4") + _mp("3/10") * t, 0, -1]),
+])
+def test_exact_decisions_on_revolute_legs_agree_with_50_digits(robot, text, oracle_name,
+                                                               pose_at):
+    from pathlib import Path
+
+    from singcheck.certify.exact import AlgebraicPoint, det_a_vanishes_at
+    from tests import robot_oracles
+
+    if text.startswith("trajectories/"):
+        text = (Path(__file__).resolve().parent.parent / text).read_text()
+    path = _revolute_path(robot, text)
+    report = certify_path(path)
+    mpmath.mp.dps = 50
+    oracle = getattr(robot_oracles, oracle_name)()
+    start = path.trajectory.range.start.rational
+    end = path.trajectory.range.end.rational
+    modes = _oracle_modes(path, oracle, pose_at, (start + end) / 2 + Fraction(1, 97))
+    assert report.candidates
+    for c in report.candidates:
+        point = AlgebraicPoint(c.root.exact)
+        t = mpmath.mpf(c.root.refined(1e-45).t.mid().str(60, radius=False))
+        # every mode whose IK is real at the root, decided by the oracle at 50 digits
+        real = {m: i for m, i in modes.items() if oracle.joints(i, pose_at(t)) is not None}
+        expected = _revolute_zero_modes(oracle, real, pose_at(t), tiny="1e-25")
+        assert expected
+        for label in real:
+            assert det_a_vanishes_at(path, point, label) == (label in expected), label
+
+
+def _five_bar_pose_zero_modes(pose_at, text, robot="five-bar", samples=(Fraction(1, 3),)):
+    """The modes whose 50-digit det A (the oracle's) is 0 at every sample time."""
+    from tests.robot_oracles import five_bar
+
+    mpmath.mp.dps = 50
+    oracle = five_bar()
+    path = _revolute_path(robot, text)
+    modes = _oracle_modes(path, oracle, pose_at, samples[0])
+    zero = None
+    for q in samples:
+        t = mpmath.mpf(q.numerator) / q.denominator
+        found = _revolute_zero_modes(oracle, modes, pose_at(t))
+        zero = found if zero is None else zero & found
+    return path, zero
+
+
+def test_five_bar_resting_where_the_distal_links_align_is_singular_all_along():
+    text = trajectory("0", "1", x="0", y="sqrt(3)")
+    path, expected = _five_bar_pose_zero_modes(lambda t: [0, mpmath.sqrt(3)], text)
+    assert expected == {"+-"}
+    report = certify_path(path)
+    assert report.verdict == "singular" and "whole path" in report.reason
+    assert [m.label for m in report.modes if m.feasible] == ["+-"]
+    assert {m for c in report.candidates for m in c.singular_modes} == expected
+
+
+def test_five_bar_on_the_surface_of_an_infeasible_mode_only_is_free():
+    # (0, 2 - √3) is 2 away from the shared elbow (0, -√3): the mode with both elbows
+    # there (th1 = -π/3, outside the limits) is singular, the elbows-out mode is not
+    text = trajectory("0", "1", x="0", y="2 - sqrt(3)")
+    path, zero = _five_bar_pose_zero_modes(lambda t: [0, 2 - mpmath.sqrt(3)], text)
+    assert len(zero) == 1 and "+-" not in zero
+    report = certify_path(path)
+    assert [m.label for m in report.modes if m.feasible] == ["+-"]
+    assert report.verdict == "singularity-free"
+    assert "lies on ξ(X) = 0" in report.reason
+
+
+def test_five_bar_arc_around_the_shared_elbow_is_singular_all_along_without_limits():
+    # P = (0, -√3) + 2(cos t, sin t): both elbows can sit at (0, -√3), 2 from each base
+    from pathlib import Path
+
+    robot = "five-bar-nolimits"
+    if robot not in _PROJECTIONS:
+        root = Path(__file__).resolve().parent.parent
+        text = (root / "robots/five-bar.yaml").read_text().replace(
+            "joint_limits: {th1: [pi/3, pi], th2: [0, 2*pi/3]}\n", "")
+        spec = parse_robot(text, "r.yaml")
+        _PROJECTIONS[robot] = project_robot(build_model(spec), get_backend("flint"))
+    text = trajectory("1/4", "1", x="2*cos(t)", y="-sqrt(3) + 2*sin(t)")
+
+    def pose_at(t):
+        return [2 * mpmath.cos(t), -mpmath.sqrt(3) + 2 * mpmath.sin(t)]
+
+    samples = [Fraction(1, 4) + Fraction(3, 4) * Fraction(k, 8) for k in range(1, 8)]
+    path, expected = _five_bar_pose_zero_modes(pose_at, text, robot, samples)
+    assert len(expected) == 1
+    report = certify_path(path)
+    assert report.verdict == "singular" and "whole path" in report.reason
+    singular = {m for c in report.candidates for m in c.singular_modes}
+    assert singular == expected
+    assert all(m.status != "unknown" for c in report.candidates for m in c.modes)

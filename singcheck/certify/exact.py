@@ -62,9 +62,9 @@ _MAX_BITS = 1 << 16
 
 
 class NotExact(Exception):
-    """The exact step does not apply (a path mixing t with sin t at a time other than a
-    multiple of π, which is transcendental; revolute legs), or ball arithmetic could not
-    separate a mode from its conjugate within the precision cap."""
+    """The exact step does not apply (e.g. a path whose angle is not k·t + qπ, a revolute
+    leg with W = 0 at the root), or ball arithmetic could not separate a mode from its
+    conjugate within the precision cap."""
 
 
 # ---------------------------------------------------------------------------------
@@ -110,8 +110,6 @@ class ModeExpression:
 
     def __init__(self, path: PathModel) -> None:
         model = path.projection.model
-        if any(leg.revolute for leg in path.legs):
-            raise NotExact("exact decisions are not implemented for revolute legs yet")
         ring_in = path.coordinates[0].context() if path.coordinates else TRIG
         path_names = ring_in.names()
         primes = [radical_prime(v) for v in path_names[3:]]
@@ -133,15 +131,23 @@ class ModeExpression:
 
         gens = dict(zip(names, ring.gens(), strict=True))
         r = ring.gens()[len(path_names):]
-        joints = []
+        images: dict[str, fmpq_mpoly] = {}
+        revolute: list[tuple[str, str, fmpq_mpoly]] = []  # (cos θ, sin θ, W) per leg
         for i, leg in enumerate(path.legs):
-            if leg.leg.degree == 2:
+            if leg.revolute:
+                # W·(cos θ, sin θ) = (-a·d + σ·b·√Δ, -b·d - σ·a·√Δ) (W = a² + b²)
+                a, b, d = (lift(x) for x in leg.coefficients)
+                root = r[quadratic.index(i)]
+                cos_v, sin_v = leg.leg.variables
+                images[cos_v], images[sin_v] = -a * d + root * b, -b * d - root * a
+                revolute.append((cos_v, sin_v, a * a + b * b))
+            elif leg.leg.degree == 2:
                 a, b, _ = leg.coefficients
-                joints.append((r[quadratic.index(i)] - lift(b)) / (2 * constant_value(a)))
+                images[leg.leg.joint] = (r[quadratic.index(i)] - lift(b)) / \
+                    (2 * constant_value(a))
             else:
                 b, c = leg.coefficients
-                joints.append(-lift(c) / constant_value(b))
-        images = dict(zip((leg.leg.joint for leg in path.legs), joints, strict=True))
+                images[leg.leg.joint] = -lift(c) / constant_value(b)
         images.update(zip(model.pose_variables, (lift(x) for x in path.coordinates),
                           strict=True))
         images.update({v: gens[v] for v in path_names[3:]})
@@ -149,13 +155,22 @@ class ModeExpression:
         if any(v not in images for v in det_names):
             raise NotExact("det A involves variables other than the joints, the pose and "
                            "square roots of the path's ring")
-        full = model.det_A.compose(*(images[v] for v in det_names), ctx=ring)
         self.fixed = len(primes)
         self.legs = quadratic
         self.D: list[dict] = [{0: TRIG.from_dict({(0, 0, 0): p})} for p in primes]
         for i in quadratic:
             self.D.append(self._split(lift(path.legs[i].discriminant)))
+        args = [images[v] for v in det_names]
+        full = ring.from_dict({})
+        for deficit, part in _by_angle_degree(model.det_A, revolute).items():
+            checkpoint()
+            term = part.compose(*args, ctx=ring)
+            for (_, _, w), k in zip(revolute, deficit, strict=True):
+                term = term * w ** k
+            full += term
         self.terms = self._split(full)
+        #: W of each revolute leg: det A along a mode is E / ∏ W^e, valid where W ≠ 0
+        self.W = [self._split(w) for _, _, w in revolute]
 
     def _split(self, p: fmpq_mpoly) -> dict:
         """A polynomial in t, s, c and the levels as a multilinear element (reduced with
@@ -181,6 +196,20 @@ class ModeExpression:
     def signs(self, label: str) -> list[int]:
         """σ per level for a working mode label: + for every √p, then the mode's signs."""
         return [1] * self.fixed + [1 if label[i] == "+" else -1 for i in self.legs]
+
+
+def _by_angle_degree(det_a: fmpq_mpoly, revolute: list) -> dict:
+    """det A's terms grouped by how far each is below its revolute joint's top degree
+    e in (cos θ, sin θ): a group with deficits k, composed with W·(cos θ, sin θ) and
+    multiplied by ∏ W^k, adds up to ∏ W^e · det A (a polynomial: no division by W)."""
+    names = det_a.context().names()
+    pairs = [(names.index(c), names.index(s)) for c, s, _ in revolute]
+    top = [max((e[i] + e[j] for e, _ in det_a.terms()), default=0) for i, j in pairs]
+    groups: dict[tuple[int, ...], dict] = {}
+    for exps, coeff in det_a.terms():
+        deficit = tuple(m - exps[i] - exps[j] for m, (i, j) in zip(top, pairs, strict=True))
+        groups.setdefault(deficit, {})[exps] = coeff
+    return {k: det_a.context().from_dict(v) for k, v in groups.items()}
 
 
 _EXPRESSIONS: dict[int, tuple[PathModel, ModeExpression]] = {}
@@ -318,6 +347,9 @@ class _Tower:
         self.D_zero: list[bool] = []
         for q, d in enumerate(self.D):  # level by level: each test uses the levels below
             self.D_zero.append(self.reduce(d, q) is None)
+        if any(self.reduce(self._of(w)) is None for w in expr.W):
+            raise NotExact("a revolute leg does not depend on its joint there (W = a² + b² "
+                           "= 0): its branches are not defined")
 
     def _of(self, element: dict) -> dict:
         out = {m: self.base.of(v) for m, v in element.items()}

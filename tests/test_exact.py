@@ -531,3 +531,111 @@ def test_five_bar_arc_around_the_shared_elbow_is_singular_all_along_without_limi
     singular = {m for c in report.candidates for m in c.singular_modes}
     assert singular == expected
     assert all(m.status != "unknown" for c in report.candidates for m in c.modes)
+
+
+# -- touches at transcendental times (paths mixing t with sin t, cos t) ---------------------
+
+
+def _orthoglide_scale_touch(lower: str, start: str, end: str, h: str, h_mp):
+    """X(t) = (1 - h(t)²/4)·X0: |X| ≤ 2, = 2 exactly where h = 0 (a tangency to the
+    sphere from inside, in the four modes whose branches meet ρ = 0 there)."""
+    report = certify(orthoglide(lower), trajectory(start, end, **along(X0_TEXT,
+                                                                     f"1 - ({h})^2/4")))
+    mpmath.mp.dps = 50
+    tau = mpmath.findroot(h_mp, float((Fraction(start) + Fraction(end)) / 2))
+
+    def det_a(t, label):  # 50 digits: ρᵢ = xᵢ ± √(4 - |X|² + xᵢ²)
+        scale = 1 - h_mp(t) ** 2 / 4
+        pose = [scale * (mpmath.mpf(x.numerator) / x.denominator) for x in X0]
+        r2 = sum(x * x for x in pose)
+        joints = [x + (1 if s == "+" else -1) * mpmath.sqrt(4 - r2 + x * x)
+                  for x, s in zip(pose, label, strict=True)]
+        return orthoglide_det_a(pose, joints)
+
+    return report, tau, det_a
+
+
+@pytest.mark.parametrize("h, h_mp, start, end", [
+    # μ has the factor (t - cos t)²: τ is the Dottie number, cos τ = τ
+    ("t - cos(t)", lambda t: t - mpmath.cos(t), "1/2", "1"),
+    # (t - sin t - 1/2)² is a square only on the circle: reduced modulo s² + c² = 1 it
+    # is t² - 2ts - t + 1/4 + ... - c², irreducible in Q[t, s, c]
+    ("t - sin(t) - 1/2", lambda t: t - mpmath.sin(t) - mpmath.mpf(1) / 2, "1", "2"),
+])
+def test_orthoglide_touching_the_sphere_at_a_transcendental_time_is_singular(h, h_mp, start,
+                                                                            end):
+    began = time.process_time()
+    report, tau, det_a = _orthoglide_scale_touch("-1", start, end, h, h_mp)
+    assert time.process_time() - began < 10
+    expected = modes_singular_on_sphere(X0)  # the pose at τ is X0 exactly
+    for label in expected:  # a tangency: det A ≠ 0 on either side, no sign change
+        eps = mpmath.mpf("1e-3")
+        assert det_a(tau - eps, label) * det_a(tau + eps, label) > 0
+        assert abs(det_a(tau, label)) < mpmath.mpf("1e-40")
+    assert report.root_method == "interval branch-and-bound"
+    assert report.verdict == "singular" and not report.undecided
+    [candidate] = report.candidates
+    assert abs(float(candidate.t.mid()) - float(tau)) < 1e-9 and candidate.t.rad() < 1e-9
+    assert set(candidate.singular_modes) == expected
+    proofs = {m.mode: m.proof for m in candidate.modes}
+    assert {proofs[m] for m in expected} == {"det A = 0 exactly (at a transcendental time)"}
+    assert all(m.status != "unknown" for m in candidate.modes)
+
+
+def test_the_transcendental_touch_is_free_when_limits_exclude_the_singular_modes():
+    report, tau, det_a = _orthoglide_scale_touch("1/10", "1", "2", "t - sin(t) - 1/2",
+                                                 lambda t: t - mpmath.sin(t) - mpmath.mpf(1) / 2)
+    assert abs(det_a(tau, "+++")) > 1  # the feasible mode (ρ = 2X at τ) is regular
+    assert [m.label for m in report.modes if m.feasible] == ["+++"]
+    assert report.verdict == "singularity-free" and not report.undecided
+
+
+def test_zero_tests_at_a_transcendental_root_agree_with_50_digits():
+    from flint import fmpq
+
+    from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig
+    from singcheck.roots.branch_bound import branch_and_bound
+    from singcheck.roots.transcendental import TranscendentalPoint
+
+    t, s, c = TRIG.gens()
+    half = TRIG.from_dict({(0, 0, 0): fmpq(1, 2)})
+    h = t - s - half  # τ - sin τ = 1/2, τ ≈ 1.4973
+    interval = TimeRange(LinearInPi(Fraction(1)), LinearInPi(Fraction(2)))
+    [root] = branch_and_bound(h, interval, 1e-9).roots
+    point = TranscendentalPoint(root.exact)
+    mpmath.mp.dps = 50
+    tau = mpmath.findroot(lambda u: u - mpmath.sin(u) - mpmath.mpf(1) / 2, 1.5)
+
+    def value(p):
+        return sum(mpmath.mpf(int(k.p)) / int(k.q) * tau ** int(i) * mpmath.sin(tau) ** int(j)
+                   * mpmath.cos(tau) ** int(m) for (i, j, m), k in p.terms())
+
+    zeros = [h, h * (t + c), s * s + c * c - 1 + h * s, (t - half) ** 2 - (1 - c * c)]
+    nonzeros = [t + s - half, t - c, (t + s - half) * (t - c), s, c - t * s]
+    for element, zero in [(e, True) for e in zeros] + [(e, False) for e in nonzeros]:
+        element = reduce_trig(element)
+        assert (abs(value(element)) < mpmath.mpf("1e-40")) == zero, str(element)
+        assert point.is_zero(element) == zero, str(element)
+
+
+@pytest.mark.parametrize("bump, bump_mp, start, end, tau", [
+    # 1 + cos t ≥ 0 touches 0 at t = π (a zero of even order on the circle)
+    ("(1 + cos(t))*(1 + t/8)", lambda t: (1 + mpmath.cos(t)) * (1 + t / 8), "3", "4",
+     lambda: mpmath.pi),
+    # cos τ = 4/5 and sin τ = 3/5 are rational, τ = acos(4/5) is transcendental
+    ("(5*cos(t) - 4)^2*(1 + t/8)", lambda t: (5 * mpmath.cos(t) - 4) ** 2 * (1 + t / 8),
+     "3/5", "7/10", lambda: mpmath.acos(mpmath.mpf(4) / 5)),
+])
+def test_touch_where_sin_and_cos_are_algebraic_but_t_is_not(bump, bump_mp, start, end, tau):
+    report = certify(orthoglide("-1"), trajectory(start, end,
+                                                  **along(X0_TEXT, f"1 - {bump}/4")))
+    mpmath.mp.dps = 50
+    tau = tau()
+    assert abs(bump_mp(tau)) < mpmath.mpf("1e-45")  # the pose at τ is X0, on the sphere
+    eps = mpmath.mpf("1e-3")
+    assert bump_mp(tau - eps) > 0 < bump_mp(tau + eps)  # inside the sphere on both sides
+    assert report.verdict == "singular"
+    [candidate] = report.candidates
+    assert abs(float(candidate.t.mid()) - float(tau)) < 1e-9
+    assert set(candidate.singular_modes) == modes_singular_on_sphere(X0)
+    assert all(m.status != "unknown" for m in candidate.modes)

@@ -47,24 +47,19 @@ from fractions import Fraction
 
 from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 
-from singcheck.algebra.intervals import excludes_zero, working_precision
+from singcheck.algebra.intervals import evaluate, excludes_zero, working_precision
 from singcheck.algebra.polynomials import constant_value
 from singcheck.algebra.radicals import radical_prime
 from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig, uses_t, uses_trig
 from singcheck.budget import checkpoint
 from singcheck.certify.path import PathModel, memo_per_object
-from singcheck.roots.enclosures import AT_POINT, IN_T, IN_U, ExactTime
+from singcheck.roots.enclosures import AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t
 from singcheck.roots.rational import RationalRoot, rational_ball
+from singcheck.roots.transcendental import NotExact, TranscendentalPoint
 
 _MAX_BITS = 1 << 16
-
-
-class NotExact(Exception):
-    """The exact step does not apply (e.g. a path whose angle is not k·t + qπ, a revolute
-    leg with W = 0 at the root), or ball arithmetic could not separate a mode from its
-    conjugate within the precision cap."""
 
 
 # ---------------------------------------------------------------------------------
@@ -285,6 +280,59 @@ class AlgebraicPoint:
         return total
 
 
+_T_ALPHA = fmpq_mpoly_ctx.get(("t", "a"), "lex")
+
+
+class TimeTranscendentalPoint:
+    """A root t = τ ≠ 0 of a path using the bare t where sin τ and cos τ are algebraic
+    (in Q(α): t = 2·atan(α) + 2kπ, or t = kπ): τ itself is then transcendental
+    (Lindemann–Weierstrass: e^{iτ} is algebraic), so an element Σ tⁱ·gᵢ(α) vanishes at
+    the root exactly when every gᵢ is 0 in Q(α).  Elements are polynomials in t and α,
+    reduced modulo α's minimal polynomial; balls take τ from the root's own enclosure."""
+
+    def __init__(self, time: ExactTime, root) -> None:
+        self.inner = AlgebraicPoint(time)  # s, c (and α) without t
+        self.root = root
+        self.f = _T_ALPHA.from_dict({(0, i): c for i, c in enumerate(self.inner.f.coeffs())})
+
+    def zero(self) -> fmpq_mpoly:
+        return _T_ALPHA.from_dict({})
+
+    def of(self, p: fmpq_mpoly) -> fmpq_mpoly:
+        by_power: dict[int, dict] = {}
+        for (i, j, k), coeff in p.terms():
+            by_power.setdefault(i, {})[(0, j, k)] = coeff
+        out = {}
+        for i, terms in by_power.items():
+            value = self.inner.of(TRIG.from_dict(terms))
+            for e, c in enumerate(value.coeffs()):
+                if c != 0:
+                    out[(i, e)] = c
+        return _T_ALPHA.from_dict(out)
+
+    def mul(self, a: fmpq_mpoly, b: fmpq_mpoly) -> fmpq_mpoly:
+        return (a * b) % self.f
+
+    def is_zero(self, a: fmpq_mpoly) -> bool:
+        return a.is_zero()
+
+    def ball(self, a: fmpq_mpoly, bits: int) -> arb:
+        t = self.root.refined(max(2.0 ** -bits, 1e-300)).t
+        alpha = self.inner.ball(fmpq_poly([0, 1]), bits)
+        return evaluate(a, [t, alpha])
+
+
+def exact_point(time: ExactTime, root=None):
+    """The base field of the exact decisions at a root (a
+    :class:`~singcheck.roots.enclosures.RealRoot`) with this exact time."""
+    if time.kind == IN_MIXED:
+        return TranscendentalPoint(time)
+    if time.kind in (IN_U, AT_POINT) and time.t_value is None and root is not None and \
+            excludes_zero(root.t):
+        return TimeTranscendentalPoint(time, root)
+    return AlgebraicPoint(time)
+
+
 class PathFunctions:
     """The trig functions along the path (μ ≡ 0): elements are reduced trig polynomials,
     exact zero tests are polynomial ones, and balls are taken at a rational time."""
@@ -390,7 +438,7 @@ class _Tower:
     def _which_vanishes(self, e: dict, k: int) -> bool:
         """True when E is the zero one of {E, Ē} (flipping level k), decided by balls."""
         bits = 64
-        while bits <= _MAX_BITS:
+        while bits <= getattr(self.base, "max_bits", _MAX_BITS):
             checkpoint()
             with working_precision(bits):
                 value = self._ball(e, k, flip=None)

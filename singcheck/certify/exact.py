@@ -48,11 +48,11 @@ from fractions import Fraction
 from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 
 from singcheck.algebra.intervals import evaluate, excludes_zero, working_precision
-from singcheck.algebra.polynomials import constant_value
+from singcheck.algebra.polynomials import constant_value, memo_per_object
 from singcheck.algebra.radicals import radical_prime
 from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig, uses_t, uses_trig
 from singcheck.budget import checkpoint
-from singcheck.certify.path import PathModel, memo_per_object
+from singcheck.certify.path import PathModel
 from singcheck.roots.enclosures import AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t

@@ -289,13 +289,11 @@ def _worker_signals() -> None:
     every worker at once), even when the parent is SIGKILLed."""
     import signal
 
-    from singcheck.elimination.cas.guard import PR_SET_PDEATHSIG, prctl
+    from singcheck.elimination.cas.guard import die_with_parent
 
-    prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
-
+    die_with_parent(_WORKER["parent"])  # SIGTERM: the default action
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _check_indices(indices: list[int]) -> list[tuple[int, dict]]:
@@ -354,7 +352,10 @@ def _forked(robot, trajectories, options, jobs: int, ordered: bool) -> Iterator[
     n = len(trajectories)
     size = max(1, min(64, n // (jobs * 16)))
     chunks = [list(range(i, min(n, i + size))) for i in range(0, n, size)]
-    _WORKER.update(robot=robot, trajectories=trajectories, options=options)
+    import os
+
+    _WORKER.update(robot=robot, trajectories=trajectories, options=options,
+                   parent=os.getpid())
     pool = ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
                                initializer=_worker_signals)
     try:

@@ -432,3 +432,115 @@ def test_the_api_reads_several_documents(orthoglide_robot, tmp_path):
     assert [s.name for s in specs] == ["heart1", "heart2"]
     assert [sc.check(orthoglide_robot, s, regions=False).verdict for s in specs] == \
         ["singular", "singularity-free"]
+
+
+# -- memory: flat in the number of paths -----------------------------------------------
+
+
+def _lines_stream(path, count: int):
+    """``count`` straight-line paths of the Orthoglide at z = 1 (cheap to certify: the
+    test is about what the batch holds), as one stream of YAML documents."""
+    with path.open("w") as f:
+        for i in range(count):
+            f.write(f"---\nname: line-{i}\nparameter: t\nrange: [0, 1]\npose:\n"
+                    f"  x: {i % 7}/10 + t/{i % 5 + 2}\n  y: {i % 3 + 1}/4\n  z: 1\n")
+    return path
+
+
+def _peak_rss_mb(args: list[str], stdin_path, env: dict) -> tuple[float, int, int]:
+    """Peak resident memory (MB) of a singcheck process, from wait4's rusage; its exit
+    status, and the number of JSON lines it wrote."""
+    import os
+    import subprocess
+    import sys
+    import tempfile
+
+    with stdin_path.open("rb") as stdin, tempfile.TemporaryFile() as out:
+        proc = subprocess.Popen([sys.executable, "-m", "singcheck", *args], cwd=ROOT,
+                                stdin=stdin, stdout=out, stderr=subprocess.DEVNULL,
+                                env={**os.environ, **env})
+        _, status, usage = os.wait4(proc.pid, 0)
+        out.seek(0)
+        lines = sum(1 for line in out if json.loads(line)["name"].startswith("line-"))
+    return usage.ru_maxrss / 1024, os.waitstatus_to_exitcode(status), lines
+
+
+@pytest.mark.slow
+def test_memory_stays_flat_from_1000_to_10000_paths_on_stdin(tmp_path):
+    """1,000 and then 10,000 paths streamed through one command each (stdin, jsonl,
+    --no-regions, two forked workers): every path comes back, and the peak memory of
+    the command grows by less than 10 MB (held whole, 10,000 parsed paths alone took
+    about 20 MB more than 1,000)."""
+    env = {"SINGCHECK_CACHE_DIR": str(tmp_path)}
+    args = ["run", ORTHO, "-", "--format", "jsonl", "--no-regions", "--backend", "flint",
+            "-q", "--jobs", "2"]
+    small, code, lines = _peak_rss_mb(args, _lines_stream(tmp_path / "1k.yaml", 1000), env)
+    assert (code, lines) == (1, 1000)  # some lines cross the singularity surface
+    large, code, lines = _peak_rss_mb(args, _lines_stream(tmp_path / "10k.yaml", 10000), env)
+    assert (code, lines) == (1, 10000)
+    assert large - small < 10, (small, large)
+
+
+# -- JUnit against the schema CI tools check reports with -------------------------------
+
+JUNIT_XSD = ROOT / "tests" / "data" / "junit-10.xsd"  # Jenkins xUnit's, vendored (MIT)
+
+#: x² + z² = 10 > l² = 4 all along: the second leg's equation x² + (y − ρ2)² + z² = l²
+#: has no real root, so no working mode is feasible anywhere on the path
+OUTSIDE = "name: outside\nparameter: t\nrange: [0, 1]\npose:\n  x: 3\n  y: t\n  z: 1\n"
+
+
+def test_junit_validates_against_the_jenkins_schema(tmp_path, monkeypatch):
+    """A batch with every kind of result (singular, free, infeasible, unknown past its
+    time limit, a bad document and a repeated name past the documents read up front)
+    gives JUnit XML that Jenkins' junit-10.xsd accepts, and whose counts read back are
+    those of the verdicts known here: 2 failures, 3 errors in 6 cases."""
+    import sys
+
+    import xmlschema
+    from junitparser import Error, Failure, JUnitXml
+
+    from singcheck import api
+    from singcheck.cli import commands as cli
+
+    monkeypatch.setattr(api, "LOOKAHEAD", 3)  # the bad documents come later: results
+    many = tmp_path / "many.yaml"
+    bad = "name: bad\nparameter: t\nrange: [0, 1]\npose:\n  x: t\n  y: 0\n  z: sin(t\n"
+    many.write_text(_stream("heart1", "heart2") + "---\n" + OUTSIDE + "---\n" +
+                    (DATA / "slow.yaml").read_text() + "---\n" + bad + _stream("heart2"))
+    report = tmp_path / "report.xml"
+    monkeypatch.setattr(sys, "argv", ["singcheck", "run", ORTHO, str(many), "--format",
+                                      "junit", "-o", str(report), "--backend", "flint",
+                                      "--time-limit", "2", "--no-regions", "--jobs", "1",
+                                      "-q", "--no-cache"])
+    with pytest.raises(SystemExit) as exit_:
+        cli.main()
+    assert exit_.value.code == 2  # the worst outcome: a bad document
+    xmlschema.XMLSchema(str(JUNIT_XSD)).validate(str(report))  # raises when invalid
+    (suite,) = list(JUnitXml.fromfile(str(report)))
+    assert (suite.tests, suite.failures, suite.errors) == (6, 2, 3)
+    results = [(case.name, [type(r).__name__ for r in case.result]) for case in suite]
+    assert results == [("heart1", ["Failure"]), ("heart2", []), ("outside", ["Failure"]),
+                       ("slow", ["Error"]), ("bad", ["Error"]), ("heart2", ["Error"])]
+    cases = list(suite)
+    assert isinstance(cases[2].result[0], Failure) and \
+        cases[2].result[0].message.startswith("infeasible")
+    assert isinstance(cases[4].result[0], Error)
+    line = len((_stream("heart1", "heart2") + "---\n" + OUTSIDE + "---\n" +
+                (DATA / "slow.yaml").read_text()).splitlines()) + 8
+    assert f"many.yaml:{line}: pose.z:" in cases[4].result[0].message
+    assert "(document 5)" in cases[4].result[0].message
+    assert "'heart2' is already used by" in cases[5].result[0].message
+
+
+def test_the_schema_test_can_fail():
+    """The vendored schema refuses what CI tools would: a testcase without a name, and a
+    time with more decimals than Surefire writes."""
+    import xmlschema
+
+    schema = xmlschema.XMLSchema(str(JUNIT_XSD))
+    good = '<testsuite name="s" tests="1" failures="0" errors="0" time="0.5">' \
+        '<testcase name="c" time="0.5"/></testsuite>'
+    assert schema.is_valid(good)
+    assert not schema.is_valid(good.replace(' name="c"', ""))
+    assert not schema.is_valid(good.replace('time="0.5">', 'time="0.123456">'))

@@ -434,6 +434,32 @@ def test_the_api_reads_several_documents(orthoglide_robot, tmp_path):
         ["singular", "singularity-free"]
 
 
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_bad_document_mid_stream_is_its_own_result(orthoglide_robot, tmp_path, jobs):
+    """Documents read lazily and parsed by the workers: the bad one in the middle is an
+    error naming its file, line and document; the others keep their order and come
+    back as certified one by one, each spec parsed here."""
+    from singcheck import api
+    from singcheck.spec.files import parse_trajectory, read_documents
+
+    good = [f"---\nname: p{i}\nparameter: t\nrange: [0, 1]\npose:\n  x: {i}/5 + t/2\n"
+            "  y: 1/4\n  z: 1\n" for i in range(6)]
+    bad = "---\nname: bad\nparameter: t\nrange: [0, 1]\npose: [1, 2]\n"
+    stream = tmp_path / "stream.yaml"
+    stream.write_text("".join(good[:3]) + bad + "".join(good[3:]))
+    docs = list(api.check_batch(orthoglide_robot, read_documents([stream]), regions=False,
+                                jobs=jobs))
+    assert [d["name"] for d in docs] == ["p0", "p1", "p2", "bad", "p3", "p4", "p5"]
+    line = len("".join(good[:3]).splitlines()) + 5
+    assert docs[3]["verdict"] == "error" and docs[3]["error"]["kind"] == "spec"
+    assert docs[3]["error"]["message"].startswith(f"{stream}:{line}: pose: ")
+    assert docs[3]["error"]["message"].endswith("(document 4)")
+    for d, text in zip(docs[:3] + docs[4:], good, strict=True):
+        spec = parse_trajectory(text, "x.yaml", orthoglide_robot.spec)
+        assert d["verdict"] == api.check(orthoglide_robot, spec, regions=False).verdict
+
+
 # -- memory: flat in the number of paths -----------------------------------------------
 
 

@@ -284,12 +284,16 @@ _WORKER: dict = {}
 def _worker_signals() -> None:
     """In a forked worker: Ctrl-C and a hangup reach the whole process group, but it is
     the parent that stops the batch (and then terminates the workers); SIGTERM ends a
-    worker silently.  So no worker prints a KeyboardInterrupt traceback."""
+    worker silently.  So no worker prints a KeyboardInterrupt traceback.  A worker dies
+    with the parent's thread that forked it (the main thread: a fork-context pool starts
+    every worker at once), even when the parent is SIGKILLed."""
     import signal
 
+    from singcheck.elimination.cas.guard import die_with_parent
+
+    die_with_parent(_WORKER["parent"])  # SIGTERM: the default action
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _check_chunk(chunk: list) -> list[dict]:
@@ -384,24 +388,36 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
     one read (before its results are yielded), so at most that many trajectories are
     held here at once, whatever the length of the batch."""
     import multiprocessing
+    import os
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
     from itertools import islice
 
     from singcheck.algebra.pickling import register
     from singcheck.report.trajectory import error_json
 
     register()  # specs cross to the workers by pickle
-    _WORKER.update(robot=robot, options=options)
-    pool = ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
-                               initializer=_worker_signals)
+    _WORKER.update(robot=robot, options=options, parent=os.getpid())
+
+    def start():
+        return ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
+                                   initializer=_worker_signals)
+
+    pool = start()
     in_flight: dict = {}  # future -> (index of its first trajectory, its trajectories)
     read = 0
 
     def submit() -> bool:
-        nonlocal read
+        nonlocal read, pool
         chunk = list(islice(items, CHUNK))
         if chunk:
-            in_flight[pool.submit(_check_chunk, chunk)] = (read, chunk)
+            try:
+                future = pool.submit(_check_chunk, chunk)
+            except BrokenProcessPool:  # a worker died: the tasks it broke are errors, and
+                _stop(pool)  # the batch goes on in a new pool
+                pool = start()
+                future = pool.submit(_check_chunk, chunk)
+            in_flight[future] = (read, chunk)
             read += len(chunk)
         return bool(chunk)
 
@@ -433,6 +449,11 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
                 next_out += 1
     finally:
         _WORKER.clear()
-        for process in list(getattr(pool, "_processes", {}).values()):
-            process.terminate()
-        pool.shutdown(wait=True, cancel_futures=True)
+        _stop(pool)
+
+
+def _stop(pool) -> None:
+    """End a worker pool now: its processes terminated, its queued tasks cancelled."""
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        process.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)

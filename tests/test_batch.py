@@ -434,6 +434,59 @@ def test_the_api_reads_several_documents(orthoglide_robot, tmp_path):
         ["singular", "singularity-free"]
 
 
+def test_forked_workers_die_with_a_sigkilled_singcheck(tmp_path):
+    """SIGKILL cannot be handled: the workers ask the kernel for their own SIGKILL when
+    the parent goes (PR_SET_PDEATHSIG) instead of computing on as orphans."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    paths = _generated(tmp_path, 40)
+    proc = subprocess.Popen([sys.executable, "-m", "singcheck", "run", ORTHO, *paths,
+                             str(DATA / "slow.yaml"), "--format", "jsonl", "--jobs", "2",
+                             "--backend", "flint", "--no-regions"],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, cwd=ROOT,
+                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)})
+
+    def workers() -> list[int]:
+        out = []
+        for name in os.listdir("/proc"):
+            try:
+                with open(f"/proc/{name}/stat", "rb") as f:
+                    fields = f.read().rsplit(b")", 1)[1].split()
+            except (OSError, IndexError):
+                continue
+            if int(fields[1]) == proc.pid and fields[0] != b"Z":
+                out.append(int(name))
+        return out
+
+    forked: list[int] = []
+    try:
+        proc.stdout.readline()  # a result streamed: the workers are busy
+        forked = workers()
+        assert forked
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 5
+        while any(os.path.exists(f"/proc/{pid}") and _running(pid) for pid in forked):
+            assert time.monotonic() < deadline, "a worker survived its parent's SIGKILL"
+            time.sleep(0.05)
+    finally:  # never leave a worker behind, even when the test fails
+        proc.kill()
+        proc.wait()
+        for pid in forked:
+            if _running(pid):
+                os.kill(pid, 9)
+
+
+def _running(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            return f.read().rsplit(b")", 1)[1].split()[0] != b"Z"
+    except OSError:
+        return False
+
 
 @pytest.mark.parametrize("jobs", [1, 2])
 def test_a_bad_document_mid_stream_is_its_own_result(orthoglide_robot, tmp_path, jobs):
@@ -505,3 +558,36 @@ def test_memory_stays_flat_from_500_to_5000_paths_on_stdin(tmp_path):
     large, code, lines = _peak_rss_mb(args, _lines_stream(tmp_path / "large.yaml", 5000), env)
     assert (code, lines) == (1, 5000)
     assert large - small < 5, (small, large)
+
+
+def test_a_dead_worker_fails_its_tasks_and_the_batch_goes_on(orthoglide_robot, tmp_path,
+                                                             monkeypatch):
+    """A worker killed mid-task (os._exit, as the OOM killer would): the trajectories
+    in flight then are errors saying so, and the ones read after it are certified by a
+    new pool of workers."""
+    import os
+
+    from singcheck import api
+    from singcheck.spec.files import read_documents
+
+    real = api.check_safely
+
+    def check_safely(robot, trajectory, **options):
+        if trajectory.name == "p1":
+            os._exit(1)
+        return real(robot, trajectory, **options)
+
+    monkeypatch.setattr(api, "check_safely", check_safely)
+    monkeypatch.setattr(api, "CHUNK", 1)
+    monkeypatch.setattr(api, "TASKS_PER_WORKER", 1)
+    stream = tmp_path / "stream.yaml"
+    stream.write_text("".join(f"---\nname: p{i}\nparameter: t\nrange: [0, 1]\npose:\n"
+                              f"  x: {i}/20 + t/2\n  y: 1/4\n  z: 1\n" for i in range(12)))
+    docs = list(api.check_batch(orthoglide_robot, read_documents([stream]), regions=False,
+                                jobs=2))
+    assert [d["name"] for d in docs] == [f"p{i}" for i in range(12)]
+    assert docs[1]["verdict"] == "error"
+    assert docs[1]["error"]["message"].startswith("the worker process failed")
+    expected = [api.check(orthoglide_robot, d.parse(orthoglide_robot.spec),
+                          regions=False).verdict for d in read_documents([stream])]
+    assert [d["verdict"] for d in docs[4:]] == expected[4:]  # after the pool was renewed

@@ -42,12 +42,6 @@ from flint import acb, arb
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
 from singcheck.algebra.radicals import evaluate_path
 from singcheck.budget import checkpoint
-from singcheck.certify.exact import (
-    AlgebraicPoint,
-    NotExact,
-    det_a_vanishes_at,
-    mode_zero_polynomial,
-)
 from singcheck.certify.path import PathModel, joint_float
 from singcheck.certify.working_modes import (
     FEASIBLE,
@@ -220,7 +214,10 @@ def _decide(path, modes, root: RealRoot, by_elimination: bool = True):
 
 
 def _decide_exactly(path, modes, time) -> dict[str, ModeAtCandidate]:
-    """The modes that ball arithmetic left open, decided in Q(α) (:mod:`.exact`)."""
+    """The modes that ball arithmetic left open, decided in Q(α) (:mod:`.exact`, loaded
+    only when balls did not decide)."""
+    from singcheck.certify.exact import AlgebraicPoint, NotExact, det_a_vanishes_at
+
     out = {}
     try:
         point = AlgebraicPoint(time)
@@ -338,6 +335,8 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
     all along), or a non-zero trig polynomial whose roots hold its zeros, which are then
     isolated and classified for that mode alone (no elimination proof: the other modes
     are not looked at).  Infeasible modes are not examined."""
+    from singcheck.certify.exact import NotExact
+
     interval = path.trajectory.range
     feasible = [m for m in modes if m.status == FEASIBLE]
     middle = gap_points(interval, [])
@@ -374,6 +373,8 @@ def _mode_zeros(path: PathModel, mode: WorkingMode, samples: list):
     """:func:`.exact.mode_zero_polynomial` at the first sample time where ball arithmetic
     tells a mode from its conjugate (a sample may happen to be a zero of the non-vanishing
     one)."""
+    from singcheck.certify.exact import NotExact, mode_zero_polynomial
+
     why = None
     for t0 in samples:
         try:

@@ -65,20 +65,39 @@ def _reduce(p: fmpq_mpoly) -> fmpq_mpoly:
 def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ...]) -> fmpq_mpoly:
     """``p(…, X = φ(t))`` for a polynomial in any context whose non-pose variables are absent
     (square roots ``sqrt(q)`` become the path ring's, which ``phi`` lives in)."""
-    names = p.context().names()
     ring = phi[0].context() if phi else TRIG
-    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    plan = _composition_plan(p.context(), ring, pose)
+    degrees = p.degrees()
     args = []
-    for v in names:
-        if v in pose:
-            args.append(phi[pose.index(v)])
-        elif radical_prime(v) is not None and v in gens:
-            args.append(gens[v])
-        elif p.degrees()[names.index(v)] > 0:
-            raise ValueError(f"{v} is not a pose variable")
+    for i, (kind, what) in enumerate(plan):
+        if kind == "pose":
+            args.append(phi[what])
+        elif kind == "gen":
+            args.append(what)
+        elif degrees[i] > 0:
+            raise ValueError(f"{what} is not a pose variable")
         else:
             args.append(ring.from_dict({}))
     return _reduce(p.compose(*args, ctx=ring))
+
+
+_PLANS: dict = {}
+
+
+def _composition_plan(source, ring, pose: tuple[str, ...]) -> tuple:
+    """Per variable of ``source``: ("pose", index in ``pose``), ("gen", the ring's
+    square-root generator) or ("absent", name); once per (context, ring, pose)."""
+    key = (id(source), id(ring), pose)
+    hit = _PLANS.get(key)
+    if hit is None or hit[0] is not source or hit[1] is not ring:
+        gens = dict(zip(ring.names(), ring.gens(), strict=True))
+        plan = tuple(("pose", pose.index(v)) if v in pose else
+                     ("gen", gens[v]) if radical_prime(v) is not None and v in gens else
+                     ("absent", v) for v in source.names())
+        if len(_PLANS) > 256:
+            _PLANS.clear()
+        hit = _PLANS[key] = (source, ring, plan)  # holds both contexts: ids not reused
+    return hit[2]
 
 
 def joint_float(value) -> float | None:
@@ -105,13 +124,27 @@ def mu_size_bound(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...],
     and a reduced trig polynomial of degree a in t and b in (s, c) has at most
     (a + 1)(2b + 1) terms.  Cheap: nothing is composed."""
     names = xi.context().names()
-    dt = [phi[pose.index(v)].degrees()[0] if v in pose else 0 for v in names]
-    dsc = [sum(phi[pose.index(v)].degrees()[1:]) if v in pose else 0 for v in names]
-    deg_t = deg_sc = 0
-    for exps, _ in xi.terms():
-        deg_t = max(deg_t, sum(e * d for e, d in zip(exps, dt, strict=True)))
-        deg_sc = max(deg_sc, sum(e * d for e, d in zip(exps, dsc, strict=True)))
+    # (a zero coordinate's degrees are -1: weight 0, an upper bound all the same)
+    dt = [max(0, phi[pose.index(v)].degrees()[0]) if v in pose else 0 for v in names]
+    dsc = [max(0, sum(phi[pose.index(v)].degrees()[1:])) if v in pose else 0 for v in names]
+    deg_t, deg_sc = _weighted_degree(xi, dt), _weighted_degree(xi, dsc)
     return deg_t, deg_sc, (deg_t + 1) * (2 * deg_sc + 1)
+
+
+_ONES: dict = {}
+_U = fmpq_mpoly_ctx.get(("u",), "lex")
+
+
+def _weighted_degree(p: fmpq_mpoly, weights: list[int]) -> int:
+    """max over the monomials of ``p`` of Σ eᵢ·wᵢ (wᵢ ≥ 0), exactly: ``p`` with every
+    coefficient made 1, composed with xᵢ = u^wᵢ, cannot cancel, so its degree in u is
+    that maximum (0 for the zero polynomial)."""
+    if p.is_zero():
+        return 0
+    ones = memo_per_object(_ONES, p, lambda q: q.context().from_dict(
+        {exps: 1 for exps, _ in q.terms()}))
+    u = _U.gens()[0]
+    return max(0, ones.compose(*[u**w for w in weights], ctx=_U).degrees()[0])
 
 
 def _refuse_costly(xi, phi, pose, trajectory) -> None:
@@ -242,14 +275,12 @@ _LIMIT_BALLS: dict = {}
 
 def _limit_balls(limits) -> tuple[arb, arb]:
     """The balls of a prismatic joint's rational limits (exact when dyadic), once per
-    limits and working precision: feasibility proofs compare against them thousands of
-    times."""
-    key = (tuple(limits), ctx.prec)
-    hit = _LIMIT_BALLS.get(key)
+    limits object and working precision: feasibility proofs compare against them
+    thousands of times (keyed by the object, not by hashing its Fractions each time)."""
+    per_prec = memo_per_object(_LIMIT_BALLS, limits, lambda _: {})
+    hit = per_prec.get(ctx.prec)
     if hit is None:
-        if len(_LIMIT_BALLS) > 256:
-            _LIMIT_BALLS.clear()
-        hit = _LIMIT_BALLS[key] = tuple(fraction_ball(v) for v in limits)
+        hit = per_prec[ctx.prec] = tuple(fraction_ball(v) for v in limits)
     return hit
 
 

@@ -194,10 +194,12 @@ class _Doc:
             return value.surd.rational_value()
         return value
 
-    def expression(self, node, key: str, compile_):
+    def expression(self, node, key: str, compile_, tree=None):
+        """``compile_`` of the expression at ``node`` (``tree``: its parse, when the
+        caller has it already)."""
         text = self.text(node, key)
         try:
-            return compile_(parse(text))
+            return compile_(parse(text) if tree is None else tree)
         except ExprError as e:
             raise self.error(node, key, f"{e.message} in {_excerpt(text)}" +
                              (f" at column {e.column}" if e.column else "")) from None

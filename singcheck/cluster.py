@@ -55,9 +55,10 @@ def _remote_check(robot: Robot, chunk: list, options: dict, region_cache: bool) 
     return [check_item(robot, item, **options) for item in chunk]
 
 
-#: trajectories per task (a task costs the scheduler about a millisecond, a trajectory a
-#: few), and tasks in flight per worker thread
-CHUNK = 16
+#: trajectories per task: on a 2-worker LocalCluster a task cost about 14 ms of CPU
+#: beyond its trajectories' own (a heart-like path: about 5 ms), so a long batch goes 64
+#: to a task, a short one in at least TASKS_PER_WORKER tasks per worker thread
+CHUNK = 64
 TASKS_PER_WORKER = 4
 
 
@@ -86,9 +87,10 @@ def check_on_cluster(address: str, robot: Robot,
         head = list(islice(items, LOOKAHEAD))
         shared_regions(robot, head, options, notify)
         shipped = client.scatter(replace(robot, region_cache=None), broadcast=True)
-        window = max(8, TASKS_PER_WORKER * threads)
+        window = max(8, TASKS_PER_WORKER * threads)  # tasks in flight
+        size = CHUNK if len(head) == LOOKAHEAD else max(1, min(CHUNK, -(-len(head) // window)))
         yield from _results(_Submitter(client, shipped, chain(head, items), options,
-                                       robot.region_cache is not None, window), ordered)
+                                       robot.region_cache is not None, window, size), ordered)
     finally:
         client.close()  # the tasks still queued or running are cancelled with it
 
@@ -98,12 +100,12 @@ class _Submitter:
     process nor the scheduler holds a task per trajectory of a long batch at once."""
 
     def __init__(self, client, shipped, items: Iterator, options, region_cache: bool,
-                 window: int) -> None:
+                 window: int, size: int) -> None:
         from distributed import as_completed
 
         self.client, self.shipped, self.options = client, shipped, options
         self.region_cache = region_cache
-        self.items = items
+        self.items, self.size = items, size
         self.read = 0
         self.batch = uuid.uuid4().hex[:12]
         self.chunks: dict[str, tuple[int, list]] = {}  # key -> (first index, trajectories)
@@ -115,7 +117,7 @@ class _Submitter:
         """Submit the next few trajectories as one task, if any is left."""
         from itertools import islice
 
-        chunk = list(islice(self.items, CHUNK))
+        chunk = list(islice(self.items, self.size))
         if not chunk:
             return
         future = self.client.submit(_remote_check, self.shipped, chunk, self.options,

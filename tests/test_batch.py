@@ -591,3 +591,68 @@ def test_a_dead_worker_fails_its_tasks_and_the_batch_goes_on(orthoglide_robot, t
     expected = [api.check(orthoglide_robot, d.parse(orthoglide_robot.spec),
                           regions=False).verdict for d in read_documents([stream])]
     assert [d["verdict"] for d in docs[4:]] == expected[4:]  # after the pool was renewed
+
+
+# -- JUnit against the schema CI tools check reports with -------------------------------
+
+JUNIT_XSD = ROOT / "tests" / "data" / "junit-10.xsd"  # Jenkins xUnit's, vendored (MIT)
+
+#: x² + z² = 10 > l² = 4 all along: the second leg's equation x² + (y − ρ2)² + z² = l²
+#: has no real root, so no working mode is feasible anywhere on the path
+OUTSIDE = "name: outside\nparameter: t\nrange: [0, 1]\npose:\n  x: 3\n  y: t\n  z: 1\n"
+
+
+def test_junit_validates_against_the_jenkins_schema(tmp_path, monkeypatch):
+    """A batch with every kind of result (singular, free, infeasible, unknown past its
+    time limit, a bad document and a repeated name past the documents read up front)
+    gives JUnit XML that Jenkins' junit-10.xsd accepts, and whose counts read back are
+    those of the verdicts known here: 2 failures, 3 errors in 6 cases."""
+    import sys
+
+    import xmlschema
+    from junitparser import Error, Failure, JUnitXml
+
+    from singcheck import api
+    from singcheck.cli import commands as cli
+
+    monkeypatch.setattr(api, "LOOKAHEAD", 3)  # the bad documents come later: results
+    many = tmp_path / "many.yaml"
+    bad = "name: bad\nparameter: t\nrange: [0, 1]\npose:\n  x: t\n  y: 0\n  z: sin(t\n"
+    many.write_text(_stream("heart1", "heart2") + "---\n" + OUTSIDE + "---\n" +
+                    (DATA / "slow.yaml").read_text() + "---\n" + bad + _stream("heart2"))
+    report = tmp_path / "report.xml"
+    monkeypatch.setattr(sys, "argv", ["singcheck", "run", ORTHO, str(many), "--format",
+                                      "junit", "-o", str(report), "--backend", "flint",
+                                      "--time-limit", "2", "--no-regions", "--jobs", "1",
+                                      "-q", "--no-cache"])
+    with pytest.raises(SystemExit) as exit_:
+        cli.main()
+    assert exit_.value.code == 2  # the worst outcome: a bad document
+    xmlschema.XMLSchema(str(JUNIT_XSD)).validate(str(report))  # raises when invalid
+    (suite,) = list(JUnitXml.fromfile(str(report)))
+    assert (suite.tests, suite.failures, suite.errors) == (6, 2, 3)
+    results = [(case.name, [type(r).__name__ for r in case.result]) for case in suite]
+    assert results == [("heart1", ["Failure"]), ("heart2", []), ("outside", ["Failure"]),
+                       ("slow", ["Error"]), ("bad", ["Error"]), ("heart2", ["Error"])]
+    cases = list(suite)
+    assert isinstance(cases[2].result[0], Failure) and \
+        cases[2].result[0].message.startswith("infeasible")
+    assert isinstance(cases[4].result[0], Error)
+    line = len((_stream("heart1", "heart2") + "---\n" + OUTSIDE + "---\n" +
+                (DATA / "slow.yaml").read_text()).splitlines()) + 8
+    assert f"many.yaml:{line}: pose.z:" in cases[4].result[0].message
+    assert "(document 5)" in cases[4].result[0].message
+    assert "'heart2' is already used by" in cases[5].result[0].message
+
+
+def test_the_schema_test_can_fail():
+    """The vendored schema refuses what CI tools would: a testcase without a name, and a
+    time with more decimals than Surefire writes."""
+    import xmlschema
+
+    schema = xmlschema.XMLSchema(str(JUNIT_XSD))
+    good = '<testsuite name="s" tests="1" failures="0" errors="0" time="0.5">' \
+        '<testcase name="c" time="0.5"/></testsuite>'
+    assert schema.is_valid(good)
+    assert not schema.is_valid(good.replace(' name="c"', ""))
+    assert not schema.is_valid(good.replace('time="0.5">', 'time="0.123456">'))

@@ -639,3 +639,38 @@ def test_touch_where_sin_and_cos_are_algebraic_but_t_is_not(bump, bump_mp, start
     assert abs(float(candidate.t.mid()) - float(tau)) < 1e-9
     assert set(candidate.singular_modes) == modes_singular_on_sphere(X0)
     assert all(m.status != "unknown" for m in candidate.modes)
+
+
+# -- the workspace line of a path lying on ξ = 0 -------------------------------------------
+
+
+@pytest.mark.parametrize("lower, surfaces, count", [
+    ("-1", {"parallel singularity ξ"}, 8),
+    # with ρ ≥ 0 the branches ρ = x - x = 0 sit on the limit, whose surface (the leg's
+    # constraint at ρ = 0: x² + y² + z² = 4) is the sphere too
+    ("0", {"parallel singularity ξ", "rho1 = 0 (min)", "rho2 = 0 (min)", "rho3 = 0 (min)"},
+     None),
+])
+def test_the_workspace_line_says_the_path_lies_on_the_surface(lower, surfaces, count):
+    from singcheck.report.trajectory import workspace_json, workspace_line
+    from singcheck.spaces.path_regions import path_in_workspace
+
+    x, y, z = X0
+    assert x * x + y * y + z * z == 4  # on the sphere, every leg's ρ = 0 surface
+    expected_count = 1
+    for v in X0:  # ρ = v ± v, both strictly inside [-1, 4] when the limit is -1
+        expected_count *= sum(Fraction(lower) < v + sign * v < 4 for sign in (1, -1))
+    assert (expected_count if lower == "-1" else None) == count
+    report = certify(orthoglide(lower), trajectory("0", "1", x="2/3", y="4/3", z="4/3"))
+    assert report.verdict == "singular"
+    w = path_in_workspace(report.path, name_region=False,
+                          mu_roots=[c.t for c in report.candidates]
+                          if report.mu_roots_complete else None)
+    assert not w.undecided and not w.crossings and w.one_region is False
+    assert {s for s, _ in w.on_surfaces} == surfaces
+    assert {where for _, where in w.on_surfaces} == {"[0, 1]"}
+    line = workspace_line(workspace_json(w))
+    assert "not all decided" not in line
+    assert line.startswith("workspace: the path lies on ") and "for t ∈ [0, 1]" in line
+    if count is not None:
+        assert line.endswith(f"({count} IK solution(s) inside the joint limits all along)")

@@ -431,6 +431,34 @@ def test_five_bar_line_tangent_where_the_distal_links_align_is_singular_at_sqrt_
     assert all(m.status != "unknown" for m in candidate.modes)
 
 
+def test_rotary_delta_touching_the_surface_in_infeasible_modes_only_is_free():
+    # on the axis, at z = -(4 + √3)/2 the elbows th = 2π/3 sit right above the centre:
+    # the three forearms are vertical, parallel (det A = 0, a double zero in t); that
+    # branch is outside the limits [-π/2, 3π/4] at the start, the feasible one is not
+    from tests.robot_oracles import rotary_delta
+
+    path = _revolute_path("rotary-delta", trajectory("5/2", "29/10", x="0", y="0", z="-t"))
+    report = certify_path(path)
+    mpmath.mp.dps = 50
+    oracle = rotary_delta()
+    tau = (4 + mpmath.sqrt(3)) / 2
+
+    def pose_at(t):
+        return [0, 0, -t]
+
+    modes = _oracle_modes(path, oracle, pose_at, Fraction(27, 10))
+    two_thirds = oracle.joints(modes["+++"], pose_at(tau))
+    assert all(abs(mpmath.cos(q) + mpmath.mpf(1) / 2) < 1e-40 for q in two_thirds)
+    singular = _revolute_zero_modes(oracle, modes, pose_at(tau), tiny="1e-25")
+    assert "+++" in singular and "---" not in singular
+    assert [m.label for m in report.modes if m.feasible] == ["---"]
+    assert report.verdict == "singularity-free"
+    [candidate] = report.candidates
+    assert abs(float(candidate.t.mid()) - float(tau)) < 1e-9
+    assert set(candidate.singular_modes) == singular
+    assert all(m.status != "unknown" for m in candidate.modes)
+
+
 def _mp(q: str):
     return mpmath.mpf(Fraction(q).numerator) / Fraction(q).denominator
 
@@ -440,6 +468,8 @@ def _mp(q: str):
     ("five-bar", "trajectories/five-bar-cross.yaml", "five_bar", lambda t: [0, 3 - 2 * t]),
     ("rotary-delta", "trajectories/rotary-delta-cross.yaml", "rotary_delta",
      lambda t: [_mp("7/4") + _mp("3/10") * t, 0, -1]),
+    ("rotary-delta", trajectory("5/2", "29/10", x="0", y="0", z="-t"), "rotary_delta",
+     lambda t: [0, 0, -t]),
 ])
 def test_exact_decisions_on_revolute_legs_agree_with_50_digits(robot, text, oracle_name,
                                                                pose_at):

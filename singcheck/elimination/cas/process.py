@@ -104,8 +104,9 @@ def _reap_strays(known: set[int]) -> None:
 def _guarded(argv: list[str] | tuple[str, ...], limit: int) -> list[str]:
     """``argv`` started through :mod:`~singcheck.elimination.cas.guard` (a fresh
     interpreter that dies with this thread and takes the program's descendants with it);
-    ``argv`` itself where no interpreter path is known."""
-    if not sys.executable:
+    ``argv`` itself where there is no interpreter or script file to run (a frozen or
+    zipped install)."""
+    if not sys.executable or not os.path.isfile(SCRIPT):
         return list(argv)
     return [sys.executable, "-I", "-S", SCRIPT, str(os.getpid()), str(limit), "--",
             *argv]

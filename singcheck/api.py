@@ -200,9 +200,7 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
             certificate = certify_trajectory(robot.projection, trajectory, tolerance)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions or not robot.model.polynomial:
-            # the workspace decomposition (CAD) needs rational polynomials in the pose:
-            # robots with angles or square roots get the certificate without it
+        if not regions:
             return Report(trajectory, certificate)
         from singcheck.spaces.path_regions import path_in_workspace, pieces_in_workspace
 
@@ -330,7 +328,7 @@ def check_batch(robot: Robot, trajectories: list[TrajectorySpec], *,
                    notify=notify)
     n = len(trajectories)
     if jobs > 1 and n > 4:
-        if regions and robot.model.polynomial and not prepare_regions(
+        if regions and not prepare_regions(
                 robot, trajectories, time_limit, notify):
             options["regions"] = False
         yield from _forked(robot, trajectories, options, jobs, ordered)

@@ -68,7 +68,7 @@ def check_on_cluster(address: str, robot: Robot, trajectories: list[TrajectorySp
         notify(f"dask scheduler {address}: {len(client.scheduler_info()['workers'])} "
                "worker(s)")
         options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit)
-        if regions and robot.model.polynomial and not prepare_regions(
+        if regions and not prepare_regions(
                 robot, trajectories, time_limit, notify):
             options["regions"] = False
         shipped = client.scatter(replace(robot, region_cache=None), broadcast=True)

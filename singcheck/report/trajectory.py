@@ -119,6 +119,7 @@ def workspace_json(w) -> dict[str, Any]:
         "ik_counts": [s.count for s in w.stretches],
         "exit_time_interval": None if w.exit_time is None else _interval(w.exit_time),
         "undecided": w.undecided,
+        **({"region_not_named": w.region_reason} if w.region_reason else {}),
     }
 
 
@@ -129,8 +130,11 @@ def workspace_line(w: dict[str, Any]) -> str:
         return "workspace: crossings not all decided: " + "; ".join(w["undecided"])
     if w["one_region"]:
         where = f"region {w['region']}" if w["region"] else "one region of the workspace"
-        return (f"workspace: the whole path lies in {where} "
+        text = (f"workspace: the whole path lies in {where} "
                 f"({counts[0]} IK solution(s) inside the joint limits all along)")
+        if w.get("region_not_named"):
+            text += f"; {w['region_not_named']}"
+        return text
     text = (f"workspace: the path crosses the discriminant variety {len(w['crossings'])} "
             f"time(s); IK solutions inside the limits along it: "
             + " → ".join("?" if c is None else str(c) for c in counts))

@@ -32,9 +32,10 @@ from singcheck.algebra.polynomials import restrict, squarefree_part
 from singcheck.budget import checkpoint
 from singcheck.elimination.projection import RobotProjection, joint_space_singularities
 from singcheck.elimination.requests import EliminationRequest
-from singcheck.errors import SingcheckError
+from singcheck.errors import SingcheckError, UnsupportedRobotError
 from singcheck.model.robot import RobotModel
 from singcheck.spaces.cad import Cell, OpenCAD, open_cad
+from singcheck.spaces.chart import Chart
 from singcheck.spaces.regions import Region, Regions, connect_regions, factor_signs
 from singcheck.spaces.solution_counts import direct_kinematics_count, ik_count, ik_root_placement
 
@@ -88,20 +89,38 @@ class SpaceAnalysis:
 # the discriminant varieties
 
 
+#: The most axes a decomposition takes: a 6-D pose (Gough–Stewart) is refused.
+MAX_AXES = 3
+
+
+def space_chart(model: RobotModel, space: str) -> Chart:
+    """The axes of the space: the pose or the joints, each angle v as tan(v/2)."""
+    names = model.pose if space == WORKSPACE else model.joints
+    if len(names) > MAX_AXES:
+        raise UnsupportedRobotError(
+            f"the {space} of {model.name} has {len(names)} axes ({', '.join(names)}): too "
+            f"many variables for a cylindrical decomposition (at most {MAX_AXES}); "
+            "`singcheck run` still certifies its paths", path=model.spec.path)
+    return Chart.of(names, model.angles)
+
+
 def workspace_variety(projection: RobotProjection,
                       parallel: bool = True) -> list[VarietyComponent]:
-    """Serial singularities, ξ (unless ``parallel`` is False) and joint limits in X."""
+    """Serial singularities, ξ (unless ``parallel`` is False) and joint limits in X (in
+    the chart: an angle φ of the pose as tan(φ/2), :mod:`singcheck.spaces.chart`)."""
     model = projection.model
+    chart = space_chart(model, WORKSPACE)
     out = []
     for leg, disc in zip(model.legs, projection.workspace_boundary, strict=True):
         if not disc.is_constant():
             out.append(VarietyComponent(SERIAL, f"leg {leg.joint}: its two branches meet",
-                                        disc))
+                                        chart.polynomial(disc)))
     if parallel and projection.expanded:  # a ξ too big to expand is left out
         out.append(VarietyComponent(PARALLEL, "ξ(X): some working mode is singular",
-                                    projection.singularity_surface))
+                                    chart.polynomial(projection.singularity_surface)))
     for s in projection.joint_limit_surfaces:
-        out.append(VarietyComponent(LIMIT, f"{s.joint} = {s.value} ({s.bound})", s.polynomial))
+        out.append(VarietyComponent(LIMIT, f"{s.joint} = {s.value} ({s.bound})",
+                                    chart.polynomial(s.polynomial)))
     return out
 
 
@@ -215,7 +234,8 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     be among ``components``): every real solution counts.
     """
     fixed = dict(fixed or {})
-    axes = model.pose if space == WORKSPACE else model.joints
+    chart = space_chart(model, space)
+    axes = chart.axes
     free, sliced = fix_axes(components, axes, fixed)
     timings = {}
     start = time.perf_counter()
@@ -226,7 +246,7 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     invariants = {}  # cell index -> what is constant on a component (for proofs)
     for cell in cad.cells:  # up to tens of thousands in 3-D
         checkpoint()
-        point = _point(axes, free, cell.sample, fixed)
+        point = chart.values(_point(axes, free, cell.sample, fixed))
         if space == WORKSPACE:
             placement = ik_root_placement(model, point, use_limits)
             cells.append(CellCount(cell, ik_count(placement), "", True))

@@ -89,7 +89,7 @@ def compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, back
     """The analysis and the labels of the surfaces left out (shared with ``plot``)."""
     from singcheck.api import elimination_engine
     from singcheck.elimination.projection import project_robot
-    from singcheck.model.robot import build_model, require_polynomial
+    from singcheck.model.robot import build_model
     from singcheck.spaces.analysis import (
         LIMIT,
         WORKSPACE,
@@ -101,7 +101,6 @@ def compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, back
 
     fixed = _slices(slices)
     model = build_model(load_robot(robot))
-    require_polynomial(model, f"the {space} analysis")
     engine = elimination_engine(backend, timeout, not no_cache, progress.note)
     axes = model.pose if space == WORKSPACE else model.joints
     with progress.status(f"computing the discriminant variety of the {space}"):

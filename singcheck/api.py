@@ -282,12 +282,16 @@ _WORKER: dict = {}
 def _worker_signals() -> None:
     """In a forked worker: Ctrl-C and a hangup reach the whole process group, but it is
     the parent that stops the batch (and then terminates the workers); SIGTERM ends a
-    worker silently.  So no worker prints a KeyboardInterrupt traceback."""
+    worker silently.  So no worker prints a KeyboardInterrupt traceback.  A worker dies
+    with the parent's thread that forked it (the main thread: a fork-context pool starts
+    every worker at once), even when the parent is SIGKILLed."""
     import signal
 
+    from singcheck.elimination.cas.guard import die_with_parent
+
+    die_with_parent(_WORKER["parent"])  # SIGTERM: the default action
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _check_indices(indices: list[int]) -> list[tuple[int, dict]]:
@@ -346,7 +350,10 @@ def _forked(robot, trajectories, options, jobs: int, ordered: bool) -> Iterator[
     n = len(trajectories)
     size = max(1, min(64, n // (jobs * 16)))
     chunks = [list(range(i, min(n, i + size))) for i in range(0, n, size)]
-    _WORKER.update(robot=robot, trajectories=trajectories, options=options)
+    import os
+
+    _WORKER.update(robot=robot, trajectories=trajectories, options=options,
+                   parent=os.getpid())
     pool = ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
                                initializer=_worker_signals)
     try:

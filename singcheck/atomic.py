@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 import stat
-import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -31,6 +30,8 @@ def write_atomically(path: str | os.PathLike, text: str, *, make_parents: bool =
 def atomic_file(path: str | os.PathLike, *, make_parents: bool = False) -> Iterator[TextIO]:
     """A text file to write bit by bit (a stream of results) that appears at ``path``
     whole when the block ends, and not at all if it raises (or Ctrl-C stops it)."""
+    import tempfile  # (with shutil, random, bz2, lzma: only when a file is written)
+
     target = Path(path)
     if make_parents:
         target.parent.mkdir(parents=True, exist_ok=True)

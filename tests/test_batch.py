@@ -432,3 +432,57 @@ def test_the_api_reads_several_documents(orthoglide_robot, tmp_path):
     assert [s.name for s in specs] == ["heart1", "heart2"]
     assert [sc.check(orthoglide_robot, s, regions=False).verdict for s in specs] == \
         ["singular", "singularity-free"]
+
+
+def test_forked_workers_die_with_a_sigkilled_singcheck(tmp_path):
+    """SIGKILL cannot be handled: the workers ask the kernel for their own SIGKILL when
+    the parent goes (PR_SET_PDEATHSIG) instead of computing on as orphans."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    paths = _generated(tmp_path, 40)
+    proc = subprocess.Popen([sys.executable, "-m", "singcheck", "run", ORTHO, *paths,
+                             str(DATA / "slow.yaml"), "--format", "jsonl", "--jobs", "2",
+                             "--backend", "flint", "--no-regions"],
+                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, cwd=ROOT,
+                            env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)})
+
+    def workers() -> list[int]:
+        out = []
+        for name in os.listdir("/proc"):
+            try:
+                with open(f"/proc/{name}/stat", "rb") as f:
+                    fields = f.read().rsplit(b")", 1)[1].split()
+            except (OSError, IndexError):
+                continue
+            if int(fields[1]) == proc.pid and fields[0] != b"Z":
+                out.append(int(name))
+        return out
+
+    forked: list[int] = []
+    try:
+        proc.stdout.readline()  # a result streamed: the workers are busy
+        forked = workers()
+        assert forked
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 5
+        while any(os.path.exists(f"/proc/{pid}") and _running(pid) for pid in forked):
+            assert time.monotonic() < deadline, "a worker survived its parent's SIGKILL"
+            time.sleep(0.05)
+    finally:  # never leave a worker behind, even when the test fails
+        proc.kill()
+        proc.wait()
+        for pid in forked:
+            if _running(pid):
+                os.kill(pid, 9)
+
+
+def _running(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            return f.read().rsplit(b")", 1)[1].split()[0] != b"Z"
+    except OSError:
+        return False

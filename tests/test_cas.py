@@ -114,10 +114,38 @@ def test_a_polynomial_of_many_thousand_terms_parses_exactly_and_fast():
 
 
 @pytest.mark.parametrize("text", ["v1+", "2*", "v1^", "(1/2*v1", "3/0*v1", "v1 v2", "x1",
-                                  "1.5*v1", ""])
+                                  "1.5*v1", "", "v1v2", "1/2/3", "--1", "v1^2^3",
+                                  "v0", "v4", "+", "2*-v1"])
 def test_malformed_polynomials_are_refused(text):
     with pytest.raises(PolynomialSyntaxError):
         parse_polynomial(text, POSE)
+
+
+def test_the_quick_reader_of_plain_text_agrees_with_the_general_one(monkeypatch):
+    """Cache entries are read by a one-regex-per-term reader; whatever it accepts must
+    read exactly as the token-by-token parser reads it (random strings of the tokens),
+    and it must read back every polynomial format_polynomial writes."""
+    from singcheck.elimination.cas import polytext
+
+    rng = random.Random(3)
+    x, y, z = POSE.gens()
+    for _ in range(300):
+        p = sum((fmpq(rng.randrange(-10**20, 10**20), rng.randrange(1, 10**12)) *
+                 x**rng.randrange(4) * y**rng.randrange(4) * z**rng.randrange(4)
+                 for _ in range(rng.randrange(6))), POSE.from_dict({}))
+        assert polytext._parse_plain(format_polynomial(p), POSE) == p
+    pieces = ["v1", "v2", "v3", "v4", "^", "^2", "*", "+", "-", "/", "0", "1", "12", "*v1"]
+    accepted = 0
+    for _ in range(20000):
+        text = "".join(rng.choice(pieces) for _ in range(rng.randrange(1, 8)))
+        quick = polytext._parse_plain(text, POSE)
+        if quick is None:
+            continue
+        accepted += 1
+        with monkeypatch.context() as m:
+            m.setattr(polytext, "_parse_plain", lambda text, ctx: None)
+            assert parse_polynomial(text, POSE) == quick, text
+    assert accepted > 500
 
 
 # -- run: the process funnel -----------------------------------------------------------
@@ -194,3 +222,17 @@ def test_live_script_that_never_ends_is_killed(name, monkeypatch):
     with pytest.raises(BackendTimeout):
         backend.eliminate(XI)
     assert time.monotonic() - start < 15
+
+
+def test_live_singular_over_its_memory_bound_is_a_backend_error(monkeypatch):
+    """A product that needs far more than 200 MiB: Singular's allocator fails under the
+    bound (``error: no more memory``) instead of the kernel's OOM killer stepping in."""
+    backend = _backend("singular")
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "200M")
+    monkeypatch.setattr(backend, "script", lambda request: (
+        "ring r=0,(x,y,z,w,u,v),dp;\npoly p = (x+y+z+w+u+v+1)^60;\np = p*p;\n"))
+    start = time.monotonic()
+    with pytest.raises(BackendError, match="Singular ran out of memory under the bound of "
+                                           "200 MiB"):
+        backend.eliminate(XI)
+    assert time.monotonic() - start < 60

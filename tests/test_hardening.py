@@ -5,6 +5,7 @@ extras, undecided boxes."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -279,14 +280,124 @@ def test_a_wrong_answer_is_never_cached(orthoglide, cache_env):
     assert again.cache.stats.hits == 1 and again.cache.stats.corrupted == 0
 
 
-def test_a_forged_region_map_is_recomputed(tmp_path, monkeypatch, capsys, cache_env):
-    """heart 2 lies in R9 of the plane z = 1 (README); an entry whose numbers were
-    changed, with a checksum recomputed by the forger, is not believed."""
+def _exact_value(p, point) -> Fraction:
+    """p at a rational point, with Fractions (independent of FLINT's evaluation)."""
+    total = Fraction(0)
+    for exps, c in p.terms():
+        term = Fraction(int(c.p), int(c.q))
+        for x, e in zip(point, exps, strict=True):
+            term *= Fraction(x) ** int(e)
+        total += term
+    return total
+
+
+def _merged_into_other_signs(payload: dict, cad, victim: int) -> dict:
+    """The forger's best relabelling: region ``victim``'s cells given to a region whose
+    factor signs differ, then all renumbered 1…N in the order of their first cell, as
+    the real numbering is (so only the signs betray it)."""
+    from singcheck.spaces.region_map import RegionMap
+
+    region_map = RegionMap.from_payload(payload)
+    samples = {c.index: c.sample for c in cad.cells}
+
+    def signs(number):
+        index = min(i for i, n in region_map.numbers.items() if n == number)
+        return tuple((v > 0) - (v < 0) for f in region_map.factors
+                     for v in [_exact_value(f, samples[index])])
+
+    other = next(n for n in sorted(set(region_map.numbers.values()))
+                 if signs(n) != signs(victim))
+    merged = {i: other if n == victim else n for i, n in region_map.numbers.items()}
+    renumber: dict[int, int] = {}
+    for index in sorted(merged):
+        renumber.setdefault(merged[index], len(renumber) + 1)
+    return {**payload, "cells": [[list(i), renumber[n]] for i, n in sorted(merged.items())]}
+
+
+def _forgeries(payload: dict, cad) -> dict[str, tuple[dict, str]]:
+    """Forged payloads, each with the check that must catch it."""
+    def swapped(a, b):
+        return {**payload, "cells": [[i, {a: b, b: a}.get(n, n)] for i, n in payload["cells"]]}
+
+    flipped = payload["factors"][0]
+    flipped = flipped[1:] if flipped.startswith("-") else "-" + flipped  # not -f: - binds
+    flipped_level = [list(level) for level in payload["levels"]]
+    flipped_level[0][0] = flipped_level[0][0] + "+1"
+    return {
+        "labels of R9 and R10 swapped": (swapped(9, 10), "not numbered 1, 2"),
+        "R9 merged into another region, renumbered": (
+            _merged_into_other_signs(payload, cad, 9), "different signs"),
+        "a factor changed": ({**payload, "factors": [flipped, *payload["factors"][1:]]},
+                             "factors are not"),
+        "a projection level changed": ({**payload, "levels": flipped_level},
+                                       "projection levels are not"),
+        "a cell dropped": ({**payload, "cells": payload["cells"][1:]}, "cells are not"),
+    }
+
+
+def test_each_forgery_of_a_region_map_fails_its_check(orthoglide_projection):
+    """heart 2 lies in R9 of the plane z = 1 (README); entries forged by someone who
+    holds the cache key (so their HMAC is right) fail the check against the inputs."""
+    from singcheck.spaces.analysis import (
+        WORKSPACE,
+        analyse,
+        decomposition,
+        select_surfaces,
+        workspace_variety,
+    )
+    from singcheck.spaces.region_map import RegionMap
+
+    fixed = {"z": Fraction(1)}
+    components, _ = select_surfaces(workspace_variety(orthoglide_projection), WORKSPACE,
+                                    "auto", 2)
+    model = orthoglide_projection.model
+    true_map = RegionMap.of(analyse(WORKSPACE, model, components, fixed))
+    cad = decomposition(model.pose, components, fixed)[2]
+    assert true_map.verify(cad) == ""
+    payload = true_map.payload()
+    forgeries = _forgeries(payload, cad)
+    for what, (forged, phrase) in forgeries.items():
+        assert forged != payload, what
+        problem = RegionMap.from_payload(forged).verify(cad)
+        assert phrase in problem, (what, problem)
+
+
+def test_a_forged_region_map_is_detected_and_recomputed(tmp_path, monkeypatch, capsys,
+                                                        cache_env):
+    """The forger holds the key (the HMAC is right): the entry is checked against its
+    inputs, the forgery is reported and recomputed, and heart 2 is in R9 again."""
     args = ("run", ORTHO, str(TRAJECTORIES / "heart2.yaml"), "-q", "--backend", "flint",
             "--format", "json")
     code, out, err = run_cli(monkeypatch, capsys, *args)
     assert code == 0, err
     assert json.loads(out)["trajectories"][0]["workspace"]["region"].startswith("R9 ")
+    (entry,) = (cache_env / "regions").glob("*.json")
+    honest = entry.read_bytes()
+    doc = json.loads(honest)
+    swapped = {9: 10, 10: 9}
+    doc["payload"]["cells"] = [[i, swapped.get(n, n)] for i, n in doc["payload"]["cells"]]
+    from singcheck.elimination.cache import write_entry
+    from singcheck.spaces import path_regions
+    from singcheck.spaces.region_map import FORMAT
+
+    write_entry(entry, FORMAT, doc["key"], doc["payload"])  # sealed with the real key
+    assert entry.read_bytes() != honest
+    path_regions._SUBSPACES.clear()
+    code, out, err = run_cli(monkeypatch, capsys, *(a for a in args if a != "-q"))
+    assert code == 0, err
+    assert json.loads(out)["trajectories"][0]["workspace"]["region"].startswith("R9 ")
+    assert "the cached region map failed its check (its regions are not numbered" in err
+    assert json.loads(entry.read_bytes())["payload"] == json.loads(honest)["payload"]
+
+
+def test_a_region_map_forged_without_the_key_is_recomputed(tmp_path, monkeypatch, capsys,
+                                                           cache_env):
+    """An entry whose numbers were changed and whose checksum was recomputed by a
+    forger without the user's key is not believed either."""
+    args = ("run", ORTHO, str(TRAJECTORIES / "heart2.yaml"), "-q", "--backend", "flint",
+            "--format", "json")
+    code, out, err = run_cli(monkeypatch, capsys, *args)
+    assert code == 0, err
     (entry,) = (cache_env / "regions").glob("*.json")
     doc = json.loads(entry.read_text())
     doc["payload"]["cells"] = [[index, 10 if n == 9 else n]
@@ -329,6 +440,15 @@ def _alive(pid: int) -> bool:
         return False
 
 
+def _pids_written(path: Path, proc: subprocess.Popen) -> list[int]:
+    """The pids a fake wrote to ``path`` (one line), waiting for it while ``proc`` runs."""
+    deadline = time.monotonic() + 60
+    while not (path.exists() and path.read_text().endswith("\n")):
+        assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
+        time.sleep(0.05)
+    return [int(pid) for pid in path.read_text().split()]
+
+
 def _fake_env(tmp_path: Path, hang: bool) -> dict:
     bin_dir = fake_cas(tmp_path, SETSID_CAS)
     tmp = tmp_path / "tmp"
@@ -346,12 +466,7 @@ def test_sigterm_and_sighup_kill_the_cas_and_its_setsid_grandchild(tmp_path, sig
                              str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular",
                              "-q"], env=env, cwd=ROOT, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
-    pids_file = tmp_path / "pids"
-    deadline = time.monotonic() + 60
-    while not (pids_file.exists() and pids_file.read_text().endswith("\n")):
-        assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
-        time.sleep(0.05)
-    cas, grandchild = map(int, pids_file.read_text().split())
+    cas, grandchild = _pids_written(tmp_path / "pids", proc)
     assert _alive(cas) and _alive(grandchild)
     assert os.getsid(grandchild) == grandchild != os.getpgid(cas)  # escaped the group
     proc.send_signal(sig)
@@ -373,6 +488,207 @@ def test_a_setsid_grandchild_does_not_outlive_a_finished_cas(tmp_path):
     time.sleep(0.2)
     assert not _alive(cas) and not _alive(grandchild)
     assert list((tmp_path / "tmp").iterdir()) == []
+
+
+# the fake CAS forks a helper in its group and a grandchild that leaves it with setsid,
+# each carrying a marker in its command line, then hangs
+MARKED_CAS = VERSION + """\
+import os, subprocess, sys, time
+marker = os.environ["FAKE_MARKER"]
+sleep = [sys.executable, "-c", "import time; time.sleep(300)", marker]
+subprocess.Popen(sleep)
+setsid = subprocess.Popen(sleep, start_new_session=True)
+with open(os.environ["FAKE_PIDS"], "w") as f:
+    f.write(f"{os.getpid()} {setsid.pid}\\n")
+time.sleep(300)
+"""
+
+# run_program from a worker thread (as a Dask worker or an API user's thread would)
+THREAD_DRIVER = """\
+import sys, threading
+from singcheck.elimination.cas.process import run_program
+worker = threading.Thread(target=run_program, args=(sys.argv[1:], 600))
+worker.start()
+worker.join()
+"""
+
+
+def _marked(marker: str) -> list[int]:
+    """The live processes whose command line holds ``marker`` (scanning /proc)."""
+    out = []
+    for name in os.listdir("/proc"):
+        if name.isdigit() and _alive(int(name)):
+            try:
+                with open(f"/proc/{name}/cmdline", "rb") as f:
+                    if marker.encode() in f.read():
+                        out.append(int(name))
+            except OSError:
+                pass
+    return out
+
+
+@pytest.mark.parametrize("caller", ["cli", "thread"])
+def test_a_sigkilled_singcheck_leaves_no_cas_process(tmp_path, caller):
+    """SIGKILL of singcheck cannot be handled; the guard the kernel signals
+    (PR_SET_PDEATHSIG) kills the CAS, its helper and its setsid'd grandchild."""
+    marker = str(tmp_path)  # in the guard's, the fake's and its children's command lines
+    env = {**_fake_env(tmp_path, hang=True), "FAKE_MARKER": marker}
+    fake_cas(tmp_path, MARKED_CAS)
+    if caller == "cli":
+        argv = [sys.executable, "-m", "singcheck", "run", ORTHO,
+                str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular", "-q"]
+    else:
+        argv = [sys.executable, "-c", THREAD_DRIVER, str(tmp_path / "bin" / "Singular")]
+    proc = subprocess.Popen(argv, env=env, cwd=ROOT, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE)
+    try:
+        cas, grandchild = _pids_written(tmp_path / "pids", proc)
+        deadline = time.monotonic() + 10
+        while len(_marked(marker)) < 4:  # the guard, the fake, its helper, its grandchild
+            assert time.monotonic() < deadline, _marked(marker)
+            time.sleep(0.05)
+        assert os.getsid(grandchild) == grandchild != os.getsid(cas)
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 5
+        while _marked(marker):
+            assert time.monotonic() < deadline, f"survived SIGKILL: {_marked(marker)}"
+            time.sleep(0.05)
+    finally:  # never leave a process behind, even when the test fails
+        proc.kill()
+        proc.wait()
+        for pid in _marked(marker):
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
+
+
+# -- memory: each CAS process runs under an address-space bound ---------------------------
+
+# asks for 8 GiB of address space (malloc, untouched: it costs no memory when granted)
+GREEDY_CAS = VERSION + """\
+import ctypes, sys
+malloc = ctypes.CDLL(None).malloc
+malloc.restype = ctypes.c_void_p
+if not malloc(ctypes.c_size_t(8 << 30)):
+    sys.exit("   ? error: no more memory")  # what Singular prints
+print("granted")
+"""
+
+
+@pytest.mark.parametrize("limit, code, phrase", [
+    ("256M", 4, "Singular ran out of memory under the bound of 256 MiB per CAS process"),
+    ("none", 4, "0 'begin' markers"),  # no bound: granted, then no result
+])
+def test_a_cas_over_its_memory_bound_is_a_one_line_backend_error(tmp_path, limit, code,
+                                                                 phrase):
+    env = {**_fake_env(tmp_path, hang=False), "SINGCHECK_MEMORY_LIMIT": limit}
+    fake_cas(tmp_path, GREEDY_CAS)
+    out = subprocess.run([sys.executable, "-m", "singcheck", "run", ORTHO,
+                          str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular", "-q"],
+                         env=env, cwd=ROOT, capture_output=True, text=True, timeout=120)
+    one_line_error(out.returncode, out.stderr, code, phrase)
+
+
+def test_a_bad_memory_bound_is_a_usage_error(tmp_path):
+    env = {**_fake_env(tmp_path, hang=False), "SINGCHECK_MEMORY_LIMIT": "lots"}
+    out = subprocess.run([sys.executable, "-m", "singcheck", "run", ORTHO,
+                          str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular", "-q"],
+                         env=env, cwd=ROOT, capture_output=True, text=True, timeout=120)
+    one_line_error(out.returncode, out.stderr, 2, "SINGCHECK_MEMORY_LIMIT='lots'")
+
+
+# in-process backends run in a forked child, under the same bounds
+
+
+def _greedy_eliminate(self, request):
+    """Asks for 8 GiB of address space (untouched: free when granted), then hangs."""
+    import ctypes
+
+    malloc = ctypes.CDLL(None).malloc
+    malloc.restype = ctypes.c_void_p
+    if not malloc(ctypes.c_size_t(8 << 30)):
+        raise MemoryError
+    time.sleep(300)
+
+
+def _aborting_eliminate(self, request):
+    """Dies the way GMP does when an allocation fails."""
+    os.write(2, b"GNU MP: Cannot allocate memory (size=4294967296)\n")
+    os.abort()
+
+
+def _endless_eliminate(self, request):
+    while True:  # one long call that no checkpoint interrupts
+        sum(range(10_000))
+
+
+@pytest.mark.parametrize("backend", ["flint", "sympy"])
+@pytest.mark.parametrize("eliminate, env, code, phrase", [
+    (_endless_eliminate, {}, 3, "unknown: time limit (1 s, --timeout): the {} backend did "
+                                "not finish and was stopped"),
+    (_greedy_eliminate, {"SINGCHECK_MEMORY_LIMIT": "256M"}, 4,
+     "the {} backend ran out of memory under the bound of 256 MiB"),
+    (_aborting_eliminate, {}, 4, "the {} backend died of SIGABRT under the bound of"),
+])
+def test_in_process_projection_is_bounded_in_time_and_memory(
+        tmp_path, monkeypatch, capsys, cache_env, backend, eliminate, env, code, phrase):
+    from singcheck.elimination.cas import flint_backend, sympy_backend
+
+    for cls in (flint_backend.FlintBackend, sympy_backend.SympyBackend):
+        monkeypatch.setattr(cls, "eliminate", eliminate)  # the forked child inherits it
+    for k, v in env.items():
+        monkeypatch.setenv(k, v)
+    start = time.monotonic()
+    code_, _, err = run_cli(monkeypatch, capsys, "run", ORTHO,
+                            str(TRAJECTORIES / "heart1.yaml"), "--backend", backend,
+                            "--timeout", "1", "-q")
+    one_line_error(code_, err, code, phrase.format(backend))
+    assert time.monotonic() - start < 20
+
+
+FORKED_DRIVER = """\
+import os, sys, time
+from singcheck.elimination.cas.isolated import run_forked
+
+def hang(path):
+    with open(path, "w") as f:
+        f.write(f"{os.getpid()}\\n")
+    time.sleep(300)
+
+run_forked(hang, sys.argv[1], 600, "hang")
+"""
+
+
+def test_the_forked_child_dies_with_a_sigkilled_singcheck(tmp_path):
+    pid_file = tmp_path / "pid"
+    proc = subprocess.Popen([sys.executable, "-c", FORKED_DRIVER, str(pid_file)], cwd=ROOT,
+                            env={**os.environ, "PYTHONPATH": str(ROOT)})
+    child = None
+    try:
+        (child,) = _pids_written(pid_file, proc)
+        assert _alive(child)
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 5
+        while _alive(child):
+            assert time.monotonic() < deadline, "the forked child survived SIGKILL"
+            time.sleep(0.05)
+    finally:
+        proc.kill()
+        proc.wait()
+        if child and _alive(child):
+            os.kill(child, signal.SIGKILL)
+
+
+def test_without_a_memory_bound_the_greedy_child_gets_its_memory(monkeypatch):
+    """The other side of the test above: the 8 GiB are granted without the bound (so it
+    is the bound that refused them), and the child then runs into the time limit."""
+    from singcheck.budget import TimeLimitExceeded
+    from singcheck.elimination.cas.isolated import run_forked
+
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "none")
+    with pytest.raises(TimeLimitExceeded):
+        run_forked(lambda r: _greedy_eliminate(None, r), None, 1.0, "greedy")
 
 
 # -- 8. -o targets ------------------------------------------------------------------------

@@ -9,6 +9,17 @@ from __future__ import annotations
 from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 
+def memo_per_object(cache: dict, obj, compute, keep: int = 256):
+    """``compute(obj)``, once per object: the entry keeps the object, so its id is not
+    reused while it is there (the cache is emptied past ``keep`` entries)."""
+    hit = cache.get(id(obj))
+    if hit is None or hit[0] is not obj:
+        if len(cache) > keep:
+            cache.clear()
+        hit = cache[id(obj)] = (obj, compute(obj))
+    return hit[1]
+
+
 def restrict(p: fmpq_mpoly, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
     """``p`` (free of the dropped variables) re-expressed in the smaller context ``ctx``."""
     names = p.context().names()

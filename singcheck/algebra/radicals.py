@@ -46,8 +46,17 @@ def radical_name(p: int) -> str:
 
 def radical_prime(name: str) -> int | None:
     """p when ``name`` is the variable of √p, else None."""
-    m = _RADICAL.match(name)
-    return int(m.group(1)) if m else None
+    hit = _RADICAL_PRIMES.get(name, _MISSING)
+    if hit is _MISSING:
+        m = _RADICAL.match(name)
+        hit = int(m.group(1)) if m else None
+        if len(_RADICAL_PRIMES) < 4096:  # names of variables: few, asked for per path
+            _RADICAL_PRIMES[name] = hit
+    return hit
+
+
+_RADICAL_PRIMES: dict[str, int | None] = {}
+_MISSING = object()
 
 
 def angle_names(v: str) -> tuple[str, str]:
@@ -216,14 +225,20 @@ def cos_pi(q: Fraction) -> Surd | None:
     sign = 1
     if j > 6:
         j, sign = 12 - j, -1  # cos(π - x) = -cos x
-    table = {0: Surd.rational(1),
-             1: (Surd.sqrt(Fraction(6)) + Surd.sqrt(Fraction(2))) / 4,
-             2: Surd.sqrt(Fraction(3)) / 2,
-             3: Surd.sqrt(Fraction(2)) / 2,
-             4: Surd.rational(Fraction(1, 2)),
-             5: (Surd.sqrt(Fraction(6)) - Surd.sqrt(Fraction(2))) / 4,
-             6: Surd()}
-    return table[j] * sign
+    if not _COS_TABLE:
+        _COS_TABLE.update({0: Surd.rational(1),
+                           1: (Surd.sqrt(Fraction(6)) + Surd.sqrt(Fraction(2))) / 4,
+                           2: Surd.sqrt(Fraction(3)) / 2,
+                           3: Surd.sqrt(Fraction(2)) / 2,
+                           4: Surd.rational(Fraction(1, 2)),
+                           5: (Surd.sqrt(Fraction(6)) - Surd.sqrt(Fraction(2))) / 4,
+                           6: Surd()})
+    return _COS_TABLE[j] * sign
+
+
+#: cos(jπ/12) for j = 0 … 6, built on first use (exact surd arithmetic: not at import,
+#: and not again for every angle of every path)
+_COS_TABLE: dict[int, Surd] = {}
 
 
 def sin_pi(q: Fraction) -> Surd | None:

@@ -148,7 +148,7 @@ def evaluate_trig(p: fmpq_mpoly, t: arb, tight: bool = False) -> arb:
     split = _split(p)
     if isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
         return split(t)
-    s, c = t.sin_cos()
+    s, c = _sin_cos_multiple(t, 1)
     total = arb(0)
     for p0, p1 in reversed(split):
         total = total * t + p0(c) + s * p1(c)
@@ -165,13 +165,34 @@ _WIDE = 1e-3
 _FOURIER_MIN_DEGREE = 4
 
 
+_LAST_T: tuple = (None, 0, {})  # (t, precision, {k: (sin kt, cos kt)})
+
+
+def _sin_cos_multiple(t: arb, k: int) -> tuple[arb, arb]:
+    """Arb's enclosures of sin kt and cos kt over the ball t, remembered for the last
+    ball asked for (a leg's coefficients and discriminant are evaluated at the same t
+    one after another).  The memo is replaced whole, never edited for another t, so
+    threads sharing it cannot mix two balls' values."""
+    global _LAST_T
+    last = _LAST_T
+    if last[0] is t and last[1] == ctx.prec:
+        values = last[2]
+    else:
+        values = {}
+        _LAST_T = (t, ctx.prec, values)
+    hit = values.get(k)
+    if hit is None:
+        hit = values[k] = (t if k == 1 else k * t).sin_cos()
+    return hit
+
+
 def _fourier_value(p: fmpq_mpoly, t: arb) -> arb | None:
     """The Fourier-form enclosure of p over the ball t (None when p's degree in c is low)."""
     form = _fourier(p)
     if form is None:
         return None
     terms, harmonics, dt = form
-    sc = {k: (k * t).sin_cos() for k in harmonics}
+    sc = {k: _sin_cos_multiple(t, k) for k in harmonics}
     powers = [arb(1), t]
     for _ in range(dt - 1):
         powers.append(powers[-1] * t)

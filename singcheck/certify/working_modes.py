@@ -108,7 +108,7 @@ def _pieces(interval: TimeRange) -> list[arb]:
     return [a.union(b) for a, b in zip(edges, edges[1:], strict=False)]
 
 
-_TIGHT_ABOVE = 0.05  # radius above which a failed piece is retried with tight enclosures
+_TIGHT_ABOVE = 0.05  # radius above which a piece gets tight enclosures (high-degree legs)
 _TIGHT_DEGREE = 10  # ... when the leg's polynomials have at least this degree in (s, c)
 
 
@@ -145,9 +145,10 @@ def _halves(piece: arb) -> tuple[arb, arb]:
 def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True) -> bool:
     """True when ``predicate(ball, tight)`` is proven on balls covering the whole range:
     a quick proof by ball arithmetic that spares a root isolation (False means "not
-    proven").  A wide piece where it fails is tried again with ``tight`` enclosures
-    (when ``retry_tight``); a piece where it still fails is halved (ball enclosures
-    tighten as pieces shrink) until a budget of evaluations is spent."""
+    proven").  With ``retry_tight`` a wide piece is tried with ``tight`` enclosures at
+    once (they include the plain one, which the polynomials' degree makes fail there);
+    a piece where it fails is halved (ball enclosures tighten as pieces shrink) until a
+    budget of evaluations is spent."""
     todo = _pieces(interval)
     budget = _budget(interval)
     spent = 0
@@ -155,12 +156,8 @@ def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True) -> boo
         piece = todo.pop()
         checkpoint()
         spent += 1
-        if predicate(piece, False):
+        if predicate(piece, retry_tight and piece.rad() > _TIGHT_ABOVE):
             continue
-        if retry_tight and piece.rad() > _TIGHT_ABOVE:
-            spent += 1
-            if predicate(piece, True):
-                continue
         if spent + len(todo) + 2 > budget:
             return False
         todo += _halves(piece)

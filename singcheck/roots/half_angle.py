@@ -151,7 +151,12 @@ def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
             ends = [arb(abs(q)).root(k) if k > 1 else arb(abs(q)) for q in (rr.lo, rr.hi)]
             return sign * ends[0].union(ends[1])
 
+    done: dict[float, arb] = {}  # tol -> its ball: the root is mapped once per tolerance
+
     def ball(tol: float) -> arb:
+        hit = done.get(tol)
+        if hit is not None:
+            return hit
         width = exact_tolerance(tol) / 4
         bits = bits_for(tol)
         rr.bisect_to(width)
@@ -159,7 +164,8 @@ def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
             width /= 16
             rr.bisect_to(width)
         with working_precision(bits):
-            return 2 * u_bounds(bits).atan()
+            hit = done[tol] = 2 * u_bounds(bits).atan()
+        return hit
 
     return ball
 

@@ -87,10 +87,9 @@ class RationalRoot:
     def sign_at(self, q: fmpq) -> int:
         """The exact sign of the polynomial at q: a ball evaluation when it decides,
         exact rational arithmetic otherwise."""
-        if self._balls is None:
-            with working_precision(128):
-                self._balls = arb_poly([arb(c) for c in self.poly.coeffs()])
         with working_precision(128):
+            if self._balls is None:
+                self._balls = _ball_polys_of(self.poly, 128)[0]
             value = self._balls(arb(q))
         if value > 0:
             return 1
@@ -202,9 +201,7 @@ class RationalRoot:
     def _ball_polys(self, bits: int) -> tuple[arb_poly, arb_poly]:
         """f and f' as ball polynomials at ``bits`` of precision (memoised)."""
         if self._newton_polys is None or self._newton_polys[0] != bits:
-            coeffs = [arb(c) for c in self.poly.coeffs()]
-            value = arb_poly(coeffs)
-            self._newton_polys = (bits, value, value.derivative())
+            self._newton_polys = (bits, *_ball_polys_of(self.poly, bits))
         return self._newton_polys[1], self._newton_polys[2]
 
     def _newton_step(self, target: fmpq) -> bool:
@@ -260,6 +257,22 @@ class RationalRoot:
             self.lo = self.hi = q
             return True
         return False
+
+
+_BALL_POLYS: dict = {}
+
+
+def _ball_polys_of(poly: fmpq_poly, bits: int) -> tuple[arb_poly, arb_poly]:
+    """f and f' as ball polynomials rounded at ``bits`` (the current precision must be
+    ``bits``), shared by the roots of one factor (they hold the same ``poly`` object)."""
+    key = (id(poly), bits)
+    hit = _BALL_POLYS.get(key)
+    if hit is None or hit[0] is not poly:  # the entry holds poly: its id is not reused
+        if len(_BALL_POLYS) > 256:
+            _BALL_POLYS.clear()
+        value = arb_poly(poly)
+        hit = _BALL_POLYS[key] = (poly, value, value.derivative())
+    return hit[1], hit[2]
 
 
 def _short_dyadic_hull(lo: fmpq, hi: fmpq, target: fmpq) -> tuple[fmpq, fmpq]:
@@ -388,7 +401,7 @@ def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
     (only the roots ≥ 0 when ``nonnegative_only``)."""
     if p.degree() < 1:
         return []
-    num = fmpz_poly([int(c * p.denom()) for c in p.coeffs()])
+    num = p.numer()  # p = num / denominator: the same roots
     _, factors = num.factor_squarefree()
     out = []
     for factor, mult in factors:

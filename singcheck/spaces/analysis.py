@@ -226,6 +226,16 @@ def _within(model: RobotModel, joints) -> bool:
                if j in limits for lo, hi in [limits[j]])
 
 
+def decomposition(axes: tuple[str, ...], components: list[VarietyComponent],
+                  fixed: dict[str, Fraction]) -> tuple[tuple[str, ...],
+                                                       list[VarietyComponent], OpenCAD]:
+    """The free axes, the components restricted to the slice, and the open CAD of their
+    complement (cells with rational samples; no regions joined yet: the cheap part)."""
+    free, sliced = fix_axes(components, axes, fixed)
+    cad = open_cad([c.polynomial for c in sliced]) if sliced else _trivial_cad(free)
+    return free, sliced, cad
+
+
 def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
             fixed: dict[str, Fraction] | None = None, use_limits: bool = True) -> SpaceAnalysis:
     """Decompose the complement of the variety and count solutions in every cell.
@@ -236,10 +246,9 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     fixed = dict(fixed or {})
     chart = space_chart(model, space)
     axes = chart.axes
-    free, sliced = fix_axes(components, axes, fixed)
     timings = {}
     start = time.perf_counter()
-    cad = open_cad([c.polynomial for c in sliced]) if sliced else _trivial_cad(free)
+    free, sliced, cad = decomposition(axes, components, fixed)
     timings["decomposition_s"] = time.perf_counter() - start
     start = time.perf_counter()
     cells = []

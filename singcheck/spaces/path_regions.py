@@ -493,7 +493,13 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
     """The region map of the subspace where ``fixed`` holds and the surfaces left out
     (``--surfaces auto``): from this process's memo, else the disk cache, else computed
     (then stored).  A batch of paths in one plane shares it."""
-    from singcheck.spaces.analysis import WORKSPACE, analyse, select_surfaces, workspace_variety
+    from singcheck.spaces.analysis import (
+        WORKSPACE,
+        analyse,
+        decomposition,
+        select_surfaces,
+        workspace_variety,
+    )
     from singcheck.spaces.region_map import RegionMap
 
     memo_key = (id(projection), tuple(sorted(fixed.items())))
@@ -504,6 +510,14 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
             left_out = [*left_out, "ξ(X) (not expanded)"]
         key = cache.key([c.polynomial for c in components], fixed) if cache else None
         regions = cache.load(key) if cache else None
+        if regions is not None:  # checked against the inputs, not only by its HMAC
+            _, _, cad = decomposition(projection.model.pose, components, fixed)
+            problem = regions.verify(cad)
+            if problem:
+                if notify:
+                    notify(f"the cached region map failed its check ({problem}): "
+                           "recomputed")
+                regions = None
         if regions is None:
             if notify:
                 where = ", ".join(f"{k} = {v}" for k, v in fixed.items()) or "in 3-D"

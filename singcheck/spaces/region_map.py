@@ -12,7 +12,10 @@ regions takes seconds; reading it back, milliseconds).  An entry is keyed by the
 of the variety's polynomials, the slice and :data:`REGIONS_VERSION`, and carries an HMAC
 of its payload under the cache's secret key (:mod:`singcheck.elimination.cache`): a
 damaged entry, or one forged by anyone who cannot read that key, is ignored and
-recomputed, never trusted.
+recomputed.  A loaded map is also checked against its inputs (:meth:`RegionMap.verify`,
+against the open CAD recomputed from the variety: about 2 % of the cost of joining the
+regions), so that even an entry sealed with the right key cannot relabel, renumber or
+re-sign regions; a map that fails is recomputed.
 """
 
 from __future__ import annotations
@@ -28,7 +31,6 @@ from singcheck.elimination.cas.polytext import (
     format_polynomial,
     parse_polynomial,
 )
-from singcheck.spaces.cad import cell_index_of, fiber
 
 #: Bump when the decomposition or the joining of regions changes what a number means.
 REGIONS_VERSION = "2"
@@ -50,8 +52,47 @@ class RegionMap:
 
     def region_at(self, point: list[Fraction]) -> int | None:
         """The region of the open cell holding a rational point (None on a root)."""
+        from singcheck.spaces.cad import cell_index_of, fiber  # (not for runs that never ask)
+
         index = cell_index_of(lambda p: fiber(self.levels, self.variables, p), tuple(point))
         return None if index is None else self.numbers.get(index)
+
+    def verify(self, cad) -> str:
+        """Check this map against ``cad``, the open CAD recomputed from the map's inputs
+        (:func:`~singcheck.spaces.analysis.decomposition`: milliseconds, against seconds
+        for joining the regions); "" when it holds, else what is wrong.
+
+        Checked exactly: the factors and every projection level are those of the
+        inputs; the map numbers exactly the CAD's cells; the numbers are 1…N in the
+        order of each region's first cell (the rule regions are numbered by); and the
+        cells of one region have the same sign of every factor at their samples (a
+        connected set off the variety cannot change sign).  So a relabelled, renumbered
+        or re-signed entry is caught; what is trusted (HMAC) is only which cells of the
+        same signs were joined into one region.
+        """
+        if tuple(cad.variables) != self.variables:
+            return "its axes are not the slice's"
+        if set(map(format_polynomial, cad.factors)) != set(map(format_polynomial, self.factors)):
+            return "its factors are not those of the variety"
+        if len(cad.levels) != len(self.levels) or any(
+                set(map(format_polynomial, a)) != set(map(format_polynomial, b))
+                for a, b in zip(cad.levels, self.levels, strict=True)):
+            return "its projection levels are not those of the variety"
+        samples = {c.index: c.sample for c in cad.cells}
+        if set(samples) != set(self.numbers):
+            return "its cells are not the decomposition's"
+        regions: dict[int, list[tuple[int, ...]]] = {}
+        for index in sorted(self.numbers):
+            regions.setdefault(self.numbers[index], []).append(index)
+        if list(regions) != list(range(1, len(regions) + 1)):
+            return "its regions are not numbered 1, 2, … in the order of their first cell"
+        from singcheck.spaces.regions import factor_signs
+
+        for number, cells in regions.items():
+            signs = {factor_signs(cad, samples[index]) for index in cells}
+            if len(signs) > 1:
+                return f"region R{number} has cells where a factor has different signs"
+        return ""
 
     # -- storage ------------------------------------------------------------------
 

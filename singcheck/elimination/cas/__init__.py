@@ -34,22 +34,26 @@ def _external(name: str):
 
 
 def get_backend(name: str = "auto", *, timeout: float | None = None) -> EliminationBackend:
-    """The backend called ``name`` (``auto``: Singular, else Macaulay2, else SymPy)."""
+    """The backend called ``name`` (``auto``: Singular, else Macaulay2, else SymPy), each
+    elimination bounded by ``timeout`` seconds (600) and the memory bound (the CAS
+    processes as the forked children of the in-process backends: :mod:`.isolated`)."""
     if name == "auto":
         for candidate in ("singular", "macaulay2"):
             if _external(candidate).find() is not None:
                 return get_backend(candidate, timeout=timeout)
-        return get_backend("sympy")
-    if name == "sympy":
-        from singcheck.elimination.cas.sympy_backend import SympyBackend
+        return get_backend("sympy", timeout=timeout)
+    from singcheck.elimination.cas.external import DEFAULT_TIMEOUT
 
-        return SympyBackend()
-    if name == "flint":
-        from singcheck.elimination.cas.flint_backend import FlintBackend
+    if name in ("sympy", "flint"):  # in a forked child, with a time and a memory bound
+        from singcheck.elimination.cas.isolated import Isolated
 
-        return FlintBackend()
+        if name == "sympy":
+            from singcheck.elimination.cas.sympy_backend import SympyBackend as InProcess
+        else:
+            from singcheck.elimination.cas.flint_backend import FlintBackend as InProcess
+        return Isolated(InProcess(), timeout or DEFAULT_TIMEOUT)
     if name in ("singular", "macaulay2"):
-        from singcheck.elimination.cas.external import DEFAULT_TIMEOUT, ExternalBackend
+        from singcheck.elimination.cas.external import ExternalBackend
 
         return ExternalBackend(_external(name), timeout=timeout or DEFAULT_TIMEOUT)
     raise BackendError(f"unknown backend {name!r}; choose one of: auto, "

@@ -9,37 +9,58 @@ temporary directory that is removed afterwards; no user init file is read
 
 from __future__ import annotations
 
-import glob
 import os
-import shutil
-import sys
-import sysconfig
-import tempfile
 from dataclasses import dataclass
 from functools import cache
-from importlib import resources
 
-from singcheck.elimination.cas.process import run_program
 from singcheck.elimination.cas.scripts import macaulay2_script, parse_result, singular_script
 from singcheck.elimination.requests import EliminationRequest, EliminationResult
 from singcheck.errors import BackendError
+
+# (the subprocess machinery, tempfile and importlib.resources are imported where a CAS
+# actually runs: a warm run answers from the cache and never needs them)
 
 DEFAULT_TIMEOUT = 600.0
 
 
 def library_path(filename: str) -> str:
-    """Absolute path of a file of ``backends/`` (installed as ``singcheck.cas_library``)."""
+    """Absolute path of a file of ``backends/`` (installed as ``singcheck.cas_library``):
+    beside the package's ``__init__.py`` when it is a directory on disk (importlib's
+    resource readers only when it is not, e.g. in a zip)."""
+    import singcheck.cas_library as library
+
+    if library.__file__:
+        path = os.path.join(os.path.dirname(library.__file__), filename)
+        if os.path.isfile(path):
+            return path
+    from importlib import resources
+
     return str(resources.files("singcheck.cas_library").joinpath(filename))
 
 
 def _passagemath_singular() -> str | None:
     """The ``Singular`` binary shipped by PyPI's passagemath-singular, if installed."""
+    import glob
+    import sys
+    import sysconfig
+
     roots = {sysconfig.get_paths()["purelib"], sysconfig.get_paths()["platlib"]}
     roots.update(p for p in sys.path if p.endswith("site-packages"))
     for root in roots:
         for path in glob.glob(os.path.join(root, "sage_wheels", "bin", "Singular")):
             if os.access(path, os.X_OK):
                 return path
+    return None
+
+
+def _on_path(program: str) -> str | None:
+    """The first executable file called ``program`` in a directory of PATH, as
+    ``shutil.which`` finds it on POSIX (without importing shutil, and with it bz2 and
+    lzma, into every warm run)."""
+    for directory in os.get_exec_path():
+        path = os.path.join(directory or os.curdir, program)
+        if os.path.isfile(path) and os.access(path, os.X_OK):
+            return path
     return None
 
 
@@ -51,7 +72,7 @@ class ExternalCAS:
     install_hint: str
 
     def find(self) -> str | None:
-        found = shutil.which(self.program)
+        found = _on_path(self.program)
         if found is None and self.name == "singular":
             found = _passagemath_singular()
         return found
@@ -113,6 +134,8 @@ def cas_version(cas: ExternalCAS, executable: str) -> str:
 
 
 def _ask_version(cas: ExternalCAS, executable: str) -> str:
+    from singcheck.elimination.cas.process import run_program
+
     run = run_program(cas.version_argv(executable), timeout=60)
     text = (run.stdout or run.stderr).strip().splitlines()
     if not text:
@@ -121,6 +144,25 @@ def _ask_version(cas: ExternalCAS, executable: str) -> str:
     if cas.name == "singular" and "version" in first:
         return first.split("version", 1)[1].split("(")[0].strip()
     return first.strip()
+
+
+def out_of_memory(run) -> str:
+    """How a failed :class:`~singcheck.elimination.cas.process.ProgramRun` met its
+    address-space bound ("" when it did not seem to): its last 4 KiB of output says an
+    allocation failed (Singular: "error: no more memory"; Macaulay2: "out of memory";
+    C++ and GMP allocators alike), or it died of SIGABRT or SIGKILL, the ways
+    allocators, garbage collectors (and the kernel's OOM killer) end it."""
+    import re
+    import signal
+
+    tail = run.stdout[-4096:] + "\n" + run.stderr[-4096:]
+    if re.search(r"no more memory|out of memory|cannot allocate memory|bad_alloc|"
+                 r"memory exhausted|unable to allocate", tail, re.IGNORECASE):
+        return "ran out of memory"
+    if run.returncode in (-signal.SIGABRT, -signal.SIGKILL):
+        return (f"died of {signal.Signals(-run.returncode).name} (most likely out of "
+                "memory)")
+    return ""
 
 
 class ExternalBackend:
@@ -150,6 +192,11 @@ class ExternalBackend:
             return self.script(request) + "\n" + f.read()
 
     def eliminate(self, request: EliminationRequest) -> EliminationResult:
+        import tempfile
+
+        from singcheck.elimination.cas.limits import describe_limit
+        from singcheck.elimination.cas.process import run_program
+
         script = self.script(request)
         with tempfile.TemporaryDirectory(prefix="singcheck-") as tmp:
             suffix = "sing" if self.name == "singular" else "m2"
@@ -157,6 +204,13 @@ class ExternalBackend:
             with open(path, "w", encoding="utf-8") as f:
                 f.write(script)
             run = run_program(self.cas.argv(self.executable, path), self.timeout, cwd=tmp)
+        if run.returncode != 0 and run.memory_limit:
+            memory = out_of_memory(run)
+            if memory:
+                raise BackendError(
+                    f"{self.cas.program} {memory} under the bound of "
+                    f"{describe_limit(run.memory_limit)} per CAS process; raise "
+                    "SINGCHECK_MEMORY_LIMIT (or set it to none) if the robot needs more")
         polys = parse_result(self.cas.program, run.stdout, run.stderr, request)
         if run.returncode != 0:
             raise BackendError(f"{self.cas.program} exited with status {run.returncode}")

@@ -25,6 +25,13 @@ class FlintBackend:
 
         return version("python-flint")
 
+    def preload(self, request: EliminationRequest) -> None:
+        """Import what :meth:`eliminate` needs (before a fork: :mod:`.isolated`)."""
+        if leg_structure(request) is None:
+            from singcheck.elimination.cas.sympy_backend import SympyBackend
+
+            SympyBackend().preload(request)
+
     def eliminate(self, request: EliminationRequest) -> EliminationResult:
         structure = leg_structure(request)
         if structure is None:

@@ -78,6 +78,9 @@ def _tokens(text: str):
 
 def parse_polynomial(text: str, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
     """Read a sum of terms ``±[coeff][*]v_i[^e]*…`` with coeff ``n``, ``n/m`` or ``(n/m)``."""
+    plain = _parse_plain(text, ctx)
+    if plain is not None:
+        return plain
     nvars = ctx.nvars()
     terms: dict[tuple[int, ...], fmpq] = {}
     toks = list(_tokens(text))
@@ -129,6 +132,45 @@ def parse_polynomial(text: str, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
         key = tuple(exps)
         c = (coeff if coeff is not None else fmpq(1)) * sign
         terms[key] = terms.get(key, fmpq(0)) + c
+    return from_terms(ctx, {k: v for k, v in terms.items() if v != 0})
+
+
+#: one term of :func:`format_polynomial`'s own form: ``±n[/m]*v_i[^e]*…`` without spaces
+#: or parentheses (possessive quantifiers: no backtracking)
+_PLAIN_TERM = re.compile(r"([-+]?)(?:([0-9]++)(?:/([0-9]++))?(\*)?)?"
+                         r"(v[0-9]++(?:\^[0-9]++)?(?:\*v[0-9]++(?:\^[0-9]++)?)*+)?")
+_PLAIN_FACTOR = re.compile(r"v([0-9]++)(?:\^([0-9]++))?")
+
+
+def _parse_plain(text: str, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly | None:
+    """:func:`parse_polynomial` for text in :func:`format_polynomial`'s form (what the
+    caches hold), a term per regular-expression match; None for anything else, which
+    the general parser then reads (or refuses, with the reason)."""
+    if not text or any(ch in text for ch in " \t\r\n()"):
+        return None
+    nvars = ctx.nvars()
+    terms: dict[tuple[int, ...], fmpq] = {}
+    pos, n = 0, len(text)
+    while pos < n:
+        m = _PLAIN_TERM.match(text, pos)
+        sign, num, den, star, factors = m.groups()
+        if m.end() == pos or (pos and not sign) or (num is None and factors is None) or \
+                (star is not None) != (num is not None and factors is not None):
+            return None
+        if num is not None and (len(num) > MAX_DIGITS or den is not None and (
+                len(den) > MAX_DIGITS or int(den) == 0)):
+            return None
+        exps = [0] * nvars
+        for f in _PLAIN_FACTOR.finditer(factors or ""):
+            index, power = f.groups()
+            if len(index) > 6 or not 1 <= int(index) <= nvars or \
+                    power is not None and (len(power) > 6 or int(power) > MAX_EXPONENT):
+                return None
+            exps[int(index) - 1] += 1 if power is None else int(power)
+        c = fmpq(1) if num is None else fmpq(int(num), 1 if den is None else int(den))
+        key = tuple(exps)
+        terms[key] = terms.get(key, fmpq(0)) + (-c if sign == "-" else c)
+        pos = m.end()
     return from_terms(ctx, {k: v for k, v in terms.items() if v != 0})
 
 

@@ -10,9 +10,18 @@ A descendant that leaves the group (``setsid``) would escape a group kill: singc
 makes itself a *child subreaper* (Linux ``PR_SET_CHILD_SUBREAPER``), so such a process
 is re-parented to singcheck when its parent dies instead of to init, and every child of
 singcheck outside singcheck's own process group that appeared during the call is
-killed and reaped before ``run_program`` returns.  (Only SIGKILL of singcheck itself
-leaves nothing to clean up with.)  Building the argv is the callers' job (pure
-functions in each adapter).
+killed and reaped before ``run_program`` returns.
+
+SIGKILL of singcheck itself leaves it nothing to clean up with: so the program is
+started through :mod:`~singcheck.elimination.cas.guard`, a small process that the kernel
+signals when the thread of singcheck that started it exits (``PR_SET_PDEATHSIG``; that
+thread is the one waiting here, in the main thread as in a worker thread), and that
+then kills the program, its group and its setsid'd descendants (it is their subreaper
+too).  The guard also bounds the program's address space (``RLIMIT_AS``,
+:func:`~singcheck.elimination.cas.limits.memory_limit`), so that a Gröbner basis that
+blows up ends with an allocation failure, reported as a backend error, instead of
+waking the kernel's OOM killer.
+Building the argv is the callers' job (pure functions in each adapter).
 """
 
 from __future__ import annotations
@@ -20,6 +29,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -27,11 +37,20 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 
+from singcheck.elimination.cas.guard import (
+    EXEC_FAILED,
+    EXEC_FAILED_MARK,
+    PR_SET_CHILD_SUBREAPER,
+    SCRIPT,
+    children,
+    prctl,
+    reap_children,
+)
+from singcheck.elimination.cas.limits import memory_limit
 from singcheck.errors import BackendError
 
 #: What a program may print on stdout and on stderr (each); beyond it, it is stopped.
 MAX_OUTPUT_BYTES = 64 * 2**20
-_PR_SET_CHILD_SUBREAPER = 36
 
 
 class BackendTimeout(BackendError):
@@ -54,6 +73,7 @@ class ProgramRun:
     stdout: str
     stderr: str
     seconds: float
+    memory_limit: int = 0  # the bound on its address space, in bytes (0: none)
 
 
 _SUBREAPER: list[bool] = []
@@ -62,38 +82,8 @@ _SUBREAPER: list[bool] = []
 def _become_subreaper() -> bool:
     """Make this process the reaper of its orphaned descendants (once; Linux only)."""
     if not _SUBREAPER:
-        ok = False
-        try:
-            import ctypes
-
-            libc = ctypes.CDLL(None, use_errno=True)
-            ok = libc.prctl(_PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) == 0
-        except (OSError, AttributeError):
-            ok = False
-        _SUBREAPER.append(ok)
+        _SUBREAPER.append(prctl(PR_SET_CHILD_SUBREAPER, 1))
     return _SUBREAPER[0]
-
-
-def _children() -> set[int]:
-    """The pids whose parent is this process (from /proc; empty where there is none)."""
-    me = os.getpid()
-    out = set()
-    try:
-        entries = os.listdir("/proc")
-    except OSError:
-        return out
-    for name in entries:
-        if not name.isdigit():
-            continue
-        try:
-            with open(f"/proc/{name}/stat", "rb") as f:
-                stat = f.read()
-        except OSError:
-            continue
-        fields = stat[stat.rfind(b")") + 2:].split()
-        if len(fields) > 1 and int(fields[1]) == me:
-            out.add(int(name))
-    return out
 
 
 def _reap_strays(known: set[int]) -> None:
@@ -101,27 +91,24 @@ def _reap_strays(known: set[int]) -> None:
     group: descendants of the program that outlived it (re-parented to us because we
     are their subreaper), including those that called setsid."""
     own_group = os.getpgid(0)
-    for _ in range(100):  # each round reaps one generation of re-parented descendants
-        strays = []
-        for pid in _children() - known:
-            try:
-                if os.getpgid(pid) != own_group:
-                    strays.append(pid)
-            except OSError:
-                continue
-        if not strays:
-            return
-        for pid in strays:
-            for kill in (os.killpg, os.kill):
-                try:
-                    kill(pid, signal.SIGKILL)
-                except OSError:
-                    pass
-        for pid in strays:
-            try:
-                os.waitpid(pid, 0)
-            except OSError:
-                pass
+
+    def keep(pid: int) -> bool:
+        try:
+            return pid in known or os.getpgid(pid) == own_group
+        except OSError:
+            return True  # gone already
+
+    reap_children(keep)
+
+
+def _guarded(argv: list[str] | tuple[str, ...], limit: int) -> list[str]:
+    """``argv`` started through :mod:`~singcheck.elimination.cas.guard` (a fresh
+    interpreter that dies with this thread and takes the program's descendants with it);
+    ``argv`` itself where no interpreter path is known."""
+    if not sys.executable:
+        return list(argv)
+    return [sys.executable, "-I", "-S", SCRIPT, str(os.getpid()), str(limit), "--",
+            *argv]
 
 
 def _kill_group(proc: subprocess.Popen) -> None:
@@ -170,11 +157,12 @@ def run_program(argv: list[str] | tuple[str, ...], timeout: float, *,
     start = time.monotonic()
     name = os.path.basename(argv[0])
     reaper = _become_subreaper()
-    known = _children() if reaper else set()
+    known = children() if reaper else set()
+    limit = memory_limit()
     with _terminate_as_interrupt(), tempfile.TemporaryFile() as out, \
             tempfile.TemporaryFile() as err:
         try:
-            proc = subprocess.Popen(list(argv), stdin=subprocess.DEVNULL, stdout=out,
+            proc = subprocess.Popen(_guarded(argv, limit), stdin=subprocess.DEVNULL, stdout=out,
                                     stderr=err, cwd=cwd, env=env, start_new_session=True)
         except OSError as e:
             raise BackendError(f"could not start {argv[0]}: {e.strerror or e}") from None
@@ -192,8 +180,12 @@ def run_program(argv: list[str] | tuple[str, ...], timeout: float, *,
                 pass
             if reaper:
                 _reap_strays(known)
+        stderr = _read(err, MAX_OUTPUT_BYTES)
+        if proc.returncode == EXEC_FAILED and stderr.startswith(EXEC_FAILED_MARK):
+            reason = stderr[len(EXEC_FAILED_MARK):].strip().splitlines()[0]
+            raise BackendError(f"could not start {reason}")
         return ProgramRun(tuple(argv), proc.returncode, _read(out, MAX_OUTPUT_BYTES),
-                          _read(err, MAX_OUTPUT_BYTES), time.monotonic() - start)
+                          stderr, time.monotonic() - start, limit)
 
 
 def _wait(proc: subprocess.Popen, out, err, end: float, name: str, timeout: float) -> None:

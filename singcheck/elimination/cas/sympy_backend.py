@@ -46,6 +46,10 @@ class SympyBackend:
 
         return version("sympy")  # without importing SymPy (a third of a second)
 
+    def preload(self, request: EliminationRequest) -> None:
+        """Import what :meth:`eliminate` needs (before a fork: :mod:`.isolated`)."""
+        import sympy  # noqa: F401
+
     def eliminate(self, request: EliminationRequest) -> EliminationResult:
         from sympy import groebner, symbols
 

@@ -266,3 +266,34 @@ def test_cli_workspace_prints_the_regions_of_an_angle_robot():
     doc = json.loads(result.stdout)
     assert doc["axes"] == ["tan(phi/2)"]
     assert doc["regions"] and doc["components_proven"] is True
+
+
+def test_five_bar_joint_space_in_the_chart_matches_an_independent_direct_kinematics():
+    from singcheck.spaces.analysis import JOINTSPACE, jointspace_variety
+
+    model = build_model(load_robot(ROBOTS / "five-bar.yaml"))
+    analysis = analyse(JOINTSPACE, model, jointspace_variety(model, get_backend("flint")))
+    assert analysis.axes == ("tan(th1/2)", "tan(th2/2)")
+    assert analysis.regions.components_proven
+    inside = set()
+    for c in analysis.cells:
+        th1, th2 = (2 * mp.atan(_mp(w)) for w in c.cell.sample)
+        # the elbows B_i = A_i + 2(cos θ_i, sin θ_i); P is on both circles of radius 2
+        b1 = (-1 + 2 * mp.cos(th1), 2 * mp.sin(th1))
+        b2 = (1 + 2 * mp.cos(th2), 2 * mp.sin(th2))
+        gap = mp.sqrt((b1[0] - b2[0]) ** 2 + (b1[1] - b2[1]) ** 2)
+        assert abs(gap - 4) > mp.mpf(10) ** -30 and gap > 0
+        assert c.count == (2 if gap < 4 else 0), c.cell.sample
+        within = mp.pi / 3 < th1 < mp.pi and 0 < th2 < 2 * mp.pi / 3
+        assert c.within_limits == within, c.cell.sample
+        if within:
+            inside.add(c.count)
+    assert inside == {0, 2}
+
+
+@pytest.mark.parametrize("robot, why", [("linear-delta", "square roots among its numbers"),
+                                        ("3-rpr", "angles in its pose")])
+def test_joint_spaces_without_an_exact_direct_kinematics_count_are_refused(robot, why):
+    result = singcheck("jointspace", str(ROBOTS / f"{robot}.yaml"), "--backend", "flint", "-q")
+    assert result.returncode == 2
+    assert why in result.stderr and len(result.stderr.strip().splitlines()) == 1

@@ -62,12 +62,13 @@ class Chart:
         denominators cleared and factors 1 + w² dropped: the same real zero set on the
         arcs (-π, π)."""
         ctx = self.context
-        if not self.angles:
-            return _move(p, ctx)
         names = p.context().names()
-        extra = tuple(f"h({v})" for v in self.angles)
+        angles = [v for v in self.angles if angle_names(v)[0] in names]
+        if not angles:
+            return _move(p, ctx)
+        extra = tuple(f"h({v})" for v in angles)
         wide = fmpq_mpoly_ctx.get((*names, *extra), "lex")
-        pairs = [tuple(names.index(n) for n in angle_names(v)) for v in self.angles]
+        pairs = [tuple(names.index(n) for n in angle_names(v)) for v in angles]
         top = [max((e[c] + e[s] for e, _ in p.terms()), default=0) for c, s in pairs]
         terms = {}
         for exps, coeff in p.terms():
@@ -91,7 +92,7 @@ class Chart:
             else:
                 args.append(zero)
         out = homogeneous.compose(*args, ctx=ctx)
-        for v in self.angles:
+        for v in angles:
             w = gens[chart_axis(v)]
             while not out.is_zero() and out.degrees()[ctx.names().index(chart_axis(v))] >= 2:
                 q, r = divmod(out, 1 + w * w)
@@ -113,8 +114,8 @@ class Chart:
 
 
 def _move(p: fmpq_mpoly, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
-    """``p`` in ``ctx`` (same variable names, possibly in another order or with absent
-    ones of degree 0); unchanged when already there."""
+    """``p`` in ``ctx`` (variables matched by name; those of ``p`` missing from ``ctx``
+    must have degree 0); unchanged when already there."""
     if p.context() is ctx:
         return p
     names = p.context().names()

@@ -498,6 +498,7 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
         analyse,
         decomposition,
         select_surfaces,
+        space_chart,
         workspace_variety,
     )
     from singcheck.spaces.region_map import RegionMap
@@ -511,7 +512,8 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
         key = cache.key([c.polynomial for c in components], fixed) if cache else None
         regions = cache.load(key) if cache else None
         if regions is not None:  # checked against the inputs, not only by its HMAC
-            _, _, cad = decomposition(projection.model.pose, components, fixed)
+            axes = space_chart(projection.model, WORKSPACE).axes
+            _, _, cad = decomposition(axes, components, fixed)
             problem = regions.verify(cad)
             if problem:
                 if notify:

@@ -285,6 +285,36 @@ def test_robots_and_trajectories_pickle_exactly(orthoglide_robot):
     assert sc.check(robot2, heart2).to_dict() == sc.check(orthoglide_robot, heart1).to_dict()
 
 
+def test_polynomials_pickle_exactly_whatever_their_variable_names():
+    """Polynomials cross a fork or a cluster as FLINT's text in renamed variables: names
+    with operators in them (cos(phi), sqrt(3), an angle function) and names that are
+    prefixes of others (s, sqrt(3)) come back term by term, as do huge fractions, the
+    zero polynomial and integer polynomials."""
+    import pickle
+    from fractions import Fraction
+
+    from flint import fmpq, fmpq_mpoly_ctx, fmpz_mpoly_ctx
+
+    from singcheck.algebra import pickling  # noqa: F401  (installs the reducers)
+
+    names = ("t", "s", "c", "sqrt(3)", "cos(t^2 + 1/2*pi)", "sin(t^2 + 1/2*pi)", "x*y", "v0")
+    ctx = fmpq_mpoly_ctx.get(names, "lex")
+    t, s, c, r3, cg, sg, xy, v0 = ctx.gens()
+    big = fmpq(3**80 + 1, 2**70 * 7)
+    p = (big * r3 * cg - fmpq(7, 3) * sg**3 * t + s * c - xy * v0 + 1) ** 4
+    expected = {tuple(int(e) for e in k): Fraction(int(v.p), int(v.q))
+                for k, v in p.to_dict().items()}
+    back = pickle.loads(pickle.dumps(p))
+    assert back.context() is ctx
+    assert {tuple(int(e) for e in k): Fraction(int(v.p), int(v.q))
+            for k, v in back.to_dict().items()} == expected
+    assert pickle.loads(pickle.dumps(ctx.from_dict({}))).is_zero()
+    zctx = fmpz_mpoly_ctx.get(("a", "ab"), "lex")
+    a, ab = zctx.gens()
+    q = -7 * a**3 * ab + 2 * ab**12 - 5
+    assert pickle.loads(pickle.dumps(q)).to_dict() == q.to_dict()
+
+
 # -- signals: what was streamed stays valid, -o writes nothing partial -----------------
 
 

@@ -431,6 +431,34 @@ def test_five_bar_line_tangent_where_the_distal_links_align_is_singular_at_sqrt_
     assert all(m.status != "unknown" for m in candidate.modes)
 
 
+def test_rotary_delta_touching_the_surface_in_infeasible_modes_only_is_free():
+    # on the axis, at z = -(4 + √3)/2 the elbows th = 2π/3 sit right above the centre:
+    # the three forearms are vertical, parallel (det A = 0, a double zero in t); that
+    # branch is outside the limits [-π/2, 3π/4] at the start, the feasible one is not
+    from tests.robot_oracles import rotary_delta
+
+    path = _revolute_path("rotary-delta", trajectory("5/2", "29/10", x="0", y="0", z="-t"))
+    report = certify_path(path)
+    mpmath.mp.dps = 50
+    oracle = rotary_delta()
+    tau = (4 + mpmath.sqrt(3)) / 2
+
+    def pose_at(t):
+        return [0, 0, -t]
+
+    modes = _oracle_modes(path, oracle, pose_at, Fraction(27, 10))
+    two_thirds = oracle.joints(modes["+++"], pose_at(tau))
+    assert all(abs(mpmath.cos(q) + mpmath.mpf(1) / 2) < 1e-40 for q in two_thirds)
+    singular = _revolute_zero_modes(oracle, modes, pose_at(tau), tiny="1e-25")
+    assert "+++" in singular and "---" not in singular
+    assert [m.label for m in report.modes if m.feasible] == ["---"]
+    assert report.verdict == "singularity-free"
+    [candidate] = report.candidates
+    assert abs(float(candidate.t.mid()) - float(tau)) < 1e-9
+    assert set(candidate.singular_modes) == singular
+    assert all(m.status != "unknown" for m in candidate.modes)
+
+
 def _mp(q: str):
     return mpmath.mpf(Fraction(q).numerator) / Fraction(q).denominator
 
@@ -440,6 +468,8 @@ def _mp(q: str):
     ("five-bar", "trajectories/five-bar-cross.yaml", "five_bar", lambda t: [0, 3 - 2 * t]),
     ("rotary-delta", "trajectories/rotary-delta-cross.yaml", "rotary_delta",
      lambda t: [_mp("7/4") + _mp("3/10") * t, 0, -1]),
+    ("rotary-delta", trajectory("5/2", "29/10", x="0", y="0", z="-t"), "rotary_delta",
+     lambda t: [0, 0, -t]),
 ])
 def test_exact_decisions_on_revolute_legs_agree_with_50_digits(robot, text, oracle_name,
                                                                pose_at):
@@ -639,3 +669,38 @@ def test_touch_where_sin_and_cos_are_algebraic_but_t_is_not(bump, bump_mp, start
     assert abs(float(candidate.t.mid()) - float(tau)) < 1e-9
     assert set(candidate.singular_modes) == modes_singular_on_sphere(X0)
     assert all(m.status != "unknown" for m in candidate.modes)
+
+
+# -- the workspace line of a path lying on ξ = 0 -------------------------------------------
+
+
+@pytest.mark.parametrize("lower, surfaces, count", [
+    ("-1", {"parallel singularity ξ"}, 8),
+    # with ρ ≥ 0 the branches ρ = x - x = 0 sit on the limit, whose surface (the leg's
+    # constraint at ρ = 0: x² + y² + z² = 4) is the sphere too
+    ("0", {"parallel singularity ξ", "rho1 = 0 (min)", "rho2 = 0 (min)", "rho3 = 0 (min)"},
+     None),
+])
+def test_the_workspace_line_says_the_path_lies_on_the_surface(lower, surfaces, count):
+    from singcheck.report.trajectory import workspace_json, workspace_line
+    from singcheck.spaces.path_regions import path_in_workspace
+
+    x, y, z = X0
+    assert x * x + y * y + z * z == 4  # on the sphere, every leg's ρ = 0 surface
+    expected_count = 1
+    for v in X0:  # ρ = v ± v, both strictly inside [-1, 4] when the limit is -1
+        expected_count *= sum(Fraction(lower) < v + sign * v < 4 for sign in (1, -1))
+    assert (expected_count if lower == "-1" else None) == count
+    report = certify(orthoglide(lower), trajectory("0", "1", x="2/3", y="4/3", z="4/3"))
+    assert report.verdict == "singular"
+    w = path_in_workspace(report.path, name_region=False,
+                          mu_roots=[c.t for c in report.candidates]
+                          if report.mu_roots_complete else None)
+    assert not w.undecided and not w.crossings and w.one_region is False
+    assert {s for s, _ in w.on_surfaces} == surfaces
+    assert {where for _, where in w.on_surfaces} == {"[0, 1]"}
+    line = workspace_line(workspace_json(w))
+    assert "not all decided" not in line
+    assert line.startswith("workspace: the path lies on ") and "for t ∈ [0, 1]" in line
+    if count is not None:
+        assert line.endswith(f"({count} IK solution(s) inside the joint limits all along)")

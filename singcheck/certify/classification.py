@@ -357,7 +357,7 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
     feasible = [m for m in modes if m.status == FEASIBLE]
     middle = gap_points(interval, [])
     samples = [arb_to_fmpq(t) for t in middle + gap_points(interval, middle)]
-    candidates, undecided, method, complete = [], [], "none", True
+    candidates, undecided, method = [], [], "none"
     for mode in feasible:
         try:
             zeros = _mode_zeros(path, mode, samples)
@@ -369,7 +369,6 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
             continue
         isolation = isolate_real_roots(zeros, interval, tolerance)
         method = isolation.method
-        complete = complete and not isolation.undecided
         for r in isolation.roots:
             c = classify_candidate(path, [mode], r, tolerance, by_elimination=False)
             candidates.append(c)
@@ -381,8 +380,9 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
     verdict, reason = verdict_of(modes, candidates, undecided)
     if verdict == VERDICT_FREE:
         reason += " (the path lies on ξ(X) = 0: each mode was decided on its own)"
+    # the candidates are the modes' own zeros, not roots of μ (which is ≡ 0)
     return TrajectoryReport(path, verdict, reason, candidates, modes, method, undecided,
-                            complete)
+                            mu_roots_complete=False)
 
 
 def _mode_zeros(path: PathModel, mode: WorkingMode, samples: list):

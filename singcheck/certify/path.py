@@ -462,23 +462,18 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
 
 
 def _on_circle(p: fmpq_mpoly) -> fmpq_mpoly:
-    """``p`` (in a ring with the path's s = sin t, c = cos t) with s² replaced by 1 - c²:
-    degree ≤ 1 in s, the same function of t.  Keeps path-wise norms small."""
+    """``p`` (in a ring with the path's s = sin t, c = cos t, s before c) with s² replaced
+    by 1 - c²: degree ≤ 1 in s, the same function of t.  Keeps path-wise norms small.
+    FLINT's remainder modulo s² + c² - 1 (s² is its leading monomial), in C."""
     ctx = p.context()
     names = ctx.names()
-    si = names.index("s")
+    si, ci = names.index("s"), names.index("c")
     if p.degrees()[si] < 2:
         return p
-    one_minus_c2 = 1 - ctx.gens()[names.index("c")] ** 2
-    groups: dict[int, dict] = {}
-    for exps, coeff in p.terms():
-        e = list(exps)
-        half, e[si] = divmod(e[si], 2)
-        groups.setdefault(half, {})[tuple(e)] = coeff
-    out = ctx.from_dict({})
-    for half, terms in groups.items():
-        out += ctx.from_dict(terms) * one_minus_c2 ** half
-    return out
+    if ci < si:
+        raise ValueError("the ring must order s before c")
+    s, c = ctx.gens()[si], ctx.gens()[ci]
+    return divmod(p, s * s + c * c - 1)[1]
 
 
 _LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}
@@ -532,7 +527,8 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
     coordinates = tuple(coordinates)
     pose_vars = model.pose_variables
     if projection.expanded:
-        mu = _compose_mu(projection.singularity_surface, coordinates, pose_vars, trajectory)
+        # ξ modulo the pose angles' circles: μ is the same (φ's cos, sin lie on them)
+        mu = _compose_mu(projection.surface_on_circles, coordinates, pose_vars, trajectory)
     else:
         mu = eliminate_along_path(model, coordinates, where)
     try:

@@ -119,6 +119,8 @@ def workspace_json(w) -> dict[str, Any]:
         "ik_counts": [s.count for s in w.stretches],
         "exit_time_interval": None if w.exit_time is None else _interval(w.exit_time),
         "undecided": w.undecided,
+        "on_surfaces": [{"surface": surface, "t_range": where}
+                        for surface, where in w.on_surfaces],
         **({"region_not_named": w.region_reason} if w.region_reason else {}),
     }
 
@@ -128,6 +130,18 @@ def workspace_line(w: dict[str, Any]) -> str:
     counts = w["ik_counts"]
     if w["one_region"] is None:
         return "workspace: crossings not all decided: " + "; ".join(w["undecided"])
+    if w.get("on_surfaces"):
+        ranges: dict[str, list[str]] = {}
+        for item in w["on_surfaces"]:
+            ranges.setdefault(item["t_range"], []).append(item["surface"])
+        text = "workspace: the path lies on " + "; on ".join(
+            f"{', '.join(surfaces)} for t ∈ {where}" for where, surfaces in ranges.items())
+        if not w["crossings"]:
+            return text + (f" ({counts[0]} IK solution(s) inside the joint limits all along)"
+                           if counts and counts[0] is not None else "")
+        return text + (f"; it crosses the discriminant variety {len(w['crossings'])} "
+                       "time(s); IK solutions inside the limits along it: "
+                       + " → ".join("?" if c is None else str(c) for c in counts))
     if w["one_region"]:
         where = f"region {w['region']}" if w["region"] else "one region of the workspace"
         text = (f"workspace: the whole path lies in {where} "

@@ -147,6 +147,9 @@ def _outcome(message: bytes, status: int, said: str, limit: int, what: str):
     if kind == "raise":
         raise value
     if kind == "memory" or os.WIFEXITED(status) and os.WEXITSTATUS(status) == 3:
+        if not limit:
+            raise BackendError(f"{what} ran out of memory (no bound was set: "
+                               "SINGCHECK_MEMORY_LIMIT=none)")
         raise BackendError(f"{what} ran out of memory under {bound}; raise "
                            "SINGCHECK_MEMORY_LIMIT (or set it to none) if the robot needs more")
     how = (f"died of {signal.Signals(os.WTERMSIG(status)).name}" if os.WIFSIGNALED(status)

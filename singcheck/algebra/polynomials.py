@@ -21,15 +21,17 @@ def memo_per_object(cache: dict, obj, compute, keep: int = 256):
 
 
 def restrict(p: fmpq_mpoly, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
-    """``p`` (free of the dropped variables) re-expressed in the smaller context ``ctx``."""
+    """``p`` (free of the dropped variables) re-expressed in the smaller context ``ctx``.
+
+    The variables are matched by name and the terms moved by FLINT in C
+    (``project_to_context``, a composition with the generators), after an exact check
+    that no dropped variable occurs: tens of thousands of terms in a millisecond."""
     names = p.context().names()
-    keep = [names.index(v) for v in ctx.names()]
-    out = {}
-    for exps, coeff in p.terms():
-        if any(e for i, e in enumerate(exps) if i not in keep):
-            raise ValueError(f"{p} still involves an eliminated variable")
-        out[tuple(exps[i] for i in keep)] = coeff
-    return ctx.from_dict(out)
+    kept = set(ctx.names())
+    degrees = p.degrees()
+    if any(degrees[i] > 0 for i, v in enumerate(names) if v not in kept):
+        raise ValueError(f"{p} still involves an eliminated variable")
+    return p.project_to_context(ctx)
 
 
 def constant_value(p: fmpq_mpoly) -> fmpq:

@@ -369,17 +369,20 @@ class PathModel:
         """Per leg, the branches of the conjugate robot (its square roots' signs flipped
         as ``signs`` says), by ball evaluation of the leg's coefficients at the pose."""
         model = self.projection.model
-        n_joint = len(model.joint_variables)
-        radicals = [b for _, b in sorted(radical_balls(model.context, signs).items())]
-        out = []
-        for leg in self.legs:
-            coefficients = leg_coefficients(leg.leg)
-            point = [arb(0)] * n_joint + list(pose) + radicals
-            values = [evaluate(c, point) for c in coefficients]
-            disc = leg_discriminant(leg.leg, coefficients)
-            out.append(branch_values(leg.leg, values,
-                                     evaluate(disc, point) if disc is not None else None))
-        return out
+        return [branches_at_pose(model, leg.leg, pose, signs) for leg in self.legs]
+
+
+def branches_at_pose(model: RobotModel, leg: Leg, pose: list, signs=None) -> dict:
+    """The leg's branches at a pose given by balls of the model's pose variables (cos φ,
+    sin φ for an angle), the square roots' signs as ``signs`` says (default: the robot's
+    own, all positive): ball evaluation of the leg's coefficients and discriminant."""
+    n_joint = len(model.joint_variables)
+    radicals = [b for _, b in sorted(radical_balls(model.context, signs).items())]
+    coefficients = _leg_coefficients(leg)
+    point = [arb(0)] * n_joint + list(pose) + radicals
+    values = [evaluate(c, point) for c in coefficients]
+    disc = leg_discriminant(leg, coefficients)
+    return branch_values(leg, values, evaluate(disc, point) if disc is not None else None)
 
 
 def _angle_k(p: fmpq_mpoly, q) -> int | None:
@@ -474,6 +477,9 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
 MAX_PATHWISE_TERMS = 2_000_000
 
 
+_DET_A_FACTORS: dict = {}
+
+
 def pathwise_size_bound(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
                         ) -> tuple[int, int, int]:
     """(degree in t, degree in sin/cos, terms) that the path-wise μ cannot exceed, and a
@@ -526,7 +532,8 @@ def pathwise_size_bound(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
     # (the legs along the path are composed too: their size counts)
     largest = max((size(bounds(f)) for _, f in norm_legs(model)), default=0)
     total_t = total_sc = 0
-    for factor, _ in model.det_A.factor()[1]:
+    for factor in memo_per_object(_DET_A_FACTORS, model,
+                                  lambda m: [g for g, _ in m.det_A.factor()[1]]):
         acc = bounds(factor)
         largest = max(largest, size(acc))
         for v, f, d in legs:
@@ -548,21 +555,19 @@ def pathwise_size_bound(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
     return total_t, total_sc, largest
 
 
-_CIRCLES: dict = {}
-
-
 def _on_circle(p: fmpq_mpoly) -> fmpq_mpoly:
-    """``p`` (in a ring with the path's s = sin t, c = cos t, s before c and after every
-    other variable, lex order) with s² replaced by 1 - c²: degree ≤ 1 in s, the same
-    function of t.  Keeps path-wise norms small.  FLINT's remainder by s² + c² - 1, whose
-    leading monomial in that order is s² (as :func:`~singcheck.algebra.trig.reduce_trig`)."""
+    """``p`` (in a ring with the path's s = sin t, c = cos t, s before c) with s² replaced
+    by 1 - c²: degree ≤ 1 in s, the same function of t.  Keeps path-wise norms small.
+    FLINT's remainder modulo s² + c² - 1 (s² is its leading monomial), in C."""
     ctx = p.context()
     names = ctx.names()
-    if p.degrees()[names.index("s")] < 2:
+    si, ci = names.index("s"), names.index("c")
+    if p.degrees()[si] < 2:
         return p
-    relation = memo_per_object(_CIRCLES, ctx, lambda ctx: (
-        ctx.gens()[names.index("s")] ** 2 + ctx.gens()[names.index("c")] ** 2 - 1))
-    return divmod(p, relation)[1]
+    if ci < si:
+        raise ValueError("the ring must order s before c")
+    s, c = ctx.gens()[si], ctx.gens()[ci]
+    return divmod(p, s * s + c * c - 1)[1]
 
 
 _LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}
@@ -616,7 +621,8 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
     coordinates = tuple(coordinates)
     pose_vars = model.pose_variables
     if projection.expanded:
-        mu = _compose_mu(projection.singularity_surface, coordinates, pose_vars, trajectory)
+        # ξ modulo the pose angles' circles: μ is the same (φ's cos, sin lie on them)
+        mu = _compose_mu(projection.surface_on_circles, coordinates, pose_vars, trajectory)
     else:
         try:
             mu = eliminate_along_path(model, coordinates, where)

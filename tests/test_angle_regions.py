@@ -19,7 +19,6 @@ from singcheck.elimination.cas import get_backend
 from singcheck.elimination.projection import project_robot
 from singcheck.model.robot import build_model
 from singcheck.spaces.analysis import (
-    LIMIT,
     PARALLEL,
     WORKSPACE,
     analyse,
@@ -189,13 +188,23 @@ def test_rotary_delta_free_path_is_named_in_its_plane_without_xi(tmp_path):
 # -- angles: the 3-RPR and the 5-bar ---------------------------------------------------------
 
 
-def test_3rpr_plane_in_the_chart_counts_match_the_oracle():
-    # the plane y = 1 in (x, tan(phi/2)), cut by the surfaces where the count changes
-    projection = _projection("3-rpr")
-    analysis = _check_cells(projection, oracles.three_rpr(), {"y": Fraction(1)},
-                            kinds=("serial singularity", LIMIT))
+def test_3rpr_plane_in_the_chart_counts_and_a_turning_path_match_the_oracle(tmp_path):
+    # the plane y = 1 in (x, tan(phi/2)), ξ included; the path moves and turns in it
+    text = "name: p\nparameter: t\nrange: [0, 1]\npose: {x: 5/2 + t/2, y: 1, phi: t}\n"
+    robot, w = _check("3-rpr", text, tmp_path)
+    assert w.one_region
+    assert w.region.endswith("of the workspace plane y = 1 (in the chart tan(phi/2): cut "
+                             "along phi = π)")
+    fixed = {"y": Fraction(1)}
+    analysis = _check_cells(robot.projection, oracles.three_rpr(), fixed)
     assert analysis.axes == ("x", "tan(phi/2)")
     assert {c.count for c in analysis.cells} == {0, 1}
+    assert [c for c in analysis.components if c.kind == PARALLEL]
+    chart = Chart.of(("x", "y", "phi"), frozenset({"phi"}))
+    oracle = oracles.three_rpr()
+    for count, X in _region_of_path(analysis, chart, fixed, w.region,
+                                    lambda t: [mp.mpf(5) / 2 + t / 2, mp.mpf(1), t], 0, 1):
+        assert count == _oracle_count(oracle, X) == 1
 
 
 def test_3rpr_turning_path_is_named_in_the_chart(tmp_path):

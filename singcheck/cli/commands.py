@@ -502,7 +502,10 @@ def _slices_by_space(robot, spaces, slices) -> dict[str, list[str]]:
     if not spaces:
         return {}
     model = build_model(load_robot(robot))
-    axes = {"workspace": model.pose, "jointspace": model.joints}
+    from singcheck.spaces.chart import Chart
+
+    axes = {"workspace": Chart.of(model.pose, model.angles).axes,
+            "jointspace": Chart.of(model.joints, model.angles).axes}
     out: dict[str, list[str]] = {space: [] for space in dict.fromkeys(spaces)}
     for text in slices:
         axis, _ = parse_slice(text)

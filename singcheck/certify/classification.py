@@ -234,7 +234,7 @@ def _decide_exactly(path, modes, root: RealRoot) -> dict[str, ModeAtCandidate]:
 
     out = {}
     try:
-        point = exact_point(root.exact, root)
+        point = exact_point(root.exact, None if _periodic(path) else root)
         zero, nonzero = (BY_ALGEBRAIC_ZERO, BY_ALGEBRAIC_NONZERO) \
             if isinstance(point, AlgebraicPoint) else (BY_MIXED_ZERO, BY_MIXED_NONZERO)
         for mode in modes:

@@ -285,7 +285,10 @@ class TimeTranscendentalPoint:
     (in Q(α): t = 2·atan(α) + 2kπ, or t = kπ): τ itself is then transcendental
     (Lindemann–Weierstrass: e^{iτ} is algebraic), so an element Σ tⁱ·gᵢ(α) vanishes at
     the root exactly when every gᵢ is 0 in Q(α).  Elements are polynomials in t and α,
-    reduced modulo α's minimal polynomial; balls take τ from the root's own enclosure."""
+    reduced modulo α's minimal polynomial; balls take τ from the root's own enclosure
+    (refined in floating-point tolerances: hence the lower precision cap)."""
+
+    max_bits = 1024
 
     def __init__(self, time: ExactTime, root) -> None:
         self.inner = AlgebraicPoint(time)  # s, c (and α) without t
@@ -317,8 +320,9 @@ class TimeTranscendentalPoint:
 
 
 def exact_point(time: ExactTime, root=None):
-    """The base field of the exact decisions at a root (a
-    :class:`~singcheck.roots.enclosures.RealRoot`) with this exact time."""
+    """The base field of the exact decisions at a root with this exact time; ``root``
+    (its :class:`~singcheck.roots.enclosures.RealRoot`) only for a path that uses the
+    bare t, where sin t, cos t algebraic leave t itself transcendental."""
     if time.kind == IN_MIXED:
         return TranscendentalPoint(time)
     if time.kind in (IN_U, AT_POINT) and time.t_value is None and root is not None and \

@@ -368,17 +368,20 @@ class PathModel:
         """Per leg, the branches of the conjugate robot (its square roots' signs flipped
         as ``signs`` says), by ball evaluation of the leg's coefficients at the pose."""
         model = self.projection.model
-        n_joint = len(model.joint_variables)
-        radicals = [b for _, b in sorted(radical_balls(model.context, signs).items())]
-        out = []
-        for leg in self.legs:
-            coefficients = leg_coefficients(leg.leg)
-            point = [arb(0)] * n_joint + list(pose) + radicals
-            values = [evaluate(c, point) for c in coefficients]
-            disc = leg_discriminant(leg.leg, coefficients)
-            out.append(branch_values(leg.leg, values,
-                                     evaluate(disc, point) if disc is not None else None))
-        return out
+        return [branches_at_pose(model, leg.leg, pose, signs) for leg in self.legs]
+
+
+def branches_at_pose(model: RobotModel, leg: Leg, pose: list, signs=None) -> dict:
+    """The leg's branches at a pose given by balls of the model's pose variables (cos φ,
+    sin φ for an angle), the square roots' signs as ``signs`` says (default: the robot's
+    own, all positive): ball evaluation of the leg's coefficients and discriminant."""
+    n_joint = len(model.joint_variables)
+    radicals = [b for _, b in sorted(radical_balls(model.context, signs).items())]
+    coefficients = _leg_coefficients(leg)
+    point = [arb(0)] * n_joint + list(pose) + radicals
+    values = [evaluate(c, point) for c in coefficients]
+    disc = leg_discriminant(leg, coefficients)
+    return branch_values(leg, values, evaluate(disc, point) if disc is not None else None)
 
 
 def _angle_k(p: fmpq_mpoly, q) -> int | None:

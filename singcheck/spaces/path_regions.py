@@ -530,7 +530,8 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
                 regions = None
         if regions is None:
             if notify:
-                where = ", ".join(f"{k} = {v}" for k, v in fixed.items()) or "in 3-D"
+                where = ", ".join(f"{k} = {v}" for k, v in fixed.items())
+                where = f"{where}; {free_axes}-D" if where else f"in {free_axes}-D"
                 notify(f"decomposing the workspace ({where}) into regions, once"
                        + (" (then kept in the cache)" if cache else ""))
             regions = RegionMap.of(analyse(WORKSPACE, projection.model, components, fixed))

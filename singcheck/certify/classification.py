@@ -370,6 +370,7 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
         isolation = isolate_real_roots(zeros, interval, tolerance)
         method = isolation.method
         for r in isolation.roots:
+            checkpoint()
             c = classify_candidate(path, [mode], r, tolerance, by_elimination=False)
             candidates.append(c)
         undecided += [(b.t, b.reason) for b in isolation.undecided
@@ -393,6 +394,7 @@ def _mode_zeros(path: PathModel, mode: WorkingMode, samples: list):
 
     why = None
     for t0 in samples:
+        checkpoint()
         try:
             return mode_zero_polynomial(path, mode.label, t0)
         except NotExact as e:

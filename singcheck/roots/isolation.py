@@ -28,6 +28,7 @@ from singcheck.algebra.radicals import (
     reduce_relations,
 )
 from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig, uses_t, uses_trig
+from singcheck.budget import checkpoint
 from singcheck.roots.branch_bound import branch_and_bound, vanishes_at_multiple_of_pi
 from singcheck.roots.enclosures import (
     AT_POINT,
@@ -73,7 +74,8 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
     poly = as_univariate_t(p)
     if len(ends) == 2 and (nonzero_on(poly, *ends) or no_root_between(poly, *ends)):
         return RootIsolation((), (), EXACT)  # quick proofs: ball arithmetic, Descartes on [a, b]
-    for rr, mult in real_roots_exact(poly):
+    for rr, mult in real_roots_exact(poly):  # up to the degree of μ
+        checkpoint()
         for q in ends:
             rr.pin(q)
 
@@ -109,6 +111,7 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
     for f, mult in factors:
         if f.is_constant():
             continue
+        checkpoint()
         iso = isolate_real_roots(f, interval, tolerance)
         roots += [(r, int(mult)) for r in iso.roots]
         undecided += list(iso.undecided)
@@ -128,6 +131,7 @@ def _merge_apart(roots: list[RealRoot], tolerance: float, why: str
     merged: list[RealRoot] = []
     undecided: list[Undecided] = []
     for r in sorted(roots, key=lambda r: float(r.t.mid())):
+        checkpoint()
         if merged and merged[-1].t.overlaps(r.t):
             prev, tol = merged[-1], tolerance
             for _ in range(6):
@@ -176,6 +180,7 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
     for k, _ in norm.factor()[1]:
         if k.is_constant():
             continue
+        checkpoint()
         iso = branch_and_bound(k, interval, tolerance)
         undecided += [Undecided(b.t, "possible tangency: the zeros of μ there are zeros of "
                                 "a factor of its norm over sin t, which could not be "
@@ -183,6 +188,7 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
                                 f"{float(b.t.upper()):.9g}] ({b.reason})")
                       for b in iso.undecided]
         for r in iso.roots:
+            checkpoint()
             zero = _vanishes_at(p, r)
             if zero is None:
                 undecided.append(Undecided(r.t, "possible tangency: could not decide exactly "
@@ -251,6 +257,7 @@ def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Root
     sigmas = conjugates(p)
     roots, undecided = [], list(iso.undecided)
     for root in iso.roots:
+        checkpoint()
         r, verdict = root, None
         for step, bits in enumerate((53, 128, 256, 512)):
             if step:

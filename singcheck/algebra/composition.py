@@ -3,7 +3,7 @@
 FLINT composes in one call, which no :func:`~singcheck.budget.checkpoint` can interrupt:
 the stacked Orthoglide's ξ (57,855 terms) composed with a path of cubes took seconds
 past a 2 s time limit.  So the cost is estimated first, from the sizes alone (exact
-integer arithmetic on degrees, bit lengths and term counts, :func:`term_costs`):
+integer arithmetic on degrees, bit lengths and term counts, :func:`composition_work`):
 
 * above :data:`MAX_COMPOSE_WORK` the composition is refused before any work
   (:class:`TooCostly`);
@@ -27,7 +27,7 @@ from flint import fmpq_mpoly, fmpq_mpoly_ctx
 from singcheck.algebra.polynomials import memo_per_object
 from singcheck.budget import checkpoint
 
-#: The most work (:func:`term_costs`) one FLINT composition call may get.  On the
+#: The most work (:func:`composition_work`) one FLINT composition call may get.  On the
 #: development machine the rate was 4·10⁸ to 6·10⁹ per second of CPU depending on the
 #: shape of the path (stacked Orthoglide, eight paths): 0.02 to 0.25 s a piece.
 PIECE_WORK = 100_000_000
@@ -36,8 +36,8 @@ PIECE_PAIRS = 2_000_000
 #: The most work a whole composition may cost: refused up front above it (15 s to 8 min
 #: of CPU at those rates; the slowest measured shapes 4·10⁸ per second, large
 #: coefficients 1.4·10¹⁰).  The stacked Orthoglide's ξ with each coordinate a cube
-#: (sin t ± cos t ± k·t)³ costs 2.0·10¹⁰ (4 s in one call, 6 s in pieces); heart 2 on
-#: it 7.2·10⁷; with coordinates of 2,000-bit coefficients times (sin t + cos t + t),
+#: (sin t ± cos t ± k·t)³ costs 2.1·10¹⁰ (4 s in one call, 6 s in pieces); heart 2 on
+#: it 7.7·10⁷; with coordinates of 2,000-bit coefficients times (sin t + cos t + t),
 #: 7.5·10¹⁰ (5 s).
 MAX_COMPOSE_WORK = 200_000_000_000
 

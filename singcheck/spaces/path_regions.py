@@ -152,6 +152,7 @@ def _crossings(path: PathModel, tolerance: float, mu_roots: list[arb] | None
     events.sort(key=lambda e: float(e[0].mid()))
     merged: list[Crossing] = []
     for t, label in events:
+        checkpoint()
         if merged and merged[-1].t.overlaps(t):
             last = merged[-1]
             merged[-1] = Crossing(last.t.union(t), (*last.surfaces, label))
@@ -530,7 +531,8 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
                 regions = None
         if regions is None:
             if notify:
-                where = ", ".join(f"{k} = {v}" for k, v in fixed.items()) or "in 3-D"
+                where = ", ".join(f"{k} = {v}" for k, v in fixed.items())
+                where = f"{where}; {free_axes}-D" if where else f"in {free_axes}-D"
                 notify(f"decomposing the workspace ({where}) into regions, once"
                        + (" (then kept in the cache)" if cache else ""))
             regions = RegionMap.of(analyse(WORKSPACE, projection.model, components, fixed))

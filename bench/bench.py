@@ -335,12 +335,16 @@ def _timed_run(cmd: list[str], stdin_path: Path, env: dict) -> dict:
 
 
 BATCH_COUNTS = tuple(int(n) for n in os.environ.get("BENCH_BATCH", "1000,10000").split(","))
+BATCH_TARGET = 200  # paths per second, 10,000 paths with --no-regions (issue 15)
+FLAT_MB = 10  # "memory flat": peak RSS grows less than this from the fewest paths to the most
 
 
 def batch_rows(counts=BATCH_COUNTS) -> list[dict]:
     """Generated heart-like paths streamed through one command (stdin, --format jsonl,
     --no-regions): --jobs 2, and a 2-worker dask LocalCluster (process workers, loopback).
-    Peak memory at 1,000 and 10,000 paths shows whether it stays flat."""
+    Each row is one run (a 10,000-path run is long enough to time once; repeating it
+    would make `make bench` take many minutes); peak memory at 1,000 and 10,000 paths
+    shows whether it stays flat."""
     exe = [sys.executable, "-m", "singcheck", "run", "robots/orthoglide.yaml", "-", "-q",
            "--format", "jsonl", "--no-regions", "--backend", "flint"]
     rows = []
@@ -364,19 +368,40 @@ def batch_rows(counts=BATCH_COUNTS) -> list[dict]:
                                                        cluster.scheduler_address]))
             for what, extra in runs:
                 row = _timed_run([*exe, *extra], stream, env)
-                rows.append({"what": f"{n} paths, jsonl, {what}", "paths": n,
-                             "paths_per_s": n / row["wall_s"], **row})
+                rows.append({"what": f"{n} paths, jsonl, {what}", "runner": what,
+                             "paths": n, "paths_per_s": n / row["wall_s"], **row})
     if cluster is not None:
         cluster.close()
     return rows
 
 
+def batch_targets(rows: list[dict]) -> list[dict]:
+    """The batch targets on this run: throughput of the largest batch, per runner, and
+    memory flat from the smallest batch to the largest."""
+    out = []
+    for runner in dict.fromkeys(r["runner"] for r in rows):
+        mine = sorted((r for r in rows if r["runner"] == runner), key=lambda r: r["paths"])
+        small, large = mine[0], mine[-1]
+        out.append({"target": f"{large['paths']} paths, {runner}: >= {BATCH_TARGET} paths/s",
+                    "value": large["paths_per_s"],
+                    "met": large["paths_per_s"] >= BATCH_TARGET})
+        if large is not small:
+            growth = large["peak_rss_mb"] - small["peak_rss_mb"]
+            out.append({"target": f"{runner}: peak RSS grows < {FLAT_MB} MB from "
+                                  f"{small['paths']} to {large['paths']} paths",
+                        "value": growth, "met": growth < FLAT_MB})
+    return out
+
+
 def print_batch(rows: list[dict]) -> None:
-    print("\nbatches: generated heart-like paths on stdin, --format jsonl --no-regions")
+    print("\nbatches: generated heart-like paths on stdin, --format jsonl --no-regions, one "
+          "run each (wall time: mind the machine's load)")
     for r in rows:
         print(f"  {r['what']:42} {r['wall_s']:8.2f} s  {r['paths_per_s']:7.1f} paths/s  "
               f"CPU {r['cpu_s']:7.2f} s  "
               f"peak RSS {r['peak_rss_mb']:6.1f} MB  exit {r['exit_code']}  {r['verdicts']}")
+    for g in batch_targets(rows):
+        print(f"  {'MET    ' if g['met'] else 'NOT MET'}  {g['target']}: {g['value']:.1f}")
 
 
 def growth_rows() -> list[dict]:
@@ -574,6 +599,7 @@ def main() -> None:
         print(f"  {r['what']:66} {cpu}wall {ms(r['median_s'])} ms" +
               (f"  {r['verdicts']}" if "verdicts" in r else ""))
     results["batch"] = batch = batch_rows()
+    results["batch_targets"] = batch_targets(batch)
     print_batch(batch)
     results["growth"] = growth = growth_rows()
     print("\ngrowth: certification CPU time per trajectory (projection cached), singcheck and "
@@ -609,6 +635,7 @@ def batch_only() -> None:
     out = ROOT / "bench" / "results.json"
     results = json.loads(out.read_text()) if out.exists() else {"machine": machine()}
     results["batch"] = batch_rows()
+    results["batch_targets"] = batch_targets(results["batch"])
     print_batch(results["batch"])
     out.write_text(json.dumps(results, indent=2) + "\n")
 

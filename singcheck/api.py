@@ -18,7 +18,7 @@ same :class:`Robot` runs no CAS and reads no cache entry.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
@@ -30,7 +30,7 @@ from singcheck.certify.pieces import certify_trajectory
 from singcheck.certify.working_modes import WorkingMode
 from singcheck.elimination.projection import MAX_SURFACE_TERMS, RobotProjection, project_robot
 from singcheck.model.robot import RobotModel, build_model
-from singcheck.spec.files import RobotSpec, TrajectorySpec
+from singcheck.spec.files import Document, RobotSpec, TrajectorySpec
 from singcheck.spec.files import load_robot as read_robot_spec
 from singcheck.spec.files import load_trajectory as read_trajectory_spec
 
@@ -289,18 +289,33 @@ def _worker_signals() -> None:
     every worker at once), even when the parent is SIGKILLed."""
     import signal
 
-    from singcheck.elimination.cas.guard import PR_SET_PDEATHSIG, prctl
+    from singcheck.elimination.cas.guard import die_with_parent
 
-    prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
-
+    die_with_parent(_WORKER["parent"])  # SIGTERM: the default action
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
-def _check_indices(indices: list[int]) -> list[tuple[int, dict]]:
-    robot, trajectories, options = _WORKER["robot"], _WORKER["trajectories"], _WORKER["options"]
-    return [(i, check_safely(robot, trajectories[i], **options)) for i in indices]
+def _check_chunk(chunk: list) -> list[dict]:
+    """A worker's task: several trajectories (specs, or documents it parses), in turn."""
+    robot, options = _WORKER["robot"], _WORKER["options"]
+    return [check_item(robot, item, **options) for item in chunk]
+
+
+def check_item(robot: Robot, item: TrajectorySpec | Document, **options) -> dict[str, Any]:
+    """:func:`check_safely` of a trajectory spec, or of a :class:`Document` read but not
+    parsed yet: it is parsed here, and one that is wrong is its own result (verdict
+    ``error``, ``error.kind`` ``spec``, the located message) like any failure of one
+    trajectory of a batch."""
+    if isinstance(item, Document):
+        from singcheck.errors import SpecError
+        from singcheck.report.trajectory import error_json
+
+        try:
+            item = item.parse(robot.spec)
+        except SpecError as e:
+            return {**error_json(item, "spec", str(e)), "time_s": 0.0}
+    return check_safely(robot, item, **options)
 
 
 def prepare_regions(robot: Robot, trajectories: list[TrajectorySpec], time_limit: float | None,
@@ -321,7 +336,25 @@ def prepare_regions(robot: Robot, trajectories: list[TrajectorySpec], time_limit
     return True
 
 
-def check_batch(robot: Robot, trajectories: list[TrajectorySpec], *,
+#: the trajectories a batch reads before it starts: the shared region maps are prepared
+#: from them, and a batch of at most 4 runs in this process
+LOOKAHEAD = 100
+#: trajectories per task of a batch's worker processes, and tasks in flight per worker
+CHUNK = 8
+TASKS_PER_WORKER = 4
+
+
+def shared_regions(robot: Robot, head: list, options: dict, notify: Notify = _quiet) -> None:
+    """Before a batch's workers start: the region maps that its first trajectories
+    share, computed once (:func:`prepare_regions`); ``options["regions"]`` is turned off
+    when that ran out of time."""
+    specs = [t for t in head if isinstance(t, TrajectorySpec)]
+    if options["regions"] and robot.model.polynomial and specs and not prepare_regions(
+            robot, specs, options["time_limit"], notify):
+        options["regions"] = False
+
+
+def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document], *,
                 tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
                 time_limit: float | None = DEFAULT_TIME_LIMIT, jobs: int = 1,
                 ordered: bool = True, notify: Notify = _quiet) -> Iterator[dict]:
@@ -329,60 +362,98 @@ def check_batch(robot: Robot, trajectories: list[TrajectorySpec], *,
     yields each one's JSON trajectory object as soon as it is known: in input order, or
     (``ordered=False``) in the order they finish.
 
-    One trajectory's failure is its own result (:func:`check_safely`); a worker process
-    that dies makes the trajectories it held ``error`` results.  ``time_limit`` bounds
-    each trajectory (and the shared region maps, once)."""
+    ``trajectories`` is read lazily, a bounded window ahead of the results (specs, or
+    :class:`~singcheck.spec.files.Document` from :func:`singcheck.spec.files.read_documents`,
+    which the workers parse), so memory does not grow with their number.  One
+    trajectory's failure is its own result (:func:`check_item`); a worker process that
+    dies makes the trajectories it held ``error`` results.  ``time_limit`` bounds each
+    trajectory (and the shared region maps, once)."""
+    from itertools import chain, islice
+
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
                    notify=notify)
-    n = len(trajectories)
-    if jobs > 1 and n > 4:
-        if regions and robot.model.polynomial and not prepare_regions(
-                robot, trajectories, time_limit, notify):
-            options["regions"] = False
-        yield from _forked(robot, trajectories, options, jobs, ordered)
+    items = iter(trajectories)
+    head = list(islice(items, LOOKAHEAD))
+    if jobs > 1 and len(head) > 4:
+        shared_regions(robot, head, options, notify)
+        yield from _forked(robot, chain(head, items), options, jobs, ordered)
         return
-    for spec in trajectories:
-        yield check_safely(robot, spec, **options)
+    for item in chain(head, items):
+        yield check_item(robot, item, **options)
 
 
-def _forked(robot, trajectories, options, jobs: int, ordered: bool) -> Iterator[dict]:
+def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterator[dict]:
+    """The batch in ``jobs`` forked workers, CHUNK trajectories per task and
+    TASKS_PER_WORKER tasks per worker in flight: a finished task is replaced by the next
+    one read (before its results are yielded), so at most that many trajectories are
+    held here at once, whatever the length of the batch."""
     import multiprocessing
+    import os
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
+    from itertools import islice
 
+    from singcheck.algebra.pickling import register
     from singcheck.report.trajectory import error_json
 
-    n = len(trajectories)
-    size = max(1, min(64, n // (jobs * 16)))
-    chunks = [list(range(i, min(n, i + size))) for i in range(0, n, size)]
-    _WORKER.update(robot=robot, trajectories=trajectories, options=options)
-    pool = ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
-                               initializer=_worker_signals)
+    register()  # specs cross to the workers by pickle
+    _WORKER.update(robot=robot, options=options, parent=os.getpid())
+
+    def start():
+        return ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
+                                   initializer=_worker_signals)
+
+    pool = start()
+    in_flight: dict = {}  # future -> (index of its first trajectory, its trajectories)
+    read = 0
+
+    def submit() -> bool:
+        nonlocal read, pool
+        chunk = list(islice(items, CHUNK))
+        if chunk:
+            try:
+                future = pool.submit(_check_chunk, chunk)
+            except BrokenProcessPool:  # a worker died: the tasks it broke are errors, and
+                _stop(pool)  # the batch goes on in a new pool
+                pool = start()
+                future = pool.submit(_check_chunk, chunk)
+            in_flight[future] = (read, chunk)
+            read += len(chunk)
+        return bool(chunk)
+
     try:
-        futures = {pool.submit(_check_indices, chunk): chunk for chunk in chunks}
-        pending = list(futures)
+        while len(in_flight) < jobs * TASKS_PER_WORKER and submit():
+            pass
         done_early: dict[int, dict] = {}
         next_out = 0
-        while pending:
-            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-            pending = [f for f in pending if f not in finished]
+        while in_flight:
+            finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
+            results: list[tuple[int, dict]] = []
             for future in finished:
-                chunk = futures.pop(future)  # a done future holds its results: let go
+                first, chunk = in_flight.pop(future)  # a done future holds its results
                 try:
-                    results = future.result()
+                    docs = future.result()
                 except Exception as e:  # the worker process died (killed, out of memory)
                     reason = f"the worker process failed: {type(e).__name__}: {e}"
-                    results = [(i, error_json(trajectories[i], "internal", reason))
-                               for i in chunk]
-                if not ordered:
-                    for _, doc in results:
-                        yield doc
-                    continue
-                done_early.update(results)
+                    docs = [error_json(item, "internal", reason) for item in chunk]
+                results += enumerate(docs, first)
+            while len(in_flight) < jobs * TASKS_PER_WORKER and submit():
+                pass
+            if not ordered:
+                for _, doc in results:
+                    yield doc
+                continue
+            done_early.update(results)
             while next_out in done_early:
                 yield done_early.pop(next_out)
                 next_out += 1
     finally:
         _WORKER.clear()
-        for process in list(getattr(pool, "_processes", {}).values()):
-            process.terminate()
-        pool.shutdown(wait=True, cancel_futures=True)
+        _stop(pool)
+
+
+def _stop(pool) -> None:
+    """End a worker pool now: its processes terminated, its queued tasks cancelled."""
+    for process in list((getattr(pool, "_processes", None) or {}).values()):
+        process.terminate()
+    pool.shutdown(wait=True, cancel_futures=True)

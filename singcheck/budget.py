@@ -43,6 +43,12 @@ def deadline(seconds: float | None) -> Iterator[None]:
         _DEADLINE.reset(token)
 
 
+def remaining() -> float | None:
+    """Seconds left before the current deadline (0 when past it; None: no deadline)."""
+    limit = _DEADLINE.get()
+    return None if limit is None else max(0.0, limit[0] - time.monotonic())
+
+
 def checkpoint() -> None:
     """Raise :class:`TimeLimitExceeded` when the current deadline has passed."""
     limit = _DEADLINE.get()

@@ -1,9 +1,11 @@
 """Batches on a Dask cluster: ``singcheck run … --scheduler ADDRESS``.
 
 The robot's projection is computed once, here, and shipped to every worker
-(``Client.scatter(…, broadcast=True)``); each trajectory is one task, which calls the
-public API (:func:`singcheck.api.check_safely`, i.e. :func:`singcheck.check` with the
-batch's failure handling); results come back as they finish.  The transport, the
+(``Client.scatter(…, broadcast=True)``); each task holds a few trajectories (CHUNK) and
+calls the public API for each (:func:`singcheck.api.check_item`, i.e.
+:func:`singcheck.check` with the batch's failure handling; a document read but not
+parsed is parsed on the worker); results come back as the tasks finish, a bounded
+number of tasks in flight.  The transport, the
 scheduling and the worker processes are dask.distributed's (``pip install
 'singcheck[dask]'``): singcheck adds no protocol of its own.  python-flint's polynomials
 cross the wire through :mod:`singcheck.algebra.pickling`.
@@ -12,20 +14,21 @@ cross the wire through :mod:`singcheck.algebra.pickling`.
 from __future__ import annotations
 
 import uuid
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import replace
 
 from singcheck.api import (
     DEFAULT_TIME_LIMIT,
     DEFAULT_TOLERANCE,
+    LOOKAHEAD,
     Notify,
     Robot,
     _quiet,
-    check_safely,
-    prepare_regions,
+    check_item,
+    shared_regions,
 )
 from singcheck.errors import BackendError, SpecError
-from singcheck.spec.files import TrajectorySpec
+from singcheck.spec.files import Document, TrajectorySpec
 
 CONNECT_TIMEOUT = 30  # seconds to reach the scheduler
 
@@ -42,40 +45,52 @@ def _client(address: str):
         raise BackendError(f"cannot reach the Dask scheduler at {address}: {e}") from None
 
 
-def _remote_check(robot: Robot, trajectory: TrajectorySpec, options: dict,
-                  region_cache: bool) -> dict:
-    """One task, on a worker: the public API on the shipped robot."""
+def _remote_check(robot: Robot, chunk: list, options: dict, region_cache: bool) -> list[dict]:
+    """One task, on a worker: the public API on the shipped robot, for a few
+    trajectories (specs, or documents parsed here) in turn."""
     if region_cache and robot.region_cache is None:
         from singcheck.spaces.region_map import RegionMapCache
 
         robot.region_cache = RegionMapCache()  # the worker's own cache directory
-    return check_safely(robot, trajectory, **options)
+    return [check_item(robot, item, **options) for item in chunk]
 
 
-def check_on_cluster(address: str, robot: Robot, trajectories: list[TrajectorySpec], *,
+#: trajectories per task: on a 2-worker LocalCluster a task cost about 14 ms of CPU
+#: beyond its trajectories' own (a heart-like path: about 5 ms), so a long batch goes 64
+#: to a task, a short one in at least TASKS_PER_WORKER tasks per worker thread
+CHUNK = 64
+TASKS_PER_WORKER = 4
+
+
+def check_on_cluster(address: str, robot: Robot,
+                     trajectories: Iterable[TrajectorySpec | Document], *,
                      tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
                      time_limit: float | None = DEFAULT_TIME_LIMIT, ordered: bool = True,
                      notify: Notify = _quiet) -> Iterator[dict]:
     """:func:`singcheck.api.check_batch` on the dask.distributed scheduler at
     ``address``: yields each trajectory's JSON object in input order, or
-    (``ordered=False``) as the tasks finish.  Stopping the iteration (Ctrl-C) cancels
-    the tasks still queued."""
+    (``ordered=False``) as the tasks finish.  ``trajectories`` is read lazily, a bounded
+    number of tasks ahead.  Stopping the iteration (Ctrl-C) cancels the tasks still
+    queued."""
+    from itertools import chain, islice
+
     from singcheck.algebra.pickling import register
 
     register()
     client = _client(address)
     try:
-        notify(f"dask scheduler {address}: {len(client.scheduler_info()['workers'])} "
-               "worker(s)")
+        workers = client.scheduler_info()["workers"]
+        threads = sum(w.get("nthreads", 1) for w in workers.values())
+        notify(f"dask scheduler {address}: {len(workers)} worker(s)")
         options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit)
-        if regions and robot.model.polynomial and not prepare_regions(
-                robot, trajectories, time_limit, notify):
-            options["regions"] = False
+        items = iter(trajectories)
+        head = list(islice(items, LOOKAHEAD))
+        shared_regions(robot, head, options, notify)
         shipped = client.scatter(replace(robot, region_cache=None), broadcast=True)
-        window = max(64, 16 * len(client.scheduler_info()["workers"]))
-        yield from _results(client, _Submitter(client, shipped, trajectories, options,
-                                               robot.region_cache is not None, window),
-                            trajectories, ordered)
+        window = max(8, TASKS_PER_WORKER * threads)  # tasks in flight
+        size = CHUNK if len(head) == LOOKAHEAD else max(1, min(CHUNK, -(-len(head) // window)))
+        yield from _results(_Submitter(client, shipped, chain(head, items), options,
+                                       robot.region_cache is not None, window, size), ordered)
     finally:
         client.close()  # the tasks still queued or running are cancelled with it
 
@@ -84,48 +99,54 @@ class _Submitter:
     """Submits the tasks a window at a time (``window`` in flight), so that neither this
     process nor the scheduler holds a task per trajectory of a long batch at once."""
 
-    def __init__(self, client, shipped, trajectories, options, region_cache: bool,
-                 window: int) -> None:
+    def __init__(self, client, shipped, items: Iterator, options, region_cache: bool,
+                 window: int, size: int) -> None:
         from distributed import as_completed
 
         self.client, self.shipped, self.options = client, shipped, options
         self.region_cache = region_cache
-        self.pending = iter(enumerate(trajectories))
+        self.items, self.size = items, size
+        self.read = 0
         self.batch = uuid.uuid4().hex[:12]
-        self.index: dict[str, int] = {}
+        self.chunks: dict[str, tuple[int, list]] = {}  # key -> (first index, trajectories)
         self.completed = as_completed(loop=client.loop)
         for _ in range(window):
             self.next()
 
     def next(self) -> None:
-        """Submit the next trajectory's task, if any is left."""
-        for i, spec in self.pending:
-            future = self.client.submit(_remote_check, self.shipped, spec, self.options,
-                                        self.region_cache, key=f"singcheck-{self.batch}-{i}",
-                                        pure=False)
-            self.index[future.key] = i
-            self.completed.add(future)
+        """Submit the next few trajectories as one task, if any is left."""
+        from itertools import islice
+
+        chunk = list(islice(self.items, self.size))
+        if not chunk:
             return
+        future = self.client.submit(_remote_check, self.shipped, chunk, self.options,
+                                    self.region_cache, key=f"singcheck-{self.batch}-{self.read}",
+                                    pure=False)
+        self.chunks[future.key] = (self.read, chunk)
+        self.read += len(chunk)
+        self.completed.add(future)
 
 
-def _results(client, tasks: _Submitter, trajectories, ordered: bool) -> Iterator[dict]:
+def _results(tasks: _Submitter, ordered: bool) -> Iterator[dict]:
     from singcheck.report.trajectory import error_json
 
     done: dict[int, dict] = {}
     next_out = 0
     for future in tasks.completed:
-        i = tasks.index.pop(future.key)
+        first, chunk = tasks.chunks.pop(future.key)
         try:
-            doc = future.result()
+            docs = future.result()
         except Exception as e:  # the task was lost (a worker died) or could not run
-            doc = error_json(trajectories[i], "internal",
-                             f"the Dask task failed: {type(e).__name__}: {e}")
+            docs = [error_json(item, "internal",
+                               f"the Dask task failed: {type(e).__name__}: {e}")
+                    for item in chunk]
         future.release()
         tasks.next()
         if not ordered:
-            yield doc
+            yield from docs
             continue
-        done[i] = doc
+        done.update(enumerate(docs, first))
         while next_out in done:
             yield done.pop(next_out)
             next_out += 1

@@ -342,3 +342,365 @@ def test_exact_decisions_with_a_square_root_in_the_robot_agree_with_50_digits():
             eps = mpmath.mpf("1e-7")
             crosses = det_a(t - eps, m.mode) * det_a(t + eps, m.mode) < 0
             assert det_a_vanishes_at(path, point, m.mode) == crosses, (float(t), m.mode)
+
+
+# -- revolute legs: the 5-bar and the rotary Delta ----------------------------------------
+
+
+def _bundled(robot: str):
+    from pathlib import Path
+
+    from singcheck.spec.files import load_robot
+
+    root = Path(__file__).resolve().parent.parent
+    if robot not in _PROJECTIONS:
+        model = build_model(load_robot(root / f"robots/{robot}.yaml"))
+        _PROJECTIONS[robot] = project_robot(model, get_backend("flint"))
+    return _PROJECTIONS[robot]
+
+
+def _revolute_path(robot: str, text: str):
+    projection = _bundled(robot)
+    return build_path(projection, parse_trajectory(text, "t.yaml", projection.model.spec))
+
+
+def _oracle_modes(path, oracle, pose_at, t0) -> dict[str, tuple[int, ...]]:
+    """Our mode label → the oracle's branch indices, matched by the joint angles at the
+    rational time t0 (the oracle's IK is its own closed form, at 50 digits)."""
+    from flint import arb
+
+    ours = [leg.branches(arb(float(t0))) for leg in path.legs]
+    theirs = [leg.branches(pose_at(mpmath.mpf(t0.numerator) / t0.denominator))
+              for leg in oracle.legs]
+    out = {}
+    for label in ("".join(s) for s in product("+-", repeat=len(path.legs))):
+        indices = []
+        for sign, branch, both in zip(label, ours, theirs, strict=True):
+            c, s = branch[sign]
+            angle = mpmath.atan2(float(s.mid()), float(c.mid()))
+            [k] = [k for k in (0, 1) if abs(mpmath.sin((angle - both[k]) / 2)) < 1e-6]
+            indices.append(k)
+        out[label] = tuple(indices)
+    return out
+
+
+def _revolute_zero_modes(oracle, modes, pose, tiny="1e-30", big="1e-8") -> set[str]:
+    """The modes whose 50-digit det A is 0 at the pose (each value must be clearly 0 or
+    clearly not)."""
+    out = set()
+    for label, indices in modes.items():
+        joints = oracle.joints(indices, pose)
+        value = abs(oracle.det_A(joints, pose))
+        assert value < mpmath.mpf(tiny) or value > mpmath.mpf(big), (label, value)
+        if value < mpmath.mpf(tiny):
+            out.add(label)
+    return out
+
+
+FIVE_BAR_TOUCH = trajectory("3/2", "2", x="t*t - 3", y="sqrt(3)")
+
+
+def test_five_bar_line_tangent_where_the_distal_links_align_is_singular_at_sqrt_3():
+    from tests.robot_oracles import five_bar
+
+    # y = √3 is tangent to the elbows-out singular curve at (0, √3) (it is symmetric in
+    # x); x = t² - 3 reaches x = 0 at the quadratic irrational t = √3
+    path = _revolute_path("five-bar", FIVE_BAR_TOUCH)
+    report = certify_path(path)
+    mpmath.mp.dps = 50
+    oracle = five_bar()
+
+    def pose_at(t):
+        return [t * t - 3, mpmath.sqrt(3)]
+
+    modes = _oracle_modes(path, oracle, pose_at, Fraction(7, 4))
+    t0 = mpmath.sqrt(3)
+    expected = _revolute_zero_modes(oracle, modes, pose_at(t0))
+    assert expected == {"+-"}
+    indices = modes["+-"]
+
+    def det(t):
+        return oracle.det_A(oracle.joints(indices, pose_at(t)), pose_at(t))
+
+    eps = mpmath.mpf("1e-4")
+    assert det(t0 - eps) * det(t0 + eps) > 0  # a tangency: no sign change
+    assert report.verdict == "singular"
+    [candidate] = report.candidates
+    assert candidate.t.contains(float(t0)) or abs(float(candidate.t.mid()) - float(t0)) < 1e-9
+    assert set(candidate.singular_modes) == expected
+    assert all(m.status != "unknown" for m in candidate.modes)
+
+
+def test_rotary_delta_touching_the_surface_in_infeasible_modes_only_is_free():
+    # on the axis, at z = -(4 + √3)/2 the elbows th = 2π/3 sit right above the centre:
+    # the three forearms are vertical, parallel (det A = 0, a double zero in t); that
+    # branch is outside the limits [-π/2, 3π/4] at the start, the feasible one is not
+    from tests.robot_oracles import rotary_delta
+
+    path = _revolute_path("rotary-delta", trajectory("5/2", "29/10", x="0", y="0", z="-t"))
+    report = certify_path(path)
+    mpmath.mp.dps = 50
+    oracle = rotary_delta()
+    tau = (4 + mpmath.sqrt(3)) / 2
+
+    def pose_at(t):
+        return [0, 0, -t]
+
+    modes = _oracle_modes(path, oracle, pose_at, Fraction(27, 10))
+    two_thirds = oracle.joints(modes["+++"], pose_at(tau))
+    assert all(abs(mpmath.cos(q) + mpmath.mpf(1) / 2) < 1e-40 for q in two_thirds)
+    singular = _revolute_zero_modes(oracle, modes, pose_at(tau), tiny="1e-25")
+    assert "+++" in singular and "---" not in singular
+    assert [m.label for m in report.modes if m.feasible] == ["---"]
+    assert report.verdict == "singularity-free"
+    [candidate] = report.candidates
+    assert abs(float(candidate.t.mid()) - float(tau)) < 1e-9
+    assert set(candidate.singular_modes) == singular
+    assert all(m.status != "unknown" for m in candidate.modes)
+
+
+def _mp(q: str):
+    return mpmath.mpf(Fraction(q).numerator) / Fraction(q).denominator
+
+
+@pytest.mark.parametrize("robot, text, oracle_name, pose_at", [
+    ("five-bar", FIVE_BAR_TOUCH, "five_bar", lambda t: [t * t - 3, mpmath.sqrt(3)]),
+    ("five-bar", "trajectories/five-bar-cross.yaml", "five_bar", lambda t: [0, 3 - 2 * t]),
+    ("rotary-delta", "trajectories/rotary-delta-cross.yaml", "rotary_delta",
+     lambda t: [_mp("7/4") + _mp("3/10") * t, 0, -1]),
+    ("rotary-delta", trajectory("5/2", "29/10", x="0", y="0", z="-t"), "rotary_delta",
+     lambda t: [0, 0, -t]),
+])
+def test_exact_decisions_on_revolute_legs_agree_with_50_digits(robot, text, oracle_name,
+                                                               pose_at):
+    from pathlib import Path
+
+    from singcheck.certify.exact import AlgebraicPoint, det_a_vanishes_at
+    from tests import robot_oracles
+
+    if text.startswith("trajectories/"):
+        text = (Path(__file__).resolve().parent.parent / text).read_text()
+    path = _revolute_path(robot, text)
+    report = certify_path(path)
+    mpmath.mp.dps = 50
+    oracle = getattr(robot_oracles, oracle_name)()
+    start = path.trajectory.range.start.rational
+    end = path.trajectory.range.end.rational
+    modes = _oracle_modes(path, oracle, pose_at, (start + end) / 2 + Fraction(1, 97))
+    assert report.candidates
+    for c in report.candidates:
+        point = AlgebraicPoint(c.root.exact)
+        t = mpmath.mpf(c.root.refined(1e-45).t.mid().str(60, radius=False))
+        # every mode whose IK is real at the root, decided by the oracle at 50 digits
+        real = {m: i for m, i in modes.items() if oracle.joints(i, pose_at(t)) is not None}
+        expected = _revolute_zero_modes(oracle, real, pose_at(t), tiny="1e-25")
+        assert expected
+        for label in real:
+            assert det_a_vanishes_at(path, point, label) == (label in expected), label
+
+
+def _five_bar_pose_zero_modes(pose_at, text, robot="five-bar", samples=(Fraction(1, 3),)):
+    """The modes whose 50-digit det A (the oracle's) is 0 at every sample time."""
+    from tests.robot_oracles import five_bar
+
+    mpmath.mp.dps = 50
+    oracle = five_bar()
+    path = _revolute_path(robot, text)
+    modes = _oracle_modes(path, oracle, pose_at, samples[0])
+    zero = None
+    for q in samples:
+        t = mpmath.mpf(q.numerator) / q.denominator
+        found = _revolute_zero_modes(oracle, modes, pose_at(t))
+        zero = found if zero is None else zero & found
+    return path, zero
+
+
+def test_five_bar_resting_where_the_distal_links_align_is_singular_all_along():
+    text = trajectory("0", "1", x="0", y="sqrt(3)")
+    path, expected = _five_bar_pose_zero_modes(lambda t: [0, mpmath.sqrt(3)], text)
+    assert expected == {"+-"}
+    report = certify_path(path)
+    assert report.verdict == "singular" and "whole path" in report.reason
+    assert [m.label for m in report.modes if m.feasible] == ["+-"]
+    assert {m for c in report.candidates for m in c.singular_modes} == expected
+
+
+def test_five_bar_on_the_surface_of_an_infeasible_mode_only_is_free():
+    # (0, 2 - √3) is 2 away from the shared elbow (0, -√3): the mode with both elbows
+    # there (th1 = -π/3, outside the limits) is singular, the elbows-out mode is not
+    text = trajectory("0", "1", x="0", y="2 - sqrt(3)")
+    path, zero = _five_bar_pose_zero_modes(lambda t: [0, 2 - mpmath.sqrt(3)], text)
+    assert len(zero) == 1 and "+-" not in zero
+    report = certify_path(path)
+    assert [m.label for m in report.modes if m.feasible] == ["+-"]
+    assert report.verdict == "singularity-free"
+    assert "lies on ξ(X) = 0" in report.reason
+
+
+def test_five_bar_arc_around_the_shared_elbow_is_singular_all_along_without_limits():
+    # P = (0, -√3) + 2(cos t, sin t): both elbows can sit at (0, -√3), 2 from each base
+    from pathlib import Path
+
+    robot = "five-bar-nolimits"
+    if robot not in _PROJECTIONS:
+        root = Path(__file__).resolve().parent.parent
+        text = (root / "robots/five-bar.yaml").read_text().replace(
+            "joint_limits: {th1: [pi/3, pi], th2: [0, 2*pi/3]}\n", "")
+        spec = parse_robot(text, "r.yaml")
+        _PROJECTIONS[robot] = project_robot(build_model(spec), get_backend("flint"))
+    text = trajectory("1/4", "1", x="2*cos(t)", y="-sqrt(3) + 2*sin(t)")
+
+    def pose_at(t):
+        return [2 * mpmath.cos(t), -mpmath.sqrt(3) + 2 * mpmath.sin(t)]
+
+    samples = [Fraction(1, 4) + Fraction(3, 4) * Fraction(k, 8) for k in range(1, 8)]
+    path, expected = _five_bar_pose_zero_modes(pose_at, text, robot, samples)
+    assert len(expected) == 1
+    report = certify_path(path)
+    assert report.verdict == "singular" and "whole path" in report.reason
+    singular = {m for c in report.candidates for m in c.singular_modes}
+    assert singular == expected
+    assert all(m.status != "unknown" for c in report.candidates for m in c.modes)
+
+
+# -- touches at transcendental times (paths mixing t with sin t, cos t) ---------------------
+
+
+def _orthoglide_scale_touch(lower: str, start: str, end: str, h: str, h_mp):
+    """X(t) = (1 - h(t)²/4)·X0: |X| ≤ 2, = 2 exactly where h = 0 (a tangency to the
+    sphere from inside, in the four modes whose branches meet ρ = 0 there)."""
+    report = certify(orthoglide(lower), trajectory(start, end, **along(X0_TEXT,
+                                                                     f"1 - ({h})^2/4")))
+    mpmath.mp.dps = 50
+    tau = mpmath.findroot(h_mp, float((Fraction(start) + Fraction(end)) / 2))
+
+    def det_a(t, label):  # 50 digits: ρᵢ = xᵢ ± √(4 - |X|² + xᵢ²)
+        scale = 1 - h_mp(t) ** 2 / 4
+        pose = [scale * (mpmath.mpf(x.numerator) / x.denominator) for x in X0]
+        r2 = sum(x * x for x in pose)
+        joints = [x + (1 if s == "+" else -1) * mpmath.sqrt(4 - r2 + x * x)
+                  for x, s in zip(pose, label, strict=True)]
+        return orthoglide_det_a(pose, joints)
+
+    return report, tau, det_a
+
+
+@pytest.mark.parametrize("h, h_mp, start, end", [
+    # μ has the factor (t - cos t)²: τ is the Dottie number, cos τ = τ
+    ("t - cos(t)", lambda t: t - mpmath.cos(t), "1/2", "1"),
+    # (t - sin t - 1/2)² is a square only on the circle: reduced modulo s² + c² = 1 it
+    # is t² - 2ts - t + 1/4 + ... - c², irreducible in Q[t, s, c]
+    ("t - sin(t) - 1/2", lambda t: t - mpmath.sin(t) - mpmath.mpf(1) / 2, "1", "2"),
+])
+def test_orthoglide_touching_the_sphere_at_a_transcendental_time_is_singular(h, h_mp, start,
+                                                                            end):
+    began = time.process_time()
+    report, tau, det_a = _orthoglide_scale_touch("-1", start, end, h, h_mp)
+    assert time.process_time() - began < 10
+    expected = modes_singular_on_sphere(X0)  # the pose at τ is X0 exactly
+    for label in expected:  # a tangency: det A ≠ 0 on either side, no sign change
+        eps = mpmath.mpf("1e-3")
+        assert det_a(tau - eps, label) * det_a(tau + eps, label) > 0
+        assert abs(det_a(tau, label)) < mpmath.mpf("1e-40")
+    assert report.root_method == "interval branch-and-bound"
+    assert report.verdict == "singular" and not report.undecided
+    [candidate] = report.candidates
+    assert abs(float(candidate.t.mid()) - float(tau)) < 1e-9 and candidate.t.rad() < 1e-9
+    assert set(candidate.singular_modes) == expected
+    proofs = {m.mode: m.proof for m in candidate.modes}
+    assert {proofs[m] for m in expected} == {"det A = 0 exactly (at a transcendental time)"}
+    assert all(m.status != "unknown" for m in candidate.modes)
+
+
+def test_the_transcendental_touch_is_free_when_limits_exclude_the_singular_modes():
+    report, tau, det_a = _orthoglide_scale_touch("1/10", "1", "2", "t - sin(t) - 1/2",
+                                                 lambda t: t - mpmath.sin(t) - mpmath.mpf(1) / 2)
+    assert abs(det_a(tau, "+++")) > 1  # the feasible mode (ρ = 2X at τ) is regular
+    assert [m.label for m in report.modes if m.feasible] == ["+++"]
+    assert report.verdict == "singularity-free" and not report.undecided
+
+
+def test_zero_tests_at_a_transcendental_root_agree_with_50_digits():
+    from flint import fmpq
+
+    from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig
+    from singcheck.roots.branch_bound import branch_and_bound
+    from singcheck.roots.transcendental import TranscendentalPoint
+
+    t, s, c = TRIG.gens()
+    half = TRIG.from_dict({(0, 0, 0): fmpq(1, 2)})
+    h = t - s - half  # τ - sin τ = 1/2, τ ≈ 1.4973
+    interval = TimeRange(LinearInPi(Fraction(1)), LinearInPi(Fraction(2)))
+    [root] = branch_and_bound(h, interval, 1e-9).roots
+    point = TranscendentalPoint(root.exact)
+    mpmath.mp.dps = 50
+    tau = mpmath.findroot(lambda u: u - mpmath.sin(u) - mpmath.mpf(1) / 2, 1.5)
+
+    def value(p):
+        return sum(mpmath.mpf(int(k.p)) / int(k.q) * tau ** int(i) * mpmath.sin(tau) ** int(j)
+                   * mpmath.cos(tau) ** int(m) for (i, j, m), k in p.terms())
+
+    zeros = [h, h * (t + c), s * s + c * c - 1 + h * s, (t - half) ** 2 - (1 - c * c)]
+    nonzeros = [t + s - half, t - c, (t + s - half) * (t - c), s, c - t * s]
+    for element, zero in [(e, True) for e in zeros] + [(e, False) for e in nonzeros]:
+        element = reduce_trig(element)
+        assert (abs(value(element)) < mpmath.mpf("1e-40")) == zero, str(element)
+        assert point.is_zero(element) == zero, str(element)
+
+
+@pytest.mark.parametrize("bump, bump_mp, start, end, tau", [
+    # 1 + cos t ≥ 0 touches 0 at t = π (a zero of even order on the circle)
+    ("(1 + cos(t))*(1 + t/8)", lambda t: (1 + mpmath.cos(t)) * (1 + t / 8), "3", "4",
+     lambda: mpmath.pi),
+    # cos τ = 4/5 and sin τ = 3/5 are rational, τ = acos(4/5) is transcendental
+    ("(5*cos(t) - 4)^2*(1 + t/8)", lambda t: (5 * mpmath.cos(t) - 4) ** 2 * (1 + t / 8),
+     "3/5", "7/10", lambda: mpmath.acos(mpmath.mpf(4) / 5)),
+])
+def test_touch_where_sin_and_cos_are_algebraic_but_t_is_not(bump, bump_mp, start, end, tau):
+    report = certify(orthoglide("-1"), trajectory(start, end,
+                                                  **along(X0_TEXT, f"1 - {bump}/4")))
+    mpmath.mp.dps = 50
+    tau = tau()
+    assert abs(bump_mp(tau)) < mpmath.mpf("1e-45")  # the pose at τ is X0, on the sphere
+    eps = mpmath.mpf("1e-3")
+    assert bump_mp(tau - eps) > 0 < bump_mp(tau + eps)  # inside the sphere on both sides
+    assert report.verdict == "singular"
+    [candidate] = report.candidates
+    assert abs(float(candidate.t.mid()) - float(tau)) < 1e-9
+    assert set(candidate.singular_modes) == modes_singular_on_sphere(X0)
+    assert all(m.status != "unknown" for m in candidate.modes)
+
+
+# -- the workspace line of a path lying on ξ = 0 -------------------------------------------
+
+
+@pytest.mark.parametrize("lower, surfaces, count", [
+    ("-1", {"parallel singularity ξ"}, 8),
+    # with ρ ≥ 0 the branches ρ = x - x = 0 sit on the limit, whose surface (the leg's
+    # constraint at ρ = 0: x² + y² + z² = 4) is the sphere too
+    ("0", {"parallel singularity ξ", "rho1 = 0 (min)", "rho2 = 0 (min)", "rho3 = 0 (min)"},
+     None),
+])
+def test_the_workspace_line_says_the_path_lies_on_the_surface(lower, surfaces, count):
+    from singcheck.report.trajectory import workspace_json, workspace_line
+    from singcheck.spaces.path_regions import path_in_workspace
+
+    x, y, z = X0
+    assert x * x + y * y + z * z == 4  # on the sphere, every leg's ρ = 0 surface
+    expected_count = 1
+    for v in X0:  # ρ = v ± v, both strictly inside [-1, 4] when the limit is -1
+        expected_count *= sum(Fraction(lower) < v + sign * v < 4 for sign in (1, -1))
+    assert (expected_count if lower == "-1" else None) == count
+    report = certify(orthoglide(lower), trajectory("0", "1", x="2/3", y="4/3", z="4/3"))
+    assert report.verdict == "singular"
+    w = path_in_workspace(report.path, name_region=False,
+                          mu_roots=[c.t for c in report.candidates]
+                          if report.mu_roots_complete else None)
+    assert not w.undecided and not w.crossings and w.one_region is False
+    assert {s for s, _ in w.on_surfaces} == surfaces
+    assert {where for _, where in w.on_surfaces} == {"[0, 1]"}
+    line = workspace_line(workspace_json(w))
+    assert "not all decided" not in line
+    assert line.startswith("workspace: the path lies on ") and "for t ∈ [0, 1]" in line
+    if count is not None:
+        assert line.endswith(f"({count} IK solution(s) inside the joint limits all along)")

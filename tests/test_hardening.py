@@ -440,6 +440,15 @@ def _alive(pid: int) -> bool:
         return False
 
 
+def _pids_written(path: Path, proc: subprocess.Popen) -> list[int]:
+    """The pids a fake wrote to ``path`` (one line), waiting for it while ``proc`` runs."""
+    deadline = time.monotonic() + 60
+    while not (path.exists() and path.read_text().endswith("\n")):
+        assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
+        time.sleep(0.05)
+    return [int(pid) for pid in path.read_text().split()]
+
+
 def _fake_env(tmp_path: Path, hang: bool) -> dict:
     bin_dir = fake_cas(tmp_path, SETSID_CAS)
     tmp = tmp_path / "tmp"
@@ -457,12 +466,7 @@ def test_sigterm_and_sighup_kill_the_cas_and_its_setsid_grandchild(tmp_path, sig
                              str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular",
                              "-q"], env=env, cwd=ROOT, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True)
-    pids_file = tmp_path / "pids"
-    deadline = time.monotonic() + 60
-    while not (pids_file.exists() and pids_file.read_text().endswith("\n")):
-        assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
-        time.sleep(0.05)
-    cas, grandchild = map(int, pids_file.read_text().split())
+    cas, grandchild = _pids_written(tmp_path / "pids", proc)
     assert _alive(cas) and _alive(grandchild)
     assert os.getsid(grandchild) == grandchild != os.getpgid(cas)  # escaped the group
     proc.send_signal(sig)
@@ -538,12 +542,7 @@ def test_a_sigkilled_singcheck_leaves_no_cas_process(tmp_path, caller):
     proc = subprocess.Popen(argv, env=env, cwd=ROOT, stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE)
     try:
-        pids_file = tmp_path / "pids"
-        deadline = time.monotonic() + 60
-        while not (pids_file.exists() and pids_file.read_text().endswith("\n")):
-            assert time.monotonic() < deadline and proc.poll() is None, proc.communicate()
-            time.sleep(0.05)
-        cas, grandchild = map(int, pids_file.read_text().split())
+        cas, grandchild = _pids_written(tmp_path / "pids", proc)
         deadline = time.monotonic() + 10
         while len(_marked(marker)) < 4:  # the guard, the fake, its helper, its grandchild
             assert time.monotonic() < deadline, _marked(marker)
@@ -645,6 +644,40 @@ def test_in_process_projection_is_bounded_in_time_and_memory(
                             "--timeout", "1", "-q")
     one_line_error(code_, err, code, phrase.format(backend))
     assert time.monotonic() - start < 20
+
+
+FORKED_DRIVER = """\
+import os, sys, time
+from singcheck.elimination.cas.isolated import run_forked
+
+def hang(path):
+    with open(path, "w") as f:
+        f.write(f"{os.getpid()}\\n")
+    time.sleep(300)
+
+run_forked(hang, sys.argv[1], 600, "hang")
+"""
+
+
+def test_the_forked_child_dies_with_a_sigkilled_singcheck(tmp_path):
+    pid_file = tmp_path / "pid"
+    proc = subprocess.Popen([sys.executable, "-c", FORKED_DRIVER, str(pid_file)], cwd=ROOT,
+                            env={**os.environ, "PYTHONPATH": str(ROOT)})
+    child = None
+    try:
+        (child,) = _pids_written(pid_file, proc)
+        assert _alive(child)
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 5
+        while _alive(child):
+            assert time.monotonic() < deadline, "the forked child survived SIGKILL"
+            time.sleep(0.05)
+    finally:
+        proc.kill()
+        proc.wait()
+        if child and _alive(child):
+            os.kill(child, signal.SIGKILL)
 
 
 def test_without_a_memory_bound_the_greedy_child_gets_its_memory(monkeypatch):

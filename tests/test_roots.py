@@ -104,11 +104,28 @@ def test_no_root_is_certified_empty():
 
 
 @pytest.mark.slow
-def test_a_double_root_is_undecided_not_guessed():
-    # (sin t - t/20)^2 touches zero without crossing: branch-and-bound cannot prove it
-    iso = isolate_real_roots((S - T / 20) ** 2 + 0 * T, rng(1, 20))
+def test_branch_and_bound_alone_leaves_a_double_root_undecided_not_guessed():
+    # (sin t - t/20)^2 touches zero without crossing: no sign change proves it
+    from singcheck.algebra.trig import reduce_trig
+    from singcheck.roots.branch_bound import branch_and_bound
+
+    iso = branch_and_bound(reduce_trig((S - T / 20) ** 2), rng(2, 4), 1e-9)
     assert not iso.certified
-    assert all("tangency" in u.reason or "multiple" in u.reason for u in iso.undecided)
+    assert all("tangency" in u.reason and "in t ∈ [" in u.reason for u in iso.undecided)
+
+
+def test_a_square_on_the_circle_has_its_double_roots_decided_exactly():
+    # reduced modulo s² + c² = 1, (sin t - t/20)² = 1 - c² - ts/10 + t²/400 is irreducible
+    # in Q[t, s, c]: its zeros are found through its norm over sin t, each decided exactly
+    iso = isolate_real_roots((S - T / 20) ** 2 + 0 * T, rng(1, 20))
+    assert iso.certified
+
+    def f(t):
+        return mpmath.sin(t) - t / 20
+
+    grid = [1 + mpmath.mpf(i) / 100 for i in range(1901)]
+    brackets = [(a, b) for a, b in zip(grid, grid[1:], strict=False) if f(a) * f(b) < 0]
+    assert_roots(iso, [mpmath.findroot(f, (a, b), solver="bisect") for a, b in brackets])
 
 
 def test_identically_zero_is_refused():

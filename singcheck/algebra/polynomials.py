@@ -9,16 +9,29 @@ from __future__ import annotations
 from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 
+def memo_per_object(cache: dict, obj, compute, keep: int = 256):
+    """``compute(obj)``, once per object: the entry keeps the object, so its id is not
+    reused while it is there (the cache is emptied past ``keep`` entries)."""
+    hit = cache.get(id(obj))
+    if hit is None or hit[0] is not obj:
+        if len(cache) > keep:
+            cache.clear()
+        hit = cache[id(obj)] = (obj, compute(obj))
+    return hit[1]
+
+
 def restrict(p: fmpq_mpoly, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
-    """``p`` (free of the dropped variables) re-expressed in the smaller context ``ctx``."""
+    """``p`` (free of the dropped variables) re-expressed in the smaller context ``ctx``.
+
+    The variables are matched by name and the terms moved by FLINT in C
+    (``project_to_context``, a composition with the generators), after an exact check
+    that no dropped variable occurs: tens of thousands of terms in a millisecond."""
     names = p.context().names()
-    keep = [names.index(v) for v in ctx.names()]
-    out = {}
-    for exps, coeff in p.terms():
-        if any(e for i, e in enumerate(exps) if i not in keep):
-            raise ValueError(f"{p} still involves an eliminated variable")
-        out[tuple(exps[i] for i in keep)] = coeff
-    return ctx.from_dict(out)
+    kept = set(ctx.names())
+    degrees = p.degrees()
+    if any(degrees[i] > 0 for i, v in enumerate(names) if v not in kept):
+        raise ValueError(f"{p} still involves an eliminated variable")
+    return p.project_to_context(ctx)
 
 
 def constant_value(p: fmpq_mpoly) -> fmpq:

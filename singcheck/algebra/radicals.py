@@ -261,6 +261,31 @@ def surd_polynomial(value: Surd, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
     return out
 
 
+def constant_surd(p: fmpq_mpoly) -> Surd | None:
+    """The exact number a polynomial in the ``sqrt(q)`` variables alone stands for (its
+    terms Σ c·√q₁·…·√qₖ summed in the multiquadratic field), or None when it involves any
+    other variable.  Inverse of :func:`surd_polynomial`.
+
+    >>> ctx = fmpq_mpoly_ctx.get(("x", "sqrt(2)", "sqrt(3)"), "lex")
+    >>> _, r2, r3 = ctx.gens()
+    >>> str(constant_surd(r2 * r3 / 2 + r3 ** 2))
+    '3 + 1/2*sqrt(6)'
+    >>> constant_surd(ctx.gens()[0] + r2) is None
+    True
+    """
+    primes = {i: q for i, q in radical_variables(p.context())}
+    total = Surd()
+    for exps, coeff in p.terms():
+        if any(e and i not in primes for i, e in enumerate(exps)):
+            return None
+        term = Surd.rational(Fraction(int(coeff.p), int(coeff.q)))
+        for i, e in enumerate(exps):
+            if e:
+                term = term * Surd.sqrt(Fraction(primes[i])) ** e
+        total = total + term
+    return total
+
+
 def radical_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
     """[(index, p)] for every ``sqrt(p)`` variable of ``ctx``."""
     out = []
@@ -316,6 +341,20 @@ def reduce_relations(p: fmpq_mpoly) -> fmpq_mpoly:
                 factor *= (1 - gens[c] ** 2) ** h
         out += ctx.from_dict({k: v for k, v in terms.items() if v != 0}) * factor
     return out
+
+
+def modulo_circles(p: fmpq_mpoly) -> fmpq_mpoly:
+    """``p`` modulo ``cos(v)² + sin(v)² - 1`` of each angle pair of its ring: the same
+    function wherever the angles are real, often with far fewer terms.  FLINT's division
+    with remainder, one circle after the other (their leading monomials are coprime, so
+    they form a Gröbner basis and an earlier reduction is not undone): a representative
+    of degree ≤ 1 in the leading variable of each circle in the ring's order, not
+    necessarily :func:`reduce_relations`'s (which works term by term in Python)."""
+    gens = p.context().gens()
+    for c, s in angle_variables(p.context()):
+        if p.degrees()[c] >= 2 or p.degrees()[s] >= 2:
+            p = divmod(p, gens[c] ** 2 + gens[s] ** 2 - 1)[1]
+    return p
 
 
 def norm_radicals(p: fmpq_mpoly) -> fmpq_mpoly:
@@ -390,18 +429,13 @@ def path_ring(primes, functions=()) -> fmpq_mpoly_ctx:
 
 
 def into_ring(p: fmpq_mpoly, ring: fmpq_mpoly_ctx) -> fmpq_mpoly:
-    """``p`` in a ring that has all of its variables (matched by name)."""
+    """``p`` in a ring that has all of its variables (matched by name; moved by FLINT)."""
     if p.context() is ring:
         return p
-    names = ring.names()
-    where = [names.index(v) for v in p.context().names()]
-    out = {}
-    for exps, coeff in p.terms():
-        e = [0] * ring.nvars()
-        for i, k in zip(where, exps, strict=True):
-            e[i] = k
-        out[tuple(e)] = coeff
-    return ring.from_dict(out)
+    missing = set(p.context().names()) - set(ring.names())
+    if missing:
+        raise ValueError(f"{', '.join(sorted(missing))} not in the ring")
+    return p.project_to_context(ring)
 
 
 _PARTS: dict[int, tuple[fmpq_mpoly, list]] = {}

@@ -47,24 +47,19 @@ from fractions import Fraction
 
 from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 
-from singcheck.algebra.intervals import excludes_zero, working_precision
-from singcheck.algebra.polynomials import constant_value
+from singcheck.algebra.intervals import evaluate, excludes_zero, working_precision
+from singcheck.algebra.polynomials import constant_value, memo_per_object
 from singcheck.algebra.radicals import radical_prime
 from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig, uses_t, uses_trig
 from singcheck.budget import checkpoint
-from singcheck.certify.path import PathModel, memo_per_object
-from singcheck.roots.enclosures import AT_POINT, IN_T, IN_U, ExactTime
+from singcheck.certify.path import PathModel
+from singcheck.roots.enclosures import AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t
 from singcheck.roots.rational import RationalRoot, rational_ball
+from singcheck.roots.transcendental import NotExact, TranscendentalPoint
 
 _MAX_BITS = 1 << 16
-
-
-class NotExact(Exception):
-    """The exact step does not apply (a path mixing t with sin t at a time other than a
-    multiple of π, which is transcendental; revolute legs), or ball arithmetic could not
-    separate a mode from its conjugate within the precision cap."""
 
 
 # ---------------------------------------------------------------------------------
@@ -110,8 +105,6 @@ class ModeExpression:
 
     def __init__(self, path: PathModel) -> None:
         model = path.projection.model
-        if any(leg.revolute for leg in path.legs):
-            raise NotExact("exact decisions are not implemented for revolute legs yet")
         ring_in = path.coordinates[0].context() if path.coordinates else TRIG
         path_names = ring_in.names()
         primes = [radical_prime(v) for v in path_names[3:]]
@@ -133,15 +126,23 @@ class ModeExpression:
 
         gens = dict(zip(names, ring.gens(), strict=True))
         r = ring.gens()[len(path_names):]
-        joints = []
+        images: dict[str, fmpq_mpoly] = {}
+        revolute: list[tuple[str, str, fmpq_mpoly]] = []  # (cos θ, sin θ, W) per leg
         for i, leg in enumerate(path.legs):
-            if leg.leg.degree == 2:
+            if leg.revolute:
+                # W·(cos θ, sin θ) = (-a·d + σ·b·√Δ, -b·d - σ·a·√Δ) (W = a² + b²)
+                a, b, d = (lift(x) for x in leg.coefficients)
+                root = r[quadratic.index(i)]
+                cos_v, sin_v = leg.leg.variables
+                images[cos_v], images[sin_v] = -a * d + root * b, -b * d - root * a
+                revolute.append((cos_v, sin_v, a * a + b * b))
+            elif leg.leg.degree == 2:
                 a, b, _ = leg.coefficients
-                joints.append((r[quadratic.index(i)] - lift(b)) / (2 * constant_value(a)))
+                images[leg.leg.joint] = (r[quadratic.index(i)] - lift(b)) / \
+                    (2 * constant_value(a))
             else:
                 b, c = leg.coefficients
-                joints.append(-lift(c) / constant_value(b))
-        images = dict(zip((leg.leg.joint for leg in path.legs), joints, strict=True))
+                images[leg.leg.joint] = -lift(c) / constant_value(b)
         images.update(zip(model.pose_variables, (lift(x) for x in path.coordinates),
                           strict=True))
         images.update({v: gens[v] for v in path_names[3:]})
@@ -149,13 +150,22 @@ class ModeExpression:
         if any(v not in images for v in det_names):
             raise NotExact("det A involves variables other than the joints, the pose and "
                            "square roots of the path's ring")
-        full = model.det_A.compose(*(images[v] for v in det_names), ctx=ring)
         self.fixed = len(primes)
         self.legs = quadratic
         self.D: list[dict] = [{0: TRIG.from_dict({(0, 0, 0): p})} for p in primes]
         for i in quadratic:
             self.D.append(self._split(lift(path.legs[i].discriminant)))
+        args = [images[v] for v in det_names]
+        full = ring.from_dict({})
+        for deficit, part in _by_angle_degree(model.det_A, revolute).items():
+            checkpoint()
+            term = part.compose(*args, ctx=ring)
+            for (_, _, w), k in zip(revolute, deficit, strict=True):
+                term = term * w ** k
+            full += term
         self.terms = self._split(full)
+        #: W of each revolute leg: det A along a mode is E / ∏ W^e, valid where W ≠ 0
+        self.W = [self._split(w) for _, _, w in revolute]
 
     def _split(self, p: fmpq_mpoly) -> dict:
         """A polynomial in t, s, c and the levels as a multilinear element (reduced with
@@ -181,6 +191,20 @@ class ModeExpression:
     def signs(self, label: str) -> list[int]:
         """σ per level for a working mode label: + for every √p, then the mode's signs."""
         return [1] * self.fixed + [1 if label[i] == "+" else -1 for i in self.legs]
+
+
+def _by_angle_degree(det_a: fmpq_mpoly, revolute: list) -> dict:
+    """det A's terms grouped by how far each is below its revolute joint's top degree
+    e in (cos θ, sin θ): a group with deficits k, composed with W·(cos θ, sin θ) and
+    multiplied by ∏ W^k, adds up to ∏ W^e · det A (a polynomial: no division by W)."""
+    names = det_a.context().names()
+    pairs = [(names.index(c), names.index(s)) for c, s, _ in revolute]
+    top = [max((e[i] + e[j] for e, _ in det_a.terms()), default=0) for i, j in pairs]
+    groups: dict[tuple[int, ...], dict] = {}
+    for exps, coeff in det_a.terms():
+        deficit = tuple(m - exps[i] - exps[j] for m, (i, j) in zip(top, pairs, strict=True))
+        groups.setdefault(deficit, {})[exps] = coeff
+    return {k: det_a.context().from_dict(v) for k, v in groups.items()}
 
 
 _EXPRESSIONS: dict[int, tuple[PathModel, ModeExpression]] = {}
@@ -256,6 +280,59 @@ class AlgebraicPoint:
         return total
 
 
+_T_ALPHA = fmpq_mpoly_ctx.get(("t", "a"), "lex")
+
+
+class TimeTranscendentalPoint:
+    """A root t = τ ≠ 0 of a path using the bare t where sin τ and cos τ are algebraic
+    (in Q(α): t = 2·atan(α) + 2kπ, or t = kπ): τ itself is then transcendental
+    (Lindemann–Weierstrass: e^{iτ} is algebraic), so an element Σ tⁱ·gᵢ(α) vanishes at
+    the root exactly when every gᵢ is 0 in Q(α).  Elements are polynomials in t and α,
+    reduced modulo α's minimal polynomial; balls take τ from the root's own enclosure."""
+
+    def __init__(self, time: ExactTime, root) -> None:
+        self.inner = AlgebraicPoint(time)  # s, c (and α) without t
+        self.root = root
+        self.f = _T_ALPHA.from_dict({(0, i): c for i, c in enumerate(self.inner.f.coeffs())})
+
+    def zero(self) -> fmpq_mpoly:
+        return _T_ALPHA.from_dict({})
+
+    def of(self, p: fmpq_mpoly) -> fmpq_mpoly:
+        by_power: dict[int, dict] = {}
+        for (i, j, k), coeff in p.terms():
+            by_power.setdefault(i, {})[(0, j, k)] = coeff
+        out = {}
+        for i, terms in by_power.items():
+            value = self.inner.of(TRIG.from_dict(terms))
+            for e, c in enumerate(value.coeffs()):
+                if c != 0:
+                    out[(i, e)] = c
+        return _T_ALPHA.from_dict(out)
+
+    def mul(self, a: fmpq_mpoly, b: fmpq_mpoly) -> fmpq_mpoly:
+        return (a * b) % self.f
+
+    def is_zero(self, a: fmpq_mpoly) -> bool:
+        return a.is_zero()
+
+    def ball(self, a: fmpq_mpoly, bits: int) -> arb:
+        t = self.root.refined(max(2.0 ** -bits, 1e-300)).t
+        alpha = self.inner.ball(fmpq_poly([0, 1]), bits)
+        return evaluate(a, [t, alpha])
+
+
+def exact_point(time: ExactTime, root=None):
+    """The base field of the exact decisions at a root (a
+    :class:`~singcheck.roots.enclosures.RealRoot`) with this exact time."""
+    if time.kind == IN_MIXED:
+        return TranscendentalPoint(time)
+    if time.kind in (IN_U, AT_POINT) and time.t_value is None and root is not None and \
+            excludes_zero(root.t):
+        return TimeTranscendentalPoint(time, root)
+    return AlgebraicPoint(time)
+
+
 class PathFunctions:
     """The trig functions along the path (μ ≡ 0): elements are reduced trig polynomials,
     exact zero tests are polynomial ones, and balls are taken at a rational time."""
@@ -318,6 +395,9 @@ class _Tower:
         self.D_zero: list[bool] = []
         for q, d in enumerate(self.D):  # level by level: each test uses the levels below
             self.D_zero.append(self.reduce(d, q) is None)
+        if any(self.reduce(self._of(w)) is None for w in expr.W):
+            raise NotExact("a revolute leg does not depend on its joint there (W = a² + b² "
+                           "= 0): its branches are not defined")
 
     def _of(self, element: dict) -> dict:
         out = {m: self.base.of(v) for m, v in element.items()}
@@ -358,7 +438,7 @@ class _Tower:
     def _which_vanishes(self, e: dict, k: int) -> bool:
         """True when E is the zero one of {E, Ē} (flipping level k), decided by balls."""
         bits = 64
-        while bits <= _MAX_BITS:
+        while bits <= getattr(self.base, "max_bits", _MAX_BITS):
             checkpoint()
             with working_precision(bits):
                 value = self._ball(e, k, flip=None)

@@ -24,8 +24,14 @@ from dataclasses import dataclass, field
 
 from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
+from singcheck.algebra.composition import (
+    MAX_COMPOSE_WORK,
+    CompositionTooCostly,
+    compose_in_pieces,
+    composition_work,
+)
 from singcheck.algebra.intervals import evaluate, fraction_ball
-from singcheck.algebra.polynomials import restrict
+from singcheck.algebra.polynomials import memo_per_object, restrict
 from singcheck.algebra.radicals import (
     angle_function,
     cos_pi,
@@ -47,7 +53,7 @@ from singcheck.elimination.projection import (
     norm_legs,
 )
 from singcheck.elimination.requests import norm_chain
-from singcheck.errors import UnsupportedRobotError
+from singcheck.errors import SpecError, UnsupportedRobotError
 from singcheck.model.robot import (
     REVOLUTE,
     Leg,
@@ -62,9 +68,9 @@ def _reduce(p: fmpq_mpoly) -> fmpq_mpoly:
     return reduce_trig(p) if p.context() is TRIG else reduce_relations(p)
 
 
-def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ...]) -> fmpq_mpoly:
-    """``p(…, X = φ(t))`` for a polynomial in any context whose non-pose variables are absent
-    (square roots ``sqrt(q)`` become the path ring's, which ``phi`` lives in)."""
+def _pose_args(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...],
+               pose: tuple[str, ...]) -> tuple[fmpq_mpoly_ctx, list[fmpq_mpoly]]:
+    """The ring of ``phi`` and the images of ``p``'s variables in it."""
     ring = phi[0].context() if phi else TRIG
     plan = _composition_plan(p.context(), ring, pose)
     degrees = p.degrees()
@@ -78,7 +84,17 @@ def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
             raise ValueError(f"{what} is not a pose variable")
         else:
             args.append(ring.from_dict({}))
-    return _reduce(p.compose(*args, ctx=ring))
+    return ring, args
+
+
+def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ...],
+                 work: int | None = None) -> fmpq_mpoly:
+    """``p(…, X = φ(t))`` for a polynomial in any context whose non-pose variables are absent
+    (square roots ``sqrt(q)`` become the path ring's, which ``phi`` lives in).  A costly
+    composition is refused or cut into pieces a time limit can stop
+    (:func:`~singcheck.algebra.composition.compose_in_pieces`)."""
+    ring, args = _pose_args(p, phi, pose)
+    return compose_in_pieces(p, args, ring, _reduce, work)
 
 
 _PLANS: dict = {}
@@ -123,43 +139,32 @@ def mu_size_bound(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...],
     degrees alone: each monomial of ξ becomes a product of powers of the coordinates,
     and a reduced trig polynomial of degree a in t and b in (s, c) has at most
     (a + 1)(2b + 1) terms.  Cheap: nothing is composed."""
-    names = xi.context().names()
-    # (a zero coordinate's degrees are -1: weight 0, an upper bound all the same)
-    dt = [max(0, phi[pose.index(v)].degrees()[0]) if v in pose else 0 for v in names]
-    dsc = [max(0, sum(phi[pose.index(v)].degrees()[1:])) if v in pose else 0 for v in names]
-    deg_t, deg_sc = _weighted_degree(xi, dt), _weighted_degree(xi, dsc)
+    _, deg_t, deg_sc = composition_work(xi, _pose_args(xi, phi, pose)[1])
     return deg_t, deg_sc, (deg_t + 1) * (2 * deg_sc + 1)
 
 
-_ONES: dict = {}
-_U = fmpq_mpoly_ctx.get(("u",), "lex")
+def _too_costly(what: str, trajectory: TrajectorySpec) -> SpecError:
+    return SpecError(f"too costly: {what}: lower the degrees or the coefficients of the "
+                     "coordinates, or the multiples of t in sin/cos", path=trajectory.path,
+                     line=trajectory.lines.get("pose"), key="pose")
 
 
-def _weighted_degree(p: fmpq_mpoly, weights: list[int]) -> int:
-    """max over the monomials of ``p`` of Σ eᵢ·wᵢ (wᵢ ≥ 0), exactly: ``p`` with every
-    coefficient made 1, composed with xᵢ = u^wᵢ, cannot cancel, so its degree in u is
-    that maximum (0 for the zero polynomial)."""
-    if p.is_zero():
-        return 0
-    ones = memo_per_object(_ONES, p, lambda q: q.context().from_dict(
-        {exps: 1 for exps, _ in q.terms()}))
-    u = _U.gens()[0]
-    return max(0, ones.compose(*[u**w for w in weights], ctx=_U).degrees()[0])
-
-
-def _refuse_costly(xi, phi, pose, trajectory) -> None:
-    """Refuse up front (one line, exit 2) a path whose μ would be too large to compose
-    and isolate within any reasonable budget (the composition is one FLINT call that a
-    time limit cannot interrupt)."""
-    deg_t, deg_sc, terms = mu_size_bound(xi, phi, pose)
+def _compose_mu(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ...],
+                trajectory: TrajectorySpec) -> fmpq_mpoly:
+    """μ = ξ(φ(t)), refused up front (one line, exit 2) when it could have more than
+    :data:`MAX_MU_TERMS` terms or cost more than
+    :data:`~singcheck.algebra.composition.MAX_COMPOSE_WORK`; otherwise composed in
+    pieces a time limit can stop."""
+    work, deg_t, deg_sc = composition_work(xi, _pose_args(xi, phi, pose)[1])
+    terms = (deg_t + 1) * (2 * deg_sc + 1)
     if terms > MAX_MU_TERMS:
-        from singcheck.errors import SpecError
-
-        raise SpecError(
-            f"too costly: μ(t) = ξ(φ(t)) could have {terms} terms (degree {deg_t} in t and "
-            f"{deg_sc} in sin t, cos t; at most {MAX_MU_TERMS}): lower the degree of the "
-            "coordinates or the multiples of t in sin/cos", path=trajectory.path,
-            line=trajectory.lines.get("pose"), key="pose")
+        raise _too_costly(f"μ(t) = ξ(φ(t)) could have {terms} terms (degree {deg_t} in t "
+                          f"and {deg_sc} in sin t, cos t; at most {MAX_MU_TERMS})", trajectory)
+    if work > MAX_COMPOSE_WORK:
+        raise _too_costly(f"composing μ(t) = ξ(φ(t)) would cost {work:.3g} by its a-priori "
+                          f"estimate (ξ has {len(xi)} terms; at most {MAX_COMPOSE_WORK:.3g})",
+                          trajectory)
+    return compose_pose(xi, phi, pose, work)
 
 
 @dataclass(frozen=True)
@@ -257,17 +262,6 @@ def _det_a_by_joints(model: RobotModel) -> list[tuple[tuple[tuple[int, int], ...
                  model.context.from_dict(terms)) for alpha, terms in groups.items()]
 
     return memo_per_object(_DET_A_SPLITS, model, split)
-
-
-def memo_per_object(cache: dict, obj, compute, keep: int = 256):
-    """``compute(obj)``, once per object: the entry keeps the object, so its id is not
-    reused while it is there (the cache is emptied past ``keep`` entries)."""
-    hit = cache.get(id(obj))
-    if hit is None or hit[0] is not obj:
-        if len(cache) > keep:
-            cache.clear()
-        hit = cache[id(obj)] = (obj, compute(obj))
-    return hit[1]
 
 
 _LIMIT_BALLS: dict = {}
@@ -465,23 +459,18 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
 
 
 def _on_circle(p: fmpq_mpoly) -> fmpq_mpoly:
-    """``p`` (in a ring with the path's s = sin t, c = cos t) with s² replaced by 1 - c²:
-    degree ≤ 1 in s, the same function of t.  Keeps path-wise norms small."""
+    """``p`` (in a ring with the path's s = sin t, c = cos t, s before c) with s² replaced
+    by 1 - c²: degree ≤ 1 in s, the same function of t.  Keeps path-wise norms small.
+    FLINT's remainder modulo s² + c² - 1 (s² is its leading monomial), in C."""
     ctx = p.context()
     names = ctx.names()
-    si = names.index("s")
+    si, ci = names.index("s"), names.index("c")
     if p.degrees()[si] < 2:
         return p
-    one_minus_c2 = 1 - ctx.gens()[names.index("c")] ** 2
-    groups: dict[int, dict] = {}
-    for exps, coeff in p.terms():
-        e = list(exps)
-        half, e[si] = divmod(e[si], 2)
-        groups.setdefault(half, {})[tuple(e)] = coeff
-    out = ctx.from_dict({})
-    for half, terms in groups.items():
-        out += ctx.from_dict(terms) * one_minus_c2 ** half
-    return out
+    if ci < si:
+        raise ValueError("the ring must order s before c")
+    s, c = ctx.gens()[si], ctx.gens()[ci]
+    return divmod(p, s * s + c * c - 1)[1]
 
 
 _LEG_COEFFICIENTS: dict[int, tuple[Leg, tuple[fmpq_mpoly, ...]]] = {}
@@ -535,24 +524,35 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
     coordinates = tuple(coordinates)
     pose_vars = model.pose_variables
     if projection.expanded:
-        _refuse_costly(projection.singularity_surface, coordinates, pose_vars, trajectory)
-        mu = compose_pose(projection.singularity_surface, coordinates, pose_vars)
+        # ξ modulo the pose angles' circles: μ is the same (φ's cos, sin lie on them)
+        mu = _compose_mu(projection.surface_on_circles, coordinates, pose_vars, trajectory)
     else:
         mu = eliminate_along_path(model, coordinates, where)
+    try:
+        legs = _legs_along(model, coordinates)
+        degenerate = tuple(compose_pose(w, coordinates, pose_vars)
+                           for w in degenerate_set(model))
+    except CompositionTooCostly as e:
+        raise _too_costly(f"a leg's constraint along the path: {e}", trajectory) from None
+    return PathModel(projection, trajectory, phi, mu, legs, coordinates, degenerate)
+
+
+def _legs_along(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
+                ) -> tuple[LegAlongPath, ...]:
+    pose_vars = model.pose_variables
     legs = []
     for leg in model.legs:
         in_pose_coeffs = _leg_coefficients(leg)
         coeffs = tuple(compose_pose(c, coordinates, pose_vars) for c in in_pose_coeffs)
         disc = leg_discriminant(leg, coeffs)
         limits = {}
-        if leg.kind == REVOLUTE and leg.joint in spec.joint_limits:
-            for value in spec.joint_limits[leg.joint]:
+        if leg.kind == REVOLUTE and leg.joint in model.spec.joint_limits:
+            for value in model.spec.joint_limits[leg.joint]:
                 limits[value] = compose_pose(limit_constraint(model, leg, value), coordinates,
                                              pose_vars)
         legs.append(LegAlongPath(leg, coeffs, _reduce(disc) if disc is not None else None,
                                  limits))
-    degenerate = tuple(compose_pose(w, coordinates, pose_vars) for w in degenerate_set(model))
-    return PathModel(projection, trajectory, phi, mu, tuple(legs), coordinates, degenerate)
+    return tuple(legs)
 
 
 def exact_point(q) -> arb:

@@ -34,9 +34,9 @@ Exit status:
   4  an elimination backend is missing or failed
   70 internal error
   130 interrupted (Ctrl-C, SIGTERM, SIGHUP)
-A batch exits with its worst outcome (0 < 3 < 1 < 4 < 70): a trajectory's own failure
-(time limit: unknown; backend or internal error: error) is its result, never the end of
-the batch.
+A batch exits with its worst outcome (0 < 3 < 1 < 2 < 4 < 70): a trajectory's own
+failure (time limit: unknown; bad document past the first 100, backend or internal
+error: error) is its result, never the end of the batch.
 """
 
 
@@ -155,7 +155,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
 
 
 #: a trajectory's outcome as an exit status, and how bad each is (a batch exits with
-#: the worst of its trajectories)
+#: the worst of its trajectories; USAGE: a document that is no valid trajectory)
 _SEVERITY = [ExitCode.SINGULARITY_FREE, ExitCode.UNKNOWN, ExitCode.SINGULAR,
              ExitCode.USAGE, ExitCode.BACKEND, ExitCode.INTERNAL]
 
@@ -180,12 +180,22 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
          progress, jobs, plot_dir=None, interpolation="cubic", *, time_limit=300.0,
          regions=True, scheduler=None):
     from contextlib import closing
+    from itertools import chain, islice
 
     from singcheck import api
-    from singcheck.spec.files import load_robot, load_trajectories
+    from singcheck.spec.files import load_robot, read_documents
 
     spec = load_robot(robot)
-    specs = load_trajectories(trajectories, spec, interpolation)
+    documents = read_documents(trajectories, interpolation)
+    # the first documents (all of a small batch) are parsed here, before any work: a bad
+    # one stops the run at once (exit 2, one line); past them, the documents are parsed
+    # by the workers, and a bad one is that trajectory's result
+    first = [document.parse(spec) for document in islice(documents, api.LOOKAHEAD)]
+    total = len(first) if len(first) < api.LOOKAHEAD else None  # None: not known yet
+    items = chain(first, documents)
+    kept: list = []
+    if plot_dir:
+        items = _keeping(items, kept)
     engine = api.elimination_engine(backend_name, timeout, not no_cache, progress.note)
     with progress.status(f"projecting {spec.name} onto its workspace ({engine.name})"):
         machine = api.robot_from_spec(spec, cache=not no_cache, engine=engine)
@@ -200,11 +210,11 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     if scheduler:
         from singcheck.cluster import check_on_cluster
 
-        batch = check_on_cluster(scheduler, machine, specs, **options)
+        batch = check_on_cluster(scheduler, machine, items, **options)
     else:
-        batch = api.check_batch(machine, specs, jobs=jobs, **options)
+        batch = api.check_batch(machine, items, jobs=jobs, **options)
     code = ExitCode.SINGULARITY_FREE
-    with _sink(fmt, output, projection) as sink, progress.bar(len(specs)) as advance, \
+    with _sink(fmt, output, projection) as sink, progress.bar(total) as advance, \
             closing(batch) as docs:
         for doc in docs:
             sink.add(doc)
@@ -212,8 +222,30 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
             advance(doc["name"], doc["verdict"])
         sink.finish(code, tolerance, verbose)
     if plot_dir:
-        _plot_all(machine, specs, tolerance, plot_dir, progress)
+        _plot_all(machine, _parsed(kept, spec), tolerance, plot_dir, progress)
     return code
+
+
+def _keeping(items, kept: list):
+    """``items``, each also appended to ``kept`` (for --plot, after the batch)."""
+    for item in items:
+        kept.append(item)
+        yield item
+
+
+def _parsed(items: list, robot_spec) -> list:
+    """The trajectory specs among ``items`` (documents parsed; a bad one left out: the
+    batch has reported it)."""
+    from singcheck.errors import SpecError
+    from singcheck.spec.files import Document
+
+    specs = []
+    for item in items:
+        try:
+            specs.append(item.parse(robot_spec) if isinstance(item, Document) else item)
+        except SpecError:
+            pass
+    return specs
 
 
 class _Sink:

@@ -70,6 +70,12 @@ def _options(space: str):
                          help="Seconds an external backend may run."),
             click.option("--no-cache", is_flag=True, help="Do not read or write the "
                          "elimination cache."),
+            click.option("--time-limit", type=click.FloatRange(min=0, min_open=True),
+                         default=300, show_default=True,
+                         help="Seconds allowed to the analysis (the discriminant variety, "
+                         "the decomposition, the counts and the regions; a CAS run is "
+                         "also bounded by --timeout); past it the command ends with exit "
+                         "3, unknown: time limit, and writes nothing."),
             click.option("--format", "fmt", type=click.Choice(["table", "json"]),
                          default="table", show_default=True),
             click.option("-o", "--output", type=click.Path(dir_okay=False, writable=True),
@@ -85,9 +91,20 @@ def _options(space: str):
 
 
 def compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, backend: str,
-            timeout: float, no_cache: bool, progress):
-    """The analysis and the labels of the surfaces left out (shared with ``plot``)."""
-    from singcheck.api import elimination_engine
+            timeout: float, no_cache: bool, progress, time_limit: float | None = None):
+    """The analysis and the labels of the surfaces left out (shared with ``plot``), within
+    ``time_limit`` seconds (:class:`~singcheck.budget.TimeLimitExceeded` past it)."""
+    from singcheck.budget import deadline
+
+    with deadline(time_limit):
+        return _compute(space, robot, slices, surfaces, no_limits, backend, timeout,
+                        no_cache, progress)
+
+
+def _compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, backend: str,
+             timeout: float, no_cache: bool, progress):
+    from singcheck.api import elimination_engine, hard_time_limit
+    from singcheck.budget import remaining
     from singcheck.elimination.projection import project_robot
     from singcheck.model.robot import build_model, require_polynomial
     from singcheck.spaces.analysis import (
@@ -115,15 +132,18 @@ def compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, back
         components = [c for c in components if c.kind != LIMIT]
     free = len([a for a in axes if a not in fixed])
     components, left_out = select_surfaces(components, space, surfaces, free)
-    with progress.status(f"decomposing the {space} and counting solutions"):
+    # the decomposition is pure Python: a timer backs up its checkpoints
+    with progress.status(f"decomposing the {space} and counting solutions"), \
+            hard_time_limit(remaining()):
         analysis = analyse(space, model, components, fixed, use_limits=not no_limits)
     progress.note(f"{len(analysis.cells)} cells in "
                   f"{sum(analysis.timings.values()):.2f} s")
     return analysis, left_out
 
 
-def _command(space: str, robot, slices, surfaces, no_limits, backend, timeout, no_cache, fmt,
-             output, quiet, verbose) -> None:
+def _command(space: str, robot, slices, surfaces, no_limits, backend, timeout, no_cache,
+             time_limit, fmt, output, quiet, verbose) -> None:
+    from singcheck.budget import TimeLimitExceeded
     from singcheck.cli.exitcodes import exit_codes
 
     progress = Progress(quiet)
@@ -133,9 +153,13 @@ def _command(space: str, robot, slices, surfaces, no_limits, backend, timeout, n
 
         try:
             analysis, left_out = compute(space, robot, slices, surfaces, no_limits, backend,
-                                         timeout, no_cache, progress)
+                                         timeout, no_cache, progress, time_limit)
         except SliceError as e:
             raise click.BadParameter(str(e), param_hint="--slice") from None
+        except TimeLimitExceeded as e:  # nothing partial is written
+            click.echo(f"singcheck: unknown: {e} (the {space} analysis; --time-limit)",
+                       err=True)
+            sys.exit(int(ExitCode.UNKNOWN))
         unknown = any(c.count is None for c in analysis.cells if c.within_limits)
         code = ExitCode.UNKNOWN if unknown else ExitCode.SINGULARITY_FREE
         doc = analysis_json(analysis, left_out, int(code))
@@ -166,7 +190,7 @@ _EXIT = """\b
 Exit status:
   0  every cell's count is proven
   2  bad command line or bad spec file (an unknown axis, a slice inside a surface)
-  3  some count could not be decided
+  3  some count could not be decided, or the analysis ran past --time-limit
   4  an elimination backend is missing or failed
 """
 
@@ -178,8 +202,8 @@ Examples:
   singcheck workspace robots/skew-biglide.yaml --format json
 """ + _EXIT)
 @_options("workspace")
-def workspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, fmt, output,
-              quiet, verbose) -> None:
+def workspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, time_limit, fmt,
+              output, quiet, verbose) -> None:
     """Where in the workspace the inverse kinematics has how many real solutions inside
     the joint limits, computed exactly.
 
@@ -192,7 +216,7 @@ def workspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, fm
     connected components.
     """
     _command("workspace", robot, slices, surfaces, no_limits, backend, timeout, no_cache,
-             fmt, output, quiet, verbose)
+             time_limit, fmt, output, quiet, verbose)
 
 
 @click.command(epilog="""\b
@@ -201,8 +225,8 @@ Examples:
   singcheck jointspace robots/orthoglide.yaml --slice rho3=2   # the plane rho3 = 2
 """ + _EXIT)
 @_options("jointspace")
-def jointspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, fmt, output,
-               quiet, verbose) -> None:
+def jointspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, time_limit, fmt,
+               output, quiet, verbose) -> None:
     """Where in the joint space the direct kinematics has how many real solutions
     (assembly modes), computed exactly.
 
@@ -213,4 +237,4 @@ def jointspace(robot, slices, surfaces, no_limits, backend, timeout, no_cache, f
     exactly checked segments that avoid the variety.
     """
     _command("jointspace", robot, slices, surfaces, no_limits, backend, timeout, no_cache,
-             fmt, output, quiet, verbose)
+             time_limit, fmt, output, quiet, verbose)

@@ -114,7 +114,7 @@ def _constant_lead(f: fmpq_mpoly, names, v: str) -> bool:
     return all(sum(e) == d for e, _ in f.terms() if e[i] == d)
 
 
-def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
+def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly, reduce=None) -> fmpq_mpoly:
     """The norm of ``g`` over the two points of ``f = a·c + b·s + d = 0`` on the circle
     ``c² + s² = 1``, free of c and s.
 
@@ -124,7 +124,10 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
     the product over both branches is ``G₀² - Δ·G₁²``.  Where W ≠ 0 it vanishes exactly
     when g vanishes at one of the two (complex) points; on W = 0 (the leg does not
     depend on its angle) it may vanish too: the degenerate set, handled by the caller.
+    ``reduce`` (optional, as for :func:`norm_chain`) is applied to every intermediate
+    product, which keeps them small; the result is then the same modulo its relations.
     """
+    red = reduce or (lambda x: x)
     ctx = g.context()
     names = ctx.names()
     ci, si = names.index(c), names.index(s)
@@ -132,11 +135,11 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
     zero = ctx.from_dict({})
     a, b = coefficient_in(f, ci, 1), coefficient_in(f, si, 1)
     d = coefficient_in(coefficient_in(f, ci, 0), si, 0)
-    w = a * a + b * b
-    delta = w - d * d
+    w = red(a * a + b * b)
+    delta = red(w - d * d)
 
     def mul(x, y):
-        return x[0] * y[0] + delta * x[1] * y[1], x[0] * y[1] + x[1] * y[0]
+        return red(x[0] * y[0] + red(delta * x[1]) * y[1]), red(x[0] * y[1] + x[1] * y[0])
 
     groups: dict[tuple[int, int], dict] = {}
     for exps, coeff in g.terms():
@@ -147,16 +150,16 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly) -> fmpq_mpoly:
     k = max(i + j for i, j in groups)
     cpow, spow, wpow = [(one, zero)], [(one, zero)], [one]
     for _ in range(k):
-        cpow.append(mul(cpow[-1], (-a * d, b)))
-        spow.append(mul(spow[-1], (-b * d, -a)))
-        wpow.append(wpow[-1] * w)
+        cpow.append(mul(cpow[-1], (red(-a * d), b)))
+        spow.append(mul(spow[-1], (red(-b * d), -a)))
+        wpow.append(red(wpow[-1] * w))
     g0, g1 = zero, zero
     for (i, j), terms in groups.items():
-        coefficient = ctx.from_dict(terms) * wpow[k - i - j]
+        coefficient = red(ctx.from_dict(terms) * wpow[k - i - j])
         x = mul(cpow[i], spow[j])
-        g0 += coefficient * x[0]
-        g1 += coefficient * x[1]
-    return g0 * g0 - delta * g1 * g1
+        g0 += red(coefficient * x[0])
+        g1 += red(coefficient * x[1])
+    return red(g0 * g0) - red(delta * red(g1 * g1))
 
 
 def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
@@ -177,13 +180,15 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
     _, factors = g.factor()
     total = g.context().from_dict({(0,) * g.context().nvars(): 1})
     for factor, _mult in factors:
-        acc = factor
+        acc, reduced = factor, False
         for v, f in legs:
             variables = v if isinstance(v, tuple) else (v,)
             if all(acc.degrees()[names.index(x)] <= 0 for x in variables):
                 continue  # a leg that does not touch this factor only raises its power
-            acc = revolute_norm(acc, v[0], v[1], f) if isinstance(v, tuple) else \
+            acc = revolute_norm(acc, v[0], v[1], f, reduce) if isinstance(v, tuple) else \
                 acc.resultant(f, v)
-            acc = squarefree_part(reduce(acc) if reduce else acc)
+            acc, reduced = squarefree_part(reduce(acc) if reduce else acc), True
+        if len(factors) == 1 and reduced:
+            return acc  # squarefree and monic already: the one factor's norm
         total *= acc
     return squarefree_part(total)

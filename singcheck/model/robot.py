@@ -20,7 +20,9 @@ singcheck certifies robots whose inverse kinematics is *leg-decoupled*: each
 constraint involves exactly one actuated joint (a leg), and that leg is
 
 * **prismatic**: of degree 1 or 2 in its joint ρ with a non-zero constant leading
-  coefficient; its branches are ``ρ = (-b ± √D)/(2a)``, D = b² - 4ac; or
+  coefficient (an irrational one, √3 from a parameter, is divided out: the model's
+  constraint then has leading coefficient 1); its branches are ``ρ = (-b ± √D)/(2a)``,
+  D = b² - 4ac; or
 * **revolute**: an angle joint θ entering as ``a(X)·cos θ + b(X)·sin θ + d(X)`` (degree
   ≤ 2 in the half-angle tangent); its branches are
   ``cos θ = (-a·d + σ·b·√Δ)/W``, ``sin θ = (-b·d - σ·a·√Δ)/W`` for σ = ±1, with
@@ -50,7 +52,13 @@ from typing import TYPE_CHECKING
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import coefficient_in
-from singcheck.algebra.radicals import angle_names, radical_name, reduce_relations
+from singcheck.algebra.radicals import (
+    angle_names,
+    constant_surd,
+    radical_name,
+    reduce_relations,
+    surd_polynomial,
+)
 from singcheck.errors import UnsupportedRobotError
 
 if TYPE_CHECKING:
@@ -221,11 +229,17 @@ def _legs(spec: RobotSpec) -> tuple[Leg, ...]:
             raise UnsupportedRobotError(
                 f"is of degree {degree} in {joint}; singcheck supports legs of degree 1 or 2 "
                 "in their joint (prismatic or distance legs)", path=spec.path, line=line, key=key)
-        if not coefficient_in(f, j, degree).is_constant():
-            raise UnsupportedRobotError(
-                f"the coefficient of {joint}^{degree} depends on the pose; singcheck needs it "
-                "constant so that the joint is integral over the pose (exact projection)",
-                path=spec.path, line=line, key=key)
+        lead = coefficient_in(f, j, degree)
+        if not lead.is_constant():
+            value = constant_surd(lead)
+            if value is None:
+                raise UnsupportedRobotError(
+                    f"the coefficient of {joint}^{degree} depends on the pose; singcheck needs "
+                    "it constant so that the joint is integral over the pose (exact "
+                    "projection)", path=spec.path, line=line, key=key)
+            # a non-zero algebraic constant (√3 from a parameter): the constraint divided
+            # by it has the same zeros and leading coefficient 1
+            f = reduce_relations(f * surd_polynomial(value.inverse(), spec.context))
         found[joint] = Leg(joint, j, f, index, degree)
     return tuple(found[j] for j in joints)
 
@@ -291,12 +305,16 @@ def build_model(spec: RobotSpec) -> RobotModel:
     Raises :class:`UnsupportedRobotError` (with the constraint's file and line) for a
     robot outside the leg-decoupled class, and when det A is identically zero.
     """
-    constraints = tuple(spec.constraints)
+    legs = _legs(spec)
+    # each leg's constraint, divided by its leading coefficient when that is an irrational
+    # constant (:func:`_legs`): F keeps its zeros, det A and det B change by a non-zero
+    # constant factor
+    normalised = {leg.constraint_index: leg.constraint for leg in legs}
+    constraints = tuple(normalised.get(i, f) for i, f in enumerate(spec.constraints))
     A = jacobian(constraints, spec.pose, spec.angles)
     B = jacobian(constraints, spec.joints, spec.angles)
     det_A = reduce_relations(determinant(A))
     det_B = reduce_relations(determinant(B))
-    legs = _legs(spec)
     if det_A.is_zero():
         raise UnsupportedRobotError(
             "det A = det(∂F/∂pose) is identically zero: the robot is singular everywhere",

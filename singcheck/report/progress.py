@@ -41,21 +41,23 @@ class Progress:
             sys.stderr.write(f"singcheck: {message}\n")
             sys.stderr.flush()
 
-    def bar(self, total: int):
-        """A context giving ``advance(name, verdict)``: a bar on a terminal, else notes."""
+    def bar(self, total: int | None):
+        """A context giving ``advance(name, verdict)``: a bar on a terminal, else notes
+        (``total`` None: not known, a stream being read)."""
         from contextlib import contextmanager
 
         @contextmanager
         def plain():
             done = [0]
-            step = max(1, total // 10)
+            step = max(1, total // 10) if total else 1000
+            of = f"/{total}" if total else ""
 
             def advance(name: str, verdict: str) -> None:
                 done[0] += 1
-                if total <= 20:
+                if total and total <= 20:
                     self.note(f"[{done[0]}/{total}] {name}: {verdict}")
                 elif done[0] % step == 0 or done[0] == total:
-                    self.note(f"certified {done[0]}/{total} trajectories")
+                    self.note(f"certified {done[0]}{of} trajectories")
 
             yield advance
 
@@ -72,19 +74,21 @@ class Progress:
             with Progress(TextColumn("certifying"), BarColumn(), MofNCompleteColumn(),
                           TimeRemainingColumn(), console=self.console, transient=True) as bar:
                 task = bar.add_task("certify", total=total)
+                done = [0]
 
                 def advance(name: str, verdict: str) -> None:
+                    done[0] += 1
                     bar.advance(task)
 
                 yield advance
-            self.note(f"certified {total} trajectories")
+            self.note(f"certified {done[0]} trajectories")
 
         if self.quiet:
             @contextmanager
             def silent():
                 yield lambda name, verdict: None
             return silent()
-        return rich_bar() if total > 1 and self._terminal() else plain()
+        return rich_bar() if (total is None or total > 1) and self._terminal() else plain()
 
     def status(self, message: str):
         from contextlib import nullcontext

@@ -53,6 +53,11 @@ def _range(spec) -> list[str]:
 
 
 def _trajectory_head(spec) -> dict[str, Any]:
+    """Name, file, parameter and range of a trajectory; of a document that could not be
+    read as one (a :class:`~singcheck.spec.files.Document`): its name, or FILE:LINE
+    when it has none, and null parameter and range."""
+    if hasattr(spec, "label"):
+        return {"name": spec.label, "path": spec.path, "parameter": None, "range": None}
     return {
         "name": spec.name,
         "path": spec.path,
@@ -80,8 +85,8 @@ def time_limited_json(spec, reason: str) -> dict[str, Any]:
 
 def error_json(spec, kind: str, message: str) -> dict[str, Any]:
     """The trajectory object of a trajectory whose check failed (``kind``: backend, spec
-    — refused as too costly — or internal): verdict ``error``, the reason, and nothing
-    certified."""
+    — a document that is no valid trajectory, or a path refused as too costly — or
+    internal): verdict ``error``, the reason, and nothing certified."""
     return {**time_limited_json(spec, f"error: {message}"), "verdict": "error",
             "error": {"kind": kind, "message": message}}
 
@@ -119,6 +124,8 @@ def workspace_json(w) -> dict[str, Any]:
         "ik_counts": [s.count for s in w.stretches],
         "exit_time_interval": None if w.exit_time is None else _interval(w.exit_time),
         "undecided": w.undecided,
+        "on_surfaces": [{"surface": surface, "t_range": where}
+                        for surface, where in w.on_surfaces],
     }
 
 
@@ -127,6 +134,18 @@ def workspace_line(w: dict[str, Any]) -> str:
     counts = w["ik_counts"]
     if w["one_region"] is None:
         return "workspace: crossings not all decided: " + "; ".join(w["undecided"])
+    if w.get("on_surfaces"):
+        ranges: dict[str, list[str]] = {}
+        for item in w["on_surfaces"]:
+            ranges.setdefault(item["t_range"], []).append(item["surface"])
+        text = "workspace: the path lies on " + "; on ".join(
+            f"{', '.join(surfaces)} for t ∈ {where}" for where, surfaces in ranges.items())
+        if not w["crossings"]:
+            return text + (f" ({counts[0]} IK solution(s) inside the joint limits all along)"
+                           if counts and counts[0] is not None else "")
+        return text + (f"; it crosses the discriminant variety {len(w['crossings'])} "
+                       "time(s); IK solutions inside the limits along it: "
+                       + " → ".join("?" if c is None else str(c) for c in counts))
     if w["one_region"]:
         where = f"region {w['region']}" if w["region"] else "one region of the workspace"
         return (f"workspace: the whole path lies in {where} "
@@ -179,8 +198,9 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
     for t in trajectories:
         segments = t.get("segments") or []
         pieces = f", {len(segments)} segments" if len(segments) > 1 else ""
-        title = (f"{robot['name']} · {t['name']}  ({t['parameter']} ∈ [{t['range'][0]}, "
-                 f"{t['range'][1]}]{pieces}, roots by {t['root_isolation']})")
+        title = f"{robot['name']} · {t['name']}" + (
+            f"  ({t['parameter']} ∈ [{t['range'][0]}, {t['range'][1]}]{pieces}, roots by "
+            f"{t['root_isolation']})" if t["range"] else f"  ({t['path']})")
         feasible = [m["label"] for m in t["working_modes"] if m["feasible"]]
         if t["candidates"]:
             table = Table(title=title, title_justify="left")

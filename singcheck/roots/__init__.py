@@ -3,6 +3,7 @@ ball proven to hold exactly one, every gap proven root-free, the rest ``Undecide
 
 ``rational`` isolates roots of univariate polynomials over Q exactly (Descartes
 bisection); ``half_angle`` maps sin/cos paths to Q[u] with u = tan(t/2);
-``branch_bound`` handles paths mixing t with sin t and cos t; ``isolation`` dispatches;
+``branch_bound`` handles paths mixing t with sin t and cos t, ``transcendental`` tests
+exactly whether a trig polynomial vanishes at one of their roots; ``isolation`` dispatches;
 ``enclosures`` holds the result types.  May import ``algebra`` only.
 """

@@ -28,6 +28,7 @@ left (t and the angle functions), true whatever their values.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from fractions import Fraction
 
 from flint import arb, fmpq, fmpq_mpoly
@@ -35,10 +36,12 @@ from flint import arb, fmpq, fmpq_mpoly
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
 from singcheck.algebra.radicals import evaluate_path as evaluate_trig
 from singcheck.algebra.radicals import path_derivative as derivative
-from singcheck.algebra.trig import LinearInPi, TimeRange
+from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
 from singcheck.budget import checkpoint
 from singcheck.roots.enclosures import (
     BRANCH_AND_BOUND,
+    IN_MIXED,
+    ExactTime,
     RealRoot,
     RootIsolation,
     Undecided,
@@ -93,7 +96,7 @@ def _bisect_root(p, lo: fmpq, hi: fmpq, s_lo: int, width: fmpq) -> tuple[fmpq, f
 _MAX_ORDER = 64
 
 
-def _vanishes_at_multiple_of_pi(p: fmpq_mpoly, k: int) -> bool:
+def vanishes_at_multiple_of_pi(p: fmpq_mpoly, k: int) -> bool:
     """Exactly: p(kπ, 0, (-1)^k) = 0 (see the module docstring)."""
     q = p.subs({"s": 0, "c": 1 if k % 2 == 0 else -1})
     if k == 0:
@@ -107,17 +110,17 @@ def _exact_zeros(p: fmpq_mpoly, interval: TimeRange) -> list[tuple[int, int, fmp
     start, end = float(interval.start), float(interval.end)
     out = []
     for k in range(math.floor(start / math.pi) - 1, math.ceil(end / math.pi) + 2):
-        if not _vanishes_at_multiple_of_pi(p, k):
+        if not vanishes_at_multiple_of_pi(p, k):
             continue
         with working_precision(128):
             z = k * arb.pi()
         if not inside_range(z, LinearInPi(Fraction(0), Fraction(k)), interval, 128):
             continue
         dk, order = p, 0
-        while order < _MAX_ORDER and _vanishes_at_multiple_of_pi(dk, k):
+        while order < _MAX_ORDER and vanishes_at_multiple_of_pi(dk, k):
             checkpoint()
             dk, order = derivative(dk), order + 1
-        if _vanishes_at_multiple_of_pi(dk, k):
+        if vanishes_at_multiple_of_pi(dk, k):
             continue
         for e in range(1, 64):
             checkpoint()
@@ -147,7 +150,7 @@ def _exact_root(k: int, order: int) -> RealRoot:
         with working_precision(bits_for(tol)):
             return k * arb.pi()
 
-    time = point_time(Fraction(0) if k == 0 else None, 0, 1 if k % 2 == 0 else -1)
+    time = point_time(Fraction(0) if k == 0 else None, 0, 1 if k % 2 == 0 else -1, k)
     return RealRoot(arb(0) if k == 0 else make(1e-9), order, None if k == 0 else make,
                     exact=time)
 
@@ -197,6 +200,34 @@ def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Ro
                                     [_exact_root(k, order) for k, order, _, _ in exact_zeros])
 
 
+@dataclass
+class Bracket:
+    """The one zero τ of ``p(t, sin t, cos t)`` in [lo, hi], where p is strictly monotone
+    with sign ``s_lo`` at lo and the opposite sign at hi (a root the branch-and-bound
+    proved); :meth:`ball` narrows it by bisection on exact rational points."""
+
+    p: fmpq_mpoly
+    lo: fmpq
+    hi: fmpq
+    s_lo: int
+
+    def ball(self, bits: int) -> arb:
+        """A ball of width about 2^-bits around τ (wider only when p's sign cannot be
+        told at 4000 bits next to τ)."""
+        self.lo, self.hi = _bisect_root(self.p, self.lo, self.hi, self.s_lo,
+                                        fmpq(1, 2 ** bits))
+        return rational_ball(self.lo, self.hi)
+
+
+def _mixed_time(p: fmpq_mpoly, lo: fmpq, hi: fmpq, s_lo: int) -> ExactTime | None:
+    """The exact description of a bracketed root of p (a trig polynomial in t, s, c;
+    None for a path polynomial with angle functions or square roots)."""
+    if p.context() is not TRIG or (lo <= 0 <= hi and p.subs({"t": 0, "s": 0, "c": 1}) == 0):
+        return None  # τ = 0 would be algebraic (the exact zeros at 0 are found apart)
+    bracket = Bracket(p, lo, hi, s_lo)
+    return ExactTime(IN_MIXED, lambda: bracket)
+
+
 def _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambiguous,
                              exact_roots):
     roots, undecided = list(exact_roots), []
@@ -212,8 +243,10 @@ def _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambigu
         if where is None:
             undecided.append(Undecided(t, "a root lies too close to a range end to decide"))
         elif where:
+            exact = _mixed_time(p, bracket["lo"], bracket["hi"], s_lo)
             make(tolerance)
-            roots.append(RealRoot(rational_ball(bracket["lo"], bracket["hi"]), None, make))
+            roots.append(RealRoot(rational_ball(bracket["lo"], bracket["hi"]), None, make,
+                                  exact=exact))
     for q in sorted(set(exact_points)):
         t = arb(q)
         where = inside_range(t, None, interval, 53)
@@ -222,7 +255,7 @@ def _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambigu
                                   if q == 0 else None))
     for lo, hi, reason in _merge(ambiguous):
         box = rational_ball(lo, hi)
-        undecided.append(Undecided(box, f"{reason} near t ≈ {float(box.mid()):.6g}"))
+        undecided.append(Undecided(box, f"{reason} in t ∈ [{float(lo):.9g}, {float(hi):.9g}]"))
     roots = _dedupe(sorted(roots, key=lambda r: float(r.t.mid())))
     return RootIsolation(tuple(roots), tuple(undecided), BRANCH_AND_BOUND)
 

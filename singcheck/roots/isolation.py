@@ -28,10 +28,12 @@ from singcheck.algebra.radicals import (
     reduce_relations,
 )
 from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig, uses_t, uses_trig
-from singcheck.roots.branch_bound import branch_and_bound
+from singcheck.roots.branch_bound import branch_and_bound, vanishes_at_multiple_of_pi
 from singcheck.roots.enclosures import (
+    AT_POINT,
     BRANCH_AND_BOUND,
     EXACT,
+    IN_MIXED,
     IN_T,
     ExactTime,
     IdenticallyZeroError,
@@ -47,6 +49,12 @@ from singcheck.roots.rational import (
     nonzero_on,
     real_roots_exact,
     to_fraction,
+)
+from singcheck.roots.transcendental import (
+    ONE_MINUS_C2,
+    NotExact,
+    TranscendentalPoint,
+    split_s,
 )
 
 
@@ -95,7 +103,7 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
     that stay overlapping otherwise become an undecided stretch."""
     _, factors = p.factor()
     if len(factors) == 1 and factors[0][1] == 1:
-        return branch_and_bound(p, interval, tolerance)
+        return _through_norm(p, interval, tolerance) or branch_and_bound(p, interval, tolerance)
     roots: list[tuple[RealRoot, int]] = []
     undecided: list[Undecided] = []
     for f, mult in factors:
@@ -128,6 +136,88 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
             merged[-1] = prev
         merged.append(r)
     return RootIsolation(tuple(merged), tuple(undecided), BRANCH_AND_BOUND)
+
+
+def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
+                  ) -> RootIsolation | None:
+    """The zeros of an irreducible p mixing t with sin t, cos t that is a square on the
+    circle (a structural tangency), isolated through its norm over sin t; None when p's
+    norm is squarefree (then p has no such tangency: plain branch-and-bound).
+
+    p may be a square on the circle s² + c² = 1 without being one in Q[t, s, c] (e.g.
+    (t - sin t)² = t² - 2t·s + 1 - c²): its zeros are then tangencies, which no sign
+    change proves, and the branch-and-bound would end in thousands of undecided boxes.
+    Every zero τ of p = p₀ + s·p₁ is a zero of its norm N = p₀² - p₁²(1 - c²) in Q[t, c],
+    so of one of N's irreducible factors k, as a function of t; those have simple zeros,
+    bracketed by branch-and-bound.  At each one, whether p vanishes is decided exactly
+    (:meth:`~singcheck.roots.transcendental.TranscendentalPoint.is_zero`; at t = kπ by
+    :func:`~singcheck.roots.branch_bound.vanishes_at_multiple_of_pi`): p's zeros are
+    exactly those where it does, every other stretch is root-free."""
+    p0, p1 = split_s(p)
+    if p0.is_zero() or p1.is_zero():
+        return None
+    norm = p0 * p0 - p1 * p1 * ONE_MINUS_C2
+    if all(m == 1 for _, m in norm.factor_squarefree()[1]):
+        return None
+    roots: list[RealRoot] = []
+    undecided: list[Undecided] = []
+    for k, _ in norm.factor()[1]:
+        if k.is_constant():
+            continue
+        iso = branch_and_bound(k, interval, tolerance)
+        undecided += [Undecided(b.t, "possible tangency: the zeros of μ there are zeros of "
+                                "a factor of its norm over sin t, which could not be "
+                                f"isolated in t ∈ [{float(b.t.lower()):.9g}, "
+                                f"{float(b.t.upper()):.9g}] ({b.reason})")
+                      for b in iso.undecided]
+        for r in iso.roots:
+            zero = _vanishes_at(p, r)
+            if zero is None:
+                undecided.append(Undecided(r.t, "possible tangency: could not decide exactly "
+                                           "whether μ vanishes at the zero of a factor of "
+                                           f"its norm at t ≈ {float(r.t.mid()):.9g}"))
+            elif zero:
+                roots.append(r)
+    roots.sort(key=lambda r: float(r.t.mid()))
+    kept: list[RealRoot] = []
+    for r in roots:  # two factors' zeros: apart, or one exact point t = kπ both have
+        if kept and kept[-1].t.overlaps(r.t):
+            prev, tol = kept.pop(), tolerance
+            for _ in range(6):
+                tol /= 1e4
+                prev, r = prev.refined(tol), r.refined(tol)
+                if not prev.t.overlaps(r.t):
+                    break
+            if prev.t.overlaps(r.t):
+                if prev.exact is not None and prev.exact.kind == AT_POINT and \
+                        prev.exact == r.exact:
+                    kept.append(prev)
+                else:
+                    undecided.append(Undecided(prev.t.union(r.t), "two zeros of factors of "
+                                               "the norm of μ over sin t could not be "
+                                               "separated"))
+                continue
+            kept.append(prev)
+        kept.append(r)
+    roots = kept
+    return RootIsolation(tuple(roots), tuple(undecided), BRANCH_AND_BOUND)
+
+
+def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
+    """Whether p is exactly 0 at a bracketed zero of a norm factor (None: undecided)."""
+    time = root.exact
+    if time is None:
+        return None
+    if time.kind == IN_MIXED:
+        try:
+            return TranscendentalPoint(time).is_zero(p)
+        except NotExact:
+            return None
+    if time.kind == AT_POINT and time.t_value == 0:
+        return vanishes_at_multiple_of_pi(p, 0)
+    if time.kind == AT_POINT and time.pi_multiple is not None:
+        return vanishes_at_multiple_of_pi(p, time.pi_multiple)
+    return None
 
 
 def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,

@@ -13,6 +13,9 @@ What is proven, and how:
   against the limits), which is decided because no surface passes through the point.
 * **Exit time.**  The first crossing after which the count is 0 is when the path
   leaves the workspace; its ball is the certified exit time.
+* **On a surface.**  A surface whose polynomial is identically 0 along the path (μ ≡ 0:
+  the path lies on ξ = 0) is not crossed: the path lies on it for its whole range (on
+  a multi-piece path, for that piece's range), and is then in no open region.
 * **Region.**  A path with no crossing lies in one region.  The decomposition of the
   smallest subspace holding it (pose coordinates that are rational constants fixed: a
   line, a plane, or the whole workspace) is computed (:mod:`singcheck.space_analysis`),
@@ -61,11 +64,13 @@ class PathInWorkspace:
     undecided: list[str] = field(default_factory=list)
     exit_time: arb | None = None
     region: str | None = None  # e.g. "R21 of the workspace plane z = 1"
+    #: (surface, time range) where the path lies on a surface (its polynomial ≡ 0)
+    on_surfaces: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def one_region(self) -> bool | None:
         """True/False when proven; None when some crossing could not be decided."""
-        return None if self.undecided else not self.crossings
+        return None if self.undecided else not self.crossings and not self.on_surfaces
 
 
 def path_surfaces(path: PathModel) -> list[tuple[str, object]]:
@@ -120,11 +125,11 @@ def ik_count_at(path: PathModel, t: arb) -> int | None:
 XI = "parallel singularity ξ"
 
 
-def _crossings(path: PathModel, tolerance: float,
-               mu_roots: list[arb] | None) -> tuple[list[Crossing], list[str]]:
+def _crossings(path: PathModel, tolerance: float, mu_roots: list[arb] | None
+               ) -> tuple[list[Crossing], list[str], list[str]]:
     interval = path.trajectory.range
     events: list[tuple[arb, str]] = []
-    undecided = []
+    undecided, on = [], []
     for label, poly in path_surfaces(path):
         checkpoint()
         if label == XI and mu_roots is not None:
@@ -133,7 +138,7 @@ def _crossings(path: PathModel, tolerance: float,
         try:
             iso = isolate_real_roots(poly, interval, tolerance)
         except IdenticallyZeroError:
-            undecided.append(f"the path lies on the surface {label}")
+            on.append((label, str(interval)))
             continue
         events += [(r.t, label) for r in iso.roots]
         undecided += [f"{label}: {u.reason}" for u in iso.undecided]
@@ -145,7 +150,7 @@ def _crossings(path: PathModel, tolerance: float,
             merged[-1] = Crossing(last.t.union(t), (*last.surfaces, label))
         else:
             merged.append(Crossing(t, (label,)))
-    return merged, undecided
+    return merged, undecided, on
 
 
 def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: bool = True,
@@ -158,10 +163,10 @@ def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: boo
     where region maps are kept between runs (None: computed in this process only);
     ``notify(message)`` is told before a decomposition is computed (it takes seconds).
     """
-    crossings, undecided = _crossings(path, tolerance, mu_roots)
+    crossings, undecided, on = _crossings(path, tolerance, mu_roots)
     points = gap_points(path.trajectory.range, [c.t for c in crossings])
     stretches = [Stretch(p, ik_count_at(path, p)) for p in points]
-    result = PathInWorkspace(crossings, stretches, undecided)
+    result = PathInWorkspace(crossings, stretches, undecided, on_surfaces=on)
     result.exit_time = _exit_time(result)
     if name_region and result.one_region:
         result.region = locate_region(path, region_cache, notify)
@@ -193,10 +198,13 @@ def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
     spec = report.trajectory
     items: list = []  # crossings and stretches in time order, in the user's parameter
     undecided: list[str] = []
+    on: list[tuple[str, str]] = []
     for i, (piece, r) in enumerate(zip(spec.pieces, report.pieces, strict=True)):
         mu_roots = [c.t for c in r.candidates] if r.mu_roots_complete else None
         w = path_in_workspace(r.path, tolerance, False, mu_roots)
         undecided += [f"segment {i + 1}: {u}" for u in w.undecided]
+        on += [(surface, f"{piece.global_range} (segment {i + 1})")
+               for surface, _ in w.on_surfaces]
         own = sorted([*w.crossings, *w.stretches],
                      key=lambda x: float((x.t if isinstance(x, Crossing) else x.point).mid()))
         own = [Crossing(piece.to_global(x.t), x.surfaces) if isinstance(x, Crossing)
@@ -215,7 +223,7 @@ def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
         items += own
     crossings = [x for x in items if isinstance(x, Crossing)]
     stretches = [x for x in items if isinstance(x, Stretch)]
-    result = PathInWorkspace(crossings, stretches, undecided)
+    result = PathInWorkspace(crossings, stretches, undecided, on_surfaces=on)
     result.exit_time = _exit_time(result)
     if result.one_region:
         pose = report.path.projection.model.pose

@@ -12,7 +12,7 @@ import os
 import re
 import sys
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
@@ -29,7 +29,7 @@ from singcheck.spec.grammar import (
     compile_value,
     parse,
 )
-from singcheck.spec.paths import multi_piece, parse_csv
+from singcheck.spec.paths import csv_name, multi_piece, parse_csv
 from singcheck.spec.plainyaml import compose_all as compose_plain
 from singcheck.spec.plainyaml import kind
 from singcheck.spec.trajectory import (
@@ -42,7 +42,8 @@ from singcheck.spec.trajectory import (
 )
 
 __all__ = ["RobotSpec", "TrajectorySpec", "load_robot", "load_trajectory",
-           "load_trajectories", "parse_robot", "parse_trajectory", "parse_trajectories"]
+           "load_trajectories", "parse_robot", "parse_trajectory", "parse_trajectories",
+           "Document", "read_documents"]
 
 ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
               "parameters": False, "constraints": True, "joint_limits": False,
@@ -53,7 +54,6 @@ RESERVED = {"pi", "sin", "cos", "sqrt"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
 MAX_YAML_DEPTH = 16  # lists and mappings inside one another (specs need 3)
-MAX_STREAM_BYTES = 200_000_000  # a file (or stdin) of several trajectory documents
 STDIN = "-"  # the path that reads standard input
 STDIN_NAME = "<stdin>"  # how its trajectories name their file
 MAX_DRAWING_POINTS = 1000  # every point of a drawing is evaluated once per frame drawn
@@ -196,10 +196,12 @@ class _Doc:
             return value.surd.rational_value()
         return value
 
-    def expression(self, node, key: str, compile_):
+    def expression(self, node, key: str, compile_, tree=None):
+        """``compile_`` of the expression at ``node`` (``tree``: its parse, when the
+        caller has it already)."""
         text = self.text(node, key)
         try:
-            return compile_(parse(text))
+            return compile_(parse(text) if tree is None else tree)
         except ExprError as e:
             raise self.error(node, key, f"{e.message} in {_excerpt(text)}" +
                              (f" at column {e.column}" if e.column else "")) from None
@@ -215,9 +217,10 @@ def _kind(node) -> str:
             "scalar": "a single value"}.get(kind(node), "nothing")
 
 
-def _check_depth(text: str, path: str) -> None:
+def _check_depth(text: str, path: str, offset: int = 0) -> None:
     """Refuse YAML nested deeper than MAX_YAML_DEPTH, from the event stream (PyYAML's
-    parser is a state machine; its composer, and our walks, recurse once per level)."""
+    parser is a state machine; its composer, and our walks, recurse once per level).
+    ``offset``: lines of the file before ``text`` (for the line an error names)."""
     import yaml
 
     depth = 0
@@ -228,19 +231,19 @@ def _check_depth(text: str, path: str) -> None:
                 if depth > MAX_YAML_DEPTH:
                     raise SpecError(f"lists and mappings are nested more than "
                                     f"{MAX_YAML_DEPTH} levels deep", path=path,
-                                    line=event.start_mark.line + 1)
+                                    line=event.start_mark.line + 1 + offset)
             elif isinstance(event, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
                 depth -= 1
     except yaml.YAMLError as e:
-        raise _yaml_error(e, path) from None
+        raise _yaml_error(e, path, offset) from None
 
 
-def _yaml_error(e, path: str) -> SpecError:
+def _yaml_error(e, path: str, offset: int = 0) -> SpecError:
     import yaml
 
     if isinstance(e, yaml.MarkedYAMLError):
         mark = e.problem_mark or e.context_mark
-        line = mark.line + 1 if mark else None
+        line = mark.line + 1 + offset if mark else None
         problem = (e.problem or e.context or "invalid YAML").strip()
         return SpecError(f"not valid YAML: {problem}", path=path, line=line)
     return SpecError(f"not valid YAML: {str(e).splitlines()[0]}", path=path)
@@ -254,65 +257,48 @@ def _loader():
     return getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
-def _compose(text: str, path: str):
-    """The one document of ``text``, composed (never constructed): by the quick reader
-    of plain specs (:mod:`singcheck.spec.plainyaml`) when the text is in its subset,
-    else by PyYAML (imported only then)."""
-    plain = compose_plain(text, MAX_YAML_DEPTH)
+def _compose(text: str, path: str, first_line: int = 1, empty_ok: bool = False):
+    """The node tree of one YAML document, ``text`` starting at line ``first_line`` of
+    ``path`` (the lines its nodes and errors name); None for an empty one when
+    ``empty_ok``, else an error.  Composed (never constructed) by the quick reader of
+    plain specs (:mod:`singcheck.spec.plainyaml`) when the text is in its subset, else
+    by PyYAML (imported only then)."""
+    offset = first_line - 1
+    plain = compose_plain(text, MAX_YAML_DEPTH, offset)
     if plain is not None and len(plain) == 1:
         return plain[0]
     import yaml
 
-    _check_depth(text, path)
+    _check_depth(text, path, offset)
     try:
         node = yaml.compose(text, Loader=_loader())
     except yaml.YAMLError as e:
-        raise _yaml_error(e, path) from None
-    if node is None:
-        raise SpecError("the file is empty", path=path, line=1)
-    _refuse_tags(node, _Doc(path), set())
+        raise _yaml_error(e, path, offset) from None
+    if node is None or (isinstance(node, yaml.ScalarNode) and node.value == ""
+                        and node.tag == "tag:yaml.org,2002:null"):  # nothing, or a bare ---
+        if empty_ok:
+            return None
+        raise SpecError("the file is empty", path=path, line=first_line)
+    _refuse_tags(node, _Doc(path), set(), offset)
     return node
-
-
-def _compose_all(text: str, path: str) -> Iterator:
-    """Every document of a YAML stream (``---`` between documents), composed one at a
-    time; empty documents are skipped, a stream with none is an error.  The quick reader
-    first, PyYAML for a stream outside its subset."""
-    plain = compose_plain(text, MAX_YAML_DEPTH)
-    if plain is not None:
-        yield from plain
-        return
-    import yaml
-
-    _check_depth(text, path)
-    stream = yaml.compose_all(text, Loader=_loader())
-    found = False
-    while True:
-        try:
-            node = next(stream)
-        except StopIteration:
-            break
-        except yaml.YAMLError as e:
-            raise _yaml_error(e, path) from None
-        if node is None:
-            continue
-        _refuse_tags(node, _Doc(path), set())
-        found = True
-        yield node
-    if not found:
-        raise SpecError("the file is empty", path=path, line=1)
 
 
 _PLAIN_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "null", "bool",
                                                   "map", "seq")}
 
 
-def _refuse_tags(node, doc: _Doc, seen: set[int]) -> None:
+def _refuse_tags(node, doc: _Doc, seen: set[int], offset: int = 0) -> None:
     """Refuse YAML tags, and aliases (``*name``): a node reached twice is an alias, and
-    nested aliases are how a small file expands into an enormous one."""
+    nested aliases are how a small file expands into an enormous one.  Moves each node's
+    mark ``offset`` lines down (a document cut out of a longer file)."""
     if id(node) in seen:
         raise doc.error(node, None, "YAML aliases (*name) are not allowed in specs")
     seen.add(id(node))
+    if offset:
+        import yaml
+
+        m = node.start_mark
+        node.start_mark = yaml.Mark(m.name, m.index, m.line + offset, m.column, None, None)
     if node.tag not in _PLAIN_TAGS:
         raise doc.error(node, None, f"YAML tags like {node.tag} are not allowed")
     children = []
@@ -322,7 +308,7 @@ def _refuse_tags(node, doc: _Doc, seen: set[int]) -> None:
     elif kind(node) == "sequence":
         children = node.value
     for child in children:
-        _refuse_tags(child, doc, seen)
+        _refuse_tags(child, doc, seen, offset)
 
 
 def _read(path: str | os.PathLike, limit: int = MAX_BYTES) -> str:
@@ -547,40 +533,207 @@ def load_trajectory(path: str | os.PathLike, robot: RobotSpec,
 def parse_trajectories(text: str, path: str, robot: RobotSpec) -> Iterator[TrajectorySpec]:
     """Each YAML document of ``text`` (separated by ``---``) as one trajectory; errors
     name the file, the line in it and, past the first, the document."""
-    for number, node in enumerate(_compose_all(text, path), 1):
+    import io
+
+    for document in _documents(io.BytesIO(text.encode()), path):
+        yield document.parse(robot)
+
+
+@dataclass(frozen=True)
+class Document:
+    """One trajectory of a run's input, read but not parsed yet (a worker parses it): a
+    YAML document cut out of its file, or a CSV file's table.  ``error``: what was found
+    wrong while reading it (not YAML, too big, a name already used in the run)."""
+
+    path: str  # as messages name it (<stdin> for standard input)
+    number: int  # its rank among its file's documents (1: the first)
+    line: int  # the line of the file where its text starts
+    text: str
+    name: str | None = None  # its name key, when the YAML could be read
+    name_line: int | None = None
+    csv: str | None = None  # a CSV table: its interpolation (linear or cubic)
+    error: SpecError | None = None
+
+    @property
+    def label(self) -> str:
+        """Its name, else where it starts (FILE:LINE)."""
+        return self.name or f"{self.path}:{self.line}"
+
+    def parse(self, robot: RobotSpec) -> TrajectorySpec:
+        """The trajectory spec; :class:`SpecError` naming the file, the line in it and,
+        past a file's first document, the document's number."""
+        if self.error is not None:
+            raise self.error
+        if self.csv is not None:
+            return parse_csv(self.text, self.path, robot, self.csv)
         try:
-            yield _trajectory(node, path, robot)
+            return _trajectory(_compose(self.text, self.path, self.line), self.path, robot)
         except SpecError as e:
-            if number == 1:
-                raise
-            raise SpecError(f"{e.message} (document {number})", path=e.path, line=e.line,
-                            key=e.key) from None
+            raise self.located(e) from None
+
+    def located(self, e: SpecError) -> SpecError:
+        if self.number == 1:
+            return e
+        return SpecError(f"{e.message} (document {self.number})", path=e.path, line=e.line,
+                         key=e.key)
+
+
+def _is_marker(line: bytes, marker: bytes) -> bool:
+    """A YAML document marker (``---`` or ``...`` at the start of a line, alone or
+    followed by a blank): it always ends a document, even inside a scalar."""
+    return line.startswith(marker) and (len(line) == 3 or line[3:4] in b" \t\r\n")
+
+
+def _chunks(stream, limit: int) -> Iterator[tuple[int, bytes | None]]:
+    """The documents of a YAML stream as (first line, bytes), read a line at a time: a
+    document ends where the next ``---`` starts or at ``...``; comments and directives
+    before a ``---`` go with its document.  A document over ``limit`` bytes is (line,
+    None), skipped without being held."""
+    lines: list[bytes] = []
+    size, start, number, content, too_big = 0, 1, 0, False, False
+    while True:
+        line = stream.readline(limit + 1)
+        if not line:
+            break
+        number += 1
+        start_marker = _is_marker(line, b"---")
+        if start_marker and content:
+            yield start, None if too_big else b"".join(lines)
+            lines, size, start, content, too_big = [], 0, number, False, False
+        if not too_big:
+            size += len(line)
+            too_big = size > limit
+            if too_big:
+                lines = []
+            else:
+                lines.append(line)
+        stripped = line.strip()
+        if start_marker or (stripped and not stripped.startswith(b"#")
+                            and not line.startswith(b"%")):
+            content = True
+        if _is_marker(line, b"..."):
+            if content:
+                yield start, None if too_big else b"".join(lines)
+            lines, size, start, content, too_big = [], 0, number + 1, False, False
+    if content:
+        yield start, None if too_big else b"".join(lines)
+
+
+def _documents(stream, path: str, limit: int = MAX_BYTES) -> Iterator[Document]:
+    """The non-empty YAML documents of a binary stream, one at a time, each composed
+    once to read its name (the spec itself is parsed later, by :meth:`Document.parse`);
+    a document that cannot be read is a :class:`Document` with its ``error``."""
+    number = 0
+    try:
+        for first, data in _chunks(stream, limit):
+            document = Document(path, number + 1, first, "")
+            if data is None:
+                number += 1
+                yield replace(document, error=document.located(SpecError(
+                    f"the document is larger than {limit} bytes", path=path, line=first)))
+                continue
+            try:
+                text = data.decode("utf-8")
+            except UnicodeDecodeError as e:
+                number += 1
+                line = first + data[: e.start].count(b"\n")
+                yield replace(document, error=document.located(SpecError(
+                    "the file is not UTF-8 text", path=path, line=line)))
+                continue
+            try:
+                node = _compose(text, path, first, empty_ok=True)
+            except SpecError as e:
+                number += 1
+                yield replace(document, text=text, error=document.located(e))
+                continue
+            if node is None:  # an empty document (comments only, or a stray ---)
+                continue
+            number += 1
+            yield replace(document, text=text, **_name(node))
+    except OSError as e:
+        yield Document(path, number + 1, 1, "", error=SpecError(
+            f"cannot read the file: {e.strerror or e}", path=path))
+        return
+    if number == 0:
+        yield Document(path, 1, 1, "", error=SpecError("the file is empty", path=path,
+                                                        line=1))
+
+
+def _name(node) -> dict:
+    """A trajectory document's name and its line, when its top is a mapping with one."""
+    if kind(node) == "mapping":
+        for k, v in node.value:
+            if kind(k) == "scalar" and k.value == "name" and \
+                    kind(v) == "scalar" and str(v.value).strip():
+                return {"name": str(v.value).strip(), "name_line": _line(k)}
+    return {}
+
+
+def read_documents(paths: Iterable[str | os.PathLike], interpolation: str | None = None,
+                   ) -> Iterator[Document]:
+    """Every trajectory of the files, lazily, as :class:`Document` (a YAML file, or
+    ``-``, standard input, holds one or more documents; a CSV file one table), read one
+    at a time: memory does not grow with the number of trajectories but for their
+    names, which must be unique in a run (a repeated one is that document's error).
+    A file that cannot be opened, or ``-`` given twice, is refused here, at once."""
+    paths = [os.fspath(p) for p in paths]
+    if paths.count(STDIN) > 1:
+        raise SpecError("standard input (-) is given twice", path=STDIN)
+    for path in paths:
+        if path != STDIN:
+            try:
+                with open(path, "rb"):
+                    pass
+            except OSError as e:
+                raise SpecError(f"cannot read the file: {e.strerror or e}", path=path) from None
+    return _unique(_all_documents(paths, interpolation))
+
+
+def _all_documents(paths: list[str], interpolation: str | None) -> Iterator[Document]:
+    for path in paths:
+        if path.lower().endswith(".csv"):
+            document = Document(path, 1, 1, "", name=csv_name(path),
+                                csv=interpolation or "cubic")
+            try:
+                yield replace(document, text=_read(path))
+            except SpecError as e:
+                yield replace(document, error=e)
+            continue
+        if path == STDIN:
+            yield from _documents(sys.stdin.buffer, STDIN_NAME)
+            continue
+        try:
+            stream = open(path, "rb")
+        except OSError as e:
+            yield Document(path, 1, 1, "", error=SpecError(
+                f"cannot read the file: {e.strerror or e}", path=path))
+            continue
+        with stream:
+            yield from _documents(stream, path)
+
+
+def _unique(documents: Iterator[Document]) -> Iterator[Document]:
+    """Names unique in a run: each name with where it was first seen (a dict of the
+    names, O(number of trajectories) short strings, is the one thing that grows)."""
+    seen: dict[str, tuple[str, int | None]] = {}
+    for document in documents:
+        name = document.name
+        if document.error is None and name is not None:
+            if name in seen:
+                path, line = seen[name]
+                document = replace(document, error=document.located(SpecError(
+                    f"trajectory name {name!r} is already used by {path}:{line or '?'} "
+                    "(names must be unique in a run)", path=document.path,
+                    line=document.name_line, key="name")))
+            else:
+                seen[name] = (document.path, document.name_line)
+        yield document
 
 
 def load_trajectories(paths: Iterable[str | os.PathLike], robot: RobotSpec,
                       interpolation: str | None = None) -> list[TrajectorySpec]:
     """Every trajectory of the files: a YAML file (or ``-``, standard input, once) holds
-    one or more documents, a CSV file one path; names must be unique across them all."""
-    out: list[TrajectorySpec] = []
-    seen: dict[str, TrajectorySpec] = {}
-    read_stdin = False
-    for path in map(os.fspath, paths):
-        if path == STDIN:
-            if read_stdin:
-                raise SpecError("standard input (-) is given twice", path=path)
-            read_stdin = True
-        if path.lower().endswith(".csv"):
-            specs: Iterable[TrajectorySpec] = [load_trajectory(path, robot, interpolation)]
-        else:
-            specs = parse_trajectories(_read(path, MAX_STREAM_BYTES),
-                                       STDIN_NAME if path == STDIN else path, robot)
-        for spec in specs:
-            if spec.name in seen:
-                first = seen[spec.name]
-                raise SpecError(f"trajectory name {spec.name!r} is already used by "
-                                f"{first.path}:{first.lines.get('name', '?')} (names must be "
-                                "unique in a run)", path=spec.path,
-                                line=spec.lines.get("name"), key="name")
-            seen[spec.name] = spec
-            out.append(spec)
-    return out
+    one or more documents, a CSV file one path; names must be unique across them all.
+    The first bad one raises :class:`SpecError`.  (:func:`read_documents` reads them
+    one at a time instead.)"""
+    return [document.parse(robot) for document in read_documents(paths, interpolation)]

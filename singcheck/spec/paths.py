@@ -184,6 +184,11 @@ def _check_table(path: str, parameter: str, times, lines, where) -> None:
                             f"({times[i - 1]} then {times[i]})", path=path, line=lines[i])
 
 
+def csv_name(path: str) -> str:
+    """A CSV trajectory's name: its file's name without ``.csv``."""
+    return re.sub(r"\.csv\Z", "", path.replace("\\", "/").rsplit("/", 1)[-1], flags=re.I)
+
+
 def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec:
     """A CSV table of poses: header ``PARAMETER,POSE...`` then one exact row per waypoint."""
     text = text.removeprefix("\ufeff")  # a byte-order mark some spreadsheets write
@@ -233,7 +238,7 @@ def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec
             values[name].append(value)
         lines.append(n)
     _check_table(path, parameter, times, lines, header_line)
-    stem = re.sub(r"\.csv\Z", "", path.replace("\\", "/").rsplit("/", 1)[-1], flags=re.I)
+    stem = csv_name(path)
     pieces = interpolated_pieces(path, stem, parameter, times, values, interpolation, lines)
     return _whole(path, stem, parameter, pieces, {"interpolation": interpolation})
 

@@ -74,21 +74,22 @@ _SPECIAL = re.compile(r"[0-9][0-9][0-9][0-9]-|<<\Z|=\Z")
 _FLOW_STOP = re.compile(r"[,\[\]{}:?]")
 
 
-def compose_all(text: str, max_depth: int) -> list[Node | None] | None:
+def compose_all(text: str, max_depth: int, offset: int = 0) -> list[Node] | None:
     """The documents of ``text``, or ``None`` when the text is not in the plain subset
-    (or has an empty document, or nests lists and mappings deeper than ``max_depth``)."""
+    (or has an empty document, or nests lists and mappings deeper than ``max_depth``);
+    ``offset``: lines of the file before ``text`` (added to every node's line)."""
     try:
-        docs = [_Document(lines, max_depth).node() for lines in _documents(text)]
+        docs = [_Document(lines, max_depth).node() for lines in _documents(text, offset)]
     except _Decline:
         return None
     return docs if None not in docs else None  # an empty document: as PyYAML sees it
 
 
-def _documents(text: str) -> list[list[tuple[int, int, str]]]:
+def _documents(text: str, offset: int = 0) -> list[list[tuple[int, int, str]]]:
     """Per document, its non-blank lines as (line number, indent, content without the
     comment)."""
     docs: list[list[tuple[int, int, str]]] = [[]]
-    for number, raw in enumerate(text.split("\n")):
+    for number, raw in enumerate(text.split("\n"), offset):
         if not raw.isprintable():  # (stricter than YAML's printable set)
             raise _Decline
         content = _without_comment(raw).rstrip(" ")

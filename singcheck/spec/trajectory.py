@@ -189,14 +189,14 @@ def trajectory_piece(doc, rng: TimeRange, rnode, nodes: dict, key: str, paramete
     ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
     coords, offsets = {}, {}
     for v, node in nodes.items():
-        if v in robot.angles:
+        if v in robot.angles:  # (each expression is parsed once: its tree is reused)
             coords[v], offsets[v] = doc.expression(
                 node, f"{key}.{v}", lambda n: compile_angle_coordinate(
-                    n, parameter, robot.parameters, ring, scale))
+                    n, parameter, robot.parameters, ring, scale), trees[v])
         else:
             coords[v] = doc.expression(
                 node, f"{key}.{v}", lambda n: compile_trajectory_coordinate(
-                    n, parameter, robot.parameters, ring, scale))
+                    n, parameter, robot.parameters, ring, scale), trees[v])
     used = [i for i, _ in radical_variables(ring)
             if any(p.degrees()[i] > 0 for p in coords.values())]
     names = ("t", "s", "c", *(ring.names()[i] for i in used))

@@ -51,14 +51,13 @@ def prctl(option: int, value: int) -> bool:
         return False
 
 
-def children() -> set[int]:
-    """The pids whose parent is this process (from /proc; empty where there is none)."""
-    me = os.getpid()
-    out = set()
+def _processes():
+    """(pid, state, parent pid, process group) of every process, from /proc (nothing
+    where there is no /proc)."""
     try:
         entries = os.listdir("/proc")
     except OSError:
-        return out
+        return
     for name in entries:
         if not name.isdigit():
             continue
@@ -68,31 +67,33 @@ def children() -> set[int]:
         except OSError:
             continue
         fields = stat[stat.rfind(b")") + 2:].split()
-        if len(fields) > 1 and int(fields[1]) == me:
-            out.add(int(name))
-    return out
+        if len(fields) > 2:
+            yield int(name), fields[0], int(fields[1]), int(fields[2])
+
+
+def children() -> set[int]:
+    """The pids whose parent is this process."""
+    me = os.getpid()
+    return {pid for pid, _, parent, _ in _processes() if parent == me}
 
 
 def _group_members(group: int) -> set[int]:
     """The live processes (not zombies) of process group ``group``, other than us."""
     me = os.getpid()
-    out = set()
-    try:
-        entries = os.listdir("/proc")
-    except OSError:
-        return out
-    for name in entries:
-        if not name.isdigit() or int(name) == me:
-            continue
-        try:
-            with open(f"/proc/{name}/stat", "rb") as f:
-                stat = f.read()
-        except OSError:
-            continue
-        fields = stat[stat.rfind(b")") + 2:].split()
-        if len(fields) > 2 and fields[0] != b"Z" and int(fields[2]) == group:
-            out.add(int(name))
-    return out
+    return {pid for pid, state, _, pgrp in _processes()
+            if pgrp == group and state != b"Z" and pid != me}
+
+
+def die_with_parent(parent: int, signum: int = signal.SIGKILL) -> None:
+    """In a freshly forked child: ask for ``signum`` when the parent's forking thread
+    exits (``PR_SET_PDEATHSIG``), exit at once if ``parent`` is already gone (it died
+    before the request), and take the default action for SIGINT, SIGTERM and SIGHUP
+    again (the parent's handlers are the parent's)."""
+    prctl(PR_SET_PDEATHSIG, signum)
+    if os.getppid() != parent:
+        os._exit(1)
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_DFL)
 
 
 def reap_children(keep, rounds: int = 100) -> None:
@@ -144,11 +145,7 @@ def _kill_everything() -> None:
 def _exec_cas(argv: list[str], limit: int, guard: int) -> None:
     """In the forked child: die with the guard, bound the address space, exec."""
     try:
-        prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
-        if os.getppid() != guard:
-            os._exit(1)
-        for sig in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT):
-            signal.signal(sig, signal.SIG_DFL)
+        die_with_parent(guard)
         if limit > 0:
             import resource
 

@@ -30,7 +30,7 @@ import signal
 import time
 
 from singcheck.budget import TimeLimitExceeded
-from singcheck.elimination.cas.guard import PR_SET_PDEATHSIG, prctl
+from singcheck.elimination.cas.guard import die_with_parent
 from singcheck.elimination.cas.limits import describe_limit, memory_limit
 from singcheck.elimination.requests import EliminationRequest, EliminationResult
 from singcheck.errors import BackendError
@@ -50,11 +50,7 @@ def _child(fn, argument, write: int, err: int, parent: int, limit: int) -> None:
     import pickle
 
     try:
-        prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
-        if os.getppid() != parent:
-            os._exit(1)
-        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
-            signal.signal(sig, signal.SIG_DFL)
+        die_with_parent(parent)
         signal.setitimer(signal.ITIMER_REAL, 0)  # the parent's alarm is the parent's
         os.dup2(err, 2)  # what GMP or FLINT print before aborting: for the parent
         import faulthandler

@@ -1,0 +1,137 @@
+"""Every stage has a budget (issue 16): a costly step is refused up front (exit 2, one
+line) or stops at the time limit within a bounded overrun (exit 3, ``unknown: time
+limit``) — composing ξ with a path, eliminating along a path, and the workspace and
+joint-space decompositions."""
+
+from __future__ import annotations
+
+import re
+import time
+
+import pytest
+
+from singcheck import api
+from tests.conftest import ROBOTS
+from tests.test_hardening import cache_env, run_cli, trajectory  # noqa: F401
+
+STACKED = ROBOTS / "stacked-orthoglide.yaml"
+#: each coordinate a cube: ξ (57,855 terms) composed with it took 4 s of CPU in one
+#: uninterruptible FLINT call, and overran a 2 s time limit by 6-10 s
+CUBES = {"x1": "(sin(t)+cos(t)+t)^3", "y1": "(sin(t)-cos(t)+t/2)^3",
+         "z1": "(sin(t)+2*cos(t)-t)^3", "x2": "(sin(t)+cos(t)+3*t)^3",
+         "y2": "(3*sin(t)+cos(t)+t)^3", "z2": "(sin(t)+cos(t)+t/7)^3"}
+
+
+@pytest.fixture(scope="module")
+def stacked():
+    return api.load_robot(STACKED, backend="flint", cache=False)
+
+
+# -- composing ξ with the path ------------------------------------------------------------
+
+
+def _coordinates(*texts):
+    from singcheck.spec.grammar import compile_trajectory_coordinate, parse
+
+    return tuple(compile_trajectory_coordinate(parse(text), "t", {}) for text in texts)
+
+
+@pytest.mark.parametrize("piece_work, piece_pairs", [(1, 1), (2_000, 50), (10**5, 10**3)])
+def test_composition_in_pieces_is_the_one_call_composition(orthoglide_projection, monkeypatch,
+                                                           piece_work, piece_pairs):
+    """Horner's scheme with every intermediate reduced gives exactly FLINT's one-call
+    composition, reduced modulo s² + c² - 1 (and it reaches the checkpoint)."""
+    from singcheck.algebra import composition
+    from singcheck.algebra.trig import TRIG, reduce_trig
+    from singcheck.certify.path import compose_pose
+
+    calls = []
+    monkeypatch.setattr(composition, "PIECE_WORK", piece_work)
+    monkeypatch.setattr(composition, "PIECE_PAIRS", piece_pairs)
+    monkeypatch.setattr(composition, "checkpoint", lambda: calls.append(1))
+    xi = orthoglide_projection.singularity_surface
+    phi = _coordinates("(sin(t) + cos(t) + t)^3", "t^2 - 3/7*sin(2*t)", "1 + cos(t)/5")
+    expected = reduce_trig(xi.compose(*phi, ctx=TRIG))
+    assert compose_pose(xi, phi, ("x", "y", "z")) == expected
+    assert len(calls) > 10
+
+
+def test_a_costly_composition_stops_at_the_time_limit(stacked, tmp_path, cache_env):  # noqa: F811
+    """The stacked Orthoglide with cubes: stopped within the limit and a bounded overrun
+    (before: one FLINT call ran 6-10 s past a 2 s limit)."""
+    spec = api.load_trajectory(trajectory(tmp_path, CUBES), stacked)
+    start = time.monotonic()
+    report = api.check(stacked, spec, time_limit=2, regions=False)
+    elapsed = time.monotonic() - start
+    assert report.verdict == "unknown" and "time limit" in report.reason
+    assert elapsed < 4, elapsed
+
+
+def test_a_composition_beyond_the_work_bound_is_refused_up_front(stacked, tmp_path):
+    """Coefficients of hundreds of digits: μ would have few terms but huge coefficients;
+    refused (a spec error: one line, exit 2) with the estimate and the bound, at once."""
+    from singcheck.algebra.composition import MAX_COMPOSE_WORK
+    from singcheck.errors import SpecError
+
+    big = "(12345678901234567890123456789/98765432109876543210987654321)"
+    pose = {v: f"{big}^{k}*(sin(t) + cos(t) + t)^3"
+            for v, k in zip(stacked.model.pose, (20, 19, 18, 17, 16, 15), strict=True)}
+    spec = api.load_trajectory(trajectory(tmp_path, pose), stacked)
+    start = time.monotonic()
+    with pytest.raises(SpecError) as refused:
+        api.check(stacked, spec, time_limit=60, regions=False)
+    assert time.monotonic() - start < 2
+    message = str(refused.value)
+    assert "too costly" in message and "\n" not in message
+    assert f"at most {MAX_COMPOSE_WORK:.3g}" in message
+    estimate = float(re.search(r"would cost ([0-9.e+]+)", message).group(1))
+    assert estimate > MAX_COMPOSE_WORK
+
+
+# -- workspace and joint space ------------------------------------------------------------
+
+BIG_CONSTANT = """\
+name: big
+joints: [p, q]
+pose: [x, y]
+constraints:
+  - (x - p)^2 + y^2 - 4
+  - (x - q)^2 + y^2 - (2147483648-364349)^8
+joint_limits: {p: [-4, 4], q: [-4, 4]}
+"""
+
+
+@pytest.mark.parametrize("space, robot", [("workspace", "orthoglide"),
+                                          ("jointspace", "big-constant")])
+def test_space_analyses_stop_at_the_time_limit_and_write_nothing(
+        tmp_path, monkeypatch, capsys, cache_env, space, robot):  # noqa: F811
+    """Both take 2-7 s without a limit (the decomposition); with --time-limit 1 they end
+    with exit 3, one line naming the limit, and no -o file."""
+    if robot == "big-constant":
+        path = tmp_path / "big.yaml"
+        path.write_text(BIG_CONSTANT)
+    else:
+        path = ROBOTS / f"{robot}.yaml"
+    target = tmp_path / "out.json"
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, space, str(path), "--backend", "flint",
+                             "-q", "--time-limit", "1", "--format", "json", "-o", str(target))
+    elapsed = time.monotonic() - start
+    assert code == 3, err
+    assert err.count("\n") == 1 and "unknown: time limit (1 s)" in err, err
+    assert not target.exists() and out == ""
+    assert elapsed < 4, elapsed
+
+
+def test_space_commands_state_their_time_limit():
+    from click.testing import CliRunner
+
+    from singcheck.cli.spaces import jointspace, workspace
+
+    for command in (workspace, jointspace):
+        result = CliRunner().invoke(command, ["--help"])
+        assert result.exit_code == 0
+        text = " ".join(result.output.split())
+        option = text[text.index("--time-limit FLOAT"):text.index("--format [")]
+        assert "past it the command ends with exit 3" in option
+        assert option.endswith("[default: 300; x>0] ")

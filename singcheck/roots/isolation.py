@@ -115,12 +115,23 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
         iso = isolate_real_roots(f, interval, tolerance)
         roots += [(r, int(mult)) for r in iso.roots]
         undecided += list(iso.undecided)
-    roots.sort(key=lambda item: float(item[0].t.mid()))
+    merged, apart = _merge_apart(
+        [RealRoot(r.t, None if r.multiplicity is None else r.multiplicity * mult, r._refine,
+                  exact=r.exact) for r, mult in roots], tolerance,
+        "two factors of the function have roots that could not be separated")
+    return RootIsolation(tuple(merged), tuple(undecided + apart), BRANCH_AND_BOUND)
+
+
+def _merge_apart(roots: list[RealRoot], tolerance: float, why: str
+                 ) -> tuple[list[RealRoot], list[Undecided]]:
+    """Roots of different functions, in time order: balls that overlap are refined
+    apart; a root both have (proven only for the same exact point: equal exact balls, or
+    the same t = kπ) is kept once; two balls that stay overlapping otherwise become an
+    undecided stretch, with the reason ``why``."""
     merged: list[RealRoot] = []
-    for r, mult in roots:
+    undecided: list[Undecided] = []
+    for r in sorted(roots, key=lambda r: float(r.t.mid())):
         checkpoint()
-        r = RealRoot(r.t, None if r.multiplicity is None else r.multiplicity * mult,
-                     r._refine, exact=r.exact)
         if merged and merged[-1].t.overlaps(r.t):
             prev, tol = merged[-1], tolerance
             for _ in range(6):
@@ -129,17 +140,18 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
                 tol /= 1e4
                 prev, r = prev.refined(tol), r.refined(tol)
             if prev.t.overlaps(r.t):
-                if prev.t.is_exact() and r.t.is_exact() and prev.t == r.t:
+                if (prev.t.is_exact() and r.t.is_exact() and prev.t == r.t) or \
+                        (prev.exact is not None and prev.exact.kind == AT_POINT
+                         and prev.exact == r.exact):
                     merged[-1] = RealRoot(prev.t, None, prev._refine,
                                           exact=prev.exact or r.exact)
                     continue
                 merged.pop()
-                undecided.append(Undecided(prev.t.union(r.t), "two factors of the function "
-                                           "have roots that could not be separated"))
+                undecided.append(Undecided(prev.t.union(r.t), why))
                 continue
             merged[-1] = prev
         merged.append(r)
-    return RootIsolation(tuple(merged), tuple(undecided), BRANCH_AND_BOUND)
+    return merged, undecided
 
 
 def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
@@ -184,30 +196,9 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
                                            f"its norm at t ≈ {float(r.t.mid()):.9g}"))
             elif zero:
                 roots.append(r)
-    roots.sort(key=lambda r: float(r.t.mid()))
-    kept: list[RealRoot] = []
-    for r in roots:  # two factors' zeros: apart, or one exact point t = kπ both have
-        checkpoint()
-        if kept and kept[-1].t.overlaps(r.t):
-            prev, tol = kept.pop(), tolerance
-            for _ in range(6):
-                tol /= 1e4
-                prev, r = prev.refined(tol), r.refined(tol)
-                if not prev.t.overlaps(r.t):
-                    break
-            if prev.t.overlaps(r.t):
-                if prev.exact is not None and prev.exact.kind == AT_POINT and \
-                        prev.exact == r.exact:
-                    kept.append(prev)
-                else:
-                    undecided.append(Undecided(prev.t.union(r.t), "two zeros of factors of "
-                                               "the norm of μ over sin t could not be "
-                                               "separated"))
-                continue
-            kept.append(prev)
-        kept.append(r)
-    roots = kept
-    return RootIsolation(tuple(roots), tuple(undecided), BRANCH_AND_BOUND)
+    roots, apart = _merge_apart(roots, tolerance, "two zeros of factors of the norm of μ "
+                                "over sin t could not be separated")
+    return RootIsolation(tuple(roots), tuple(undecided + apart), BRANCH_AND_BOUND)
 
 
 def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:

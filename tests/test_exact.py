@@ -523,6 +523,17 @@ def test_five_bar_resting_where_the_distal_links_align_is_singular_all_along():
     assert report.verdict == "singular" and "whole path" in report.reason
     assert [m.label for m in report.modes if m.feasible] == ["+-"]
     assert {m for c in report.candidates for m in c.singular_modes} == expected
+    # the workspace line: on ξ all along, with the oracle's IK count inside the limits
+    from singcheck.report.trajectory import workspace_json, workspace_line
+    from singcheck.spaces.path_regions import path_in_workspace
+    from tests.robot_oracles import five_bar
+
+    count = 1
+    for leg in five_bar().legs:  # angles in [lo, lo + 2π): inside when ≤ hi
+        count *= sum(1 for q in leg.branches([0, mpmath.sqrt(3)]) if q <= leg.hi + 1e-30)
+    line = workspace_line(workspace_json(path_in_workspace(path, name_region=False)))
+    assert line == ("workspace: the path lies on parallel singularity ξ for t ∈ [0, 1] "
+                    f"({count} IK solution(s) inside the joint limits all along)")
 
 
 def test_five_bar_on_the_surface_of_an_infeasible_mode_only_is_free():

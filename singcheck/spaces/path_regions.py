@@ -133,7 +133,7 @@ XI = "parallel singularity ξ"
 
 
 def _crossings(path: PathModel, tolerance: float, mu_roots: list[arb] | None
-               ) -> tuple[list[Crossing], list[str], list[str]]:
+               ) -> tuple[list[Crossing], list[str], list[tuple[str, str]]]:
     interval = path.trajectory.range
     events: list[tuple[arb, str]] = []
     undecided, on = [], []

@@ -19,7 +19,6 @@ from singcheck.elimination.cas import get_backend
 from singcheck.elimination.projection import project_robot
 from singcheck.model.robot import build_model
 from singcheck.spaces.analysis import (
-    LIMIT,
     PARALLEL,
     WORKSPACE,
     analyse,
@@ -94,21 +93,21 @@ def _check_cells(projection, oracle, fixed, kinds=None):
     return analysis
 
 
-def _region_of_path(analysis, chart, fixed, region_name, pose_of_t, t0, t1, samples=24):
-    """The named region's number, its count and its sign vector hold at 50-digit points
-    of the path (computed here from the path's own formula)."""
+def _path_in_region(analysis, chart, region_name, oracle, pose_of_t, t0, t1, samples=24):
+    """The named region's sign vector and its count hold at 50-digit points of the path
+    (computed here from the path's own formula, the count by the oracle's IK); returns
+    that count."""
     number = int(region_name.split()[0][1:])
     region = next(r for r in analysis.regions.regions if r.number == number)
     count = analysis.region_count(number)
-    factors = analysis.cad.factors
     for k in range(samples + 1):
         t = _mp(t0) + (_mp(t1) - _mp(t0)) * k / samples
         X = pose_of_t(t)
-        values = {}
-        for v, a, x in zip(chart.names, chart.axes, X, strict=True):
-            values[a] = mp.tan(x / 2) if v in chart.angles else x
-        assert tuple(_sign_at(f, values) for f in factors) == region.signs
-        yield count, X
+        values = {a: mp.tan(x / 2) if v in chart.angles else x
+                  for v, a, x in zip(chart.names, chart.axes, X, strict=True)}
+        assert tuple(_sign_at(f, values) for f in analysis.cad.factors) == region.signs
+        assert _oracle_count(oracle, X) == count
+    return count
 
 
 def _trajectory(robot, text, tmp_path):
@@ -160,11 +159,9 @@ def test_linear_delta_slice_counts_match_the_oracle_and_a_path_is_named(tmp_path
                   "pose: {x: -1/4 + t/2, y: 1/4, z: t/4}\n", tmp_path)
     assert w.one_region and w.region.endswith("of the workspace plane y = 1/4")
     chart = Chart.of(("x", "y", "z"), frozenset())
-    oracle = oracles.linear_delta()
-    for count, X in _region_of_path(analysis, chart, {"y": Fraction(1, 4)}, w.region,
-                                    lambda t: [-mp.mpf(1) / 4 + t / 2, mp.mpf(1) / 4, t / 4],
-                                    0, Fraction(1, 2)):
-        assert count == _oracle_count(oracle, X) == 1
+    assert _path_in_region(analysis, chart, w.region, oracles.linear_delta(),
+                           lambda t: [-mp.mpf(1) / 4 + t / 2, mp.mpf(1) / 4, t / 4],
+                           0, Fraction(1, 2)) == 1
 
 
 @pytest.mark.slow
@@ -179,23 +176,29 @@ def test_rotary_delta_free_path_is_named_in_its_plane_without_xi(tmp_path):
     assert w.region.endswith("plane z = -2 cut by its serial-singularity and joint-limit "
                              "surfaces only")
     chart = Chart.of(("x", "y", "z"), frozenset())
-    oracle = oracles.rotary_delta()
-    for count, X in _region_of_path(analysis, chart, {"z": Fraction(-2)}, w.region,
-                                    lambda t: [mp.cos(t) / 2, mp.sin(t) / 2, mp.mpf(-2)],
-                                    -math.pi, math.pi):
-        assert count == _oracle_count(oracle, X) == 1
+    assert _path_in_region(analysis, chart, w.region, oracles.rotary_delta(),
+                           lambda t: [mp.cos(t) / 2, mp.sin(t) / 2, mp.mpf(-2)],
+                           -math.pi, math.pi) == 1
 
 
 # -- angles: the 3-RPR and the 5-bar ---------------------------------------------------------
 
 
-def test_3rpr_plane_in_the_chart_counts_match_the_oracle():
-    # the plane y = 1 in (x, tan(phi/2)), cut by the surfaces where the count changes
-    projection = _projection("3-rpr")
-    analysis = _check_cells(projection, oracles.three_rpr(), {"y": Fraction(1)},
-                            kinds=("serial singularity", LIMIT))
+def test_3rpr_plane_in_the_chart_counts_and_a_turning_path_match_the_oracle(tmp_path):
+    # the plane y = 1 in (x, tan(phi/2)), ξ included; the path moves and turns in it
+    text = "name: p\nparameter: t\nrange: [0, 1]\npose: {x: 5/2 + t/2, y: 1, phi: t}\n"
+    robot, w = _check("3-rpr", text, tmp_path)
+    assert w.one_region
+    assert w.region.endswith("of the workspace plane y = 1 (in the chart tan(phi/2): cut "
+                             "along phi = π)")
+    fixed = {"y": Fraction(1)}
+    analysis = _check_cells(robot.projection, oracles.three_rpr(), fixed)
     assert analysis.axes == ("x", "tan(phi/2)")
     assert {c.count for c in analysis.cells} == {0, 1}
+    assert [c for c in analysis.components if c.kind == PARALLEL]
+    chart = Chart.of(("x", "y", "phi"), frozenset({"phi"}))
+    assert _path_in_region(analysis, chart, w.region, oracles.three_rpr(),
+                           lambda t: [mp.mpf(5) / 2 + t / 2, mp.mpf(1), t], 0, 1) == 1
 
 
 def test_3rpr_turning_path_is_named_in_the_chart(tmp_path):
@@ -207,11 +210,9 @@ def test_3rpr_turning_path_is_named_in_the_chart(tmp_path):
     fixed = {"x": Fraction(2), "y": Fraction(1)}
     analysis = _check_cells(robot.projection, oracles.three_rpr(), fixed)
     chart = Chart.of(("x", "y", "phi"), frozenset({"phi"}))
-    oracle = oracles.three_rpr()
-    for count, X in _region_of_path(analysis, chart, fixed, w.region,
-                                    lambda t: [mp.mpf(2), mp.mpf(1), mp.pi / 2 + t / 2],
-                                    0, 1):
-        assert count == _oracle_count(oracle, X) == 1
+    assert _path_in_region(analysis, chart, w.region, oracles.three_rpr(),
+                           lambda t: [mp.mpf(2), mp.mpf(1), mp.pi / 2 + t / 2],
+                           0, 1) == 1
 
 
 def test_five_bar_workspace_counts_match_the_oracle_and_the_free_path_is_named(tmp_path):

@@ -704,3 +704,26 @@ def test_the_workspace_line_says_the_path_lies_on_the_surface(lower, surfaces, c
     assert line.startswith("workspace: the path lies on ") and "for t ∈ [0, 1]" in line
     if count is not None:
         assert line.endswith(f"({count} IK solution(s) inside the joint limits all along)")
+
+
+def test_a_touch_without_an_exact_time_stays_unknown_with_the_reason():
+    # the Dottie-number tangency of above, its root stripped of its exact description
+    # (as for a path whose angle is not k·t + qπ): no ball proof exists for the four
+    # touching modes, so they stay unknown, and say why and where
+    from dataclasses import replace
+
+    from singcheck.certify.classification import classify_candidate
+    from singcheck.certify.working_modes import working_modes
+
+    report, tau, det_a = _orthoglide_scale_touch("-1", "1/2", "1", "t - cos(t)",
+                                                 lambda t: t - mpmath.cos(t))
+    [candidate] = report.candidates
+    bare = replace(candidate.root, exact=None)
+    again = classify_candidate(report.path, working_modes(report.path, 1e-9), bare, 1e-9)
+    unknown = {m.mode: m.proof for m in again.modes if m.status == "unknown"}
+    assert set(unknown) == modes_singular_on_sphere(X0)
+    for label in unknown:  # they are singular indeed (50 digits): unknown, not wrong
+        assert abs(det_a(tau, label)) < mpmath.mpf("1e-40")
+    assert all("no exact description" in why and f"t ≈ {float(tau):.9g}"[:12] in why
+               for why in unknown.values())
+    assert again.status == "unknown"

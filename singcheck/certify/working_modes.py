@@ -180,6 +180,7 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when)
         return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {when(t)} " \
             "(serial singularity: the path reaches the workspace boundary)", t
     for box in iso.undecided:
+        checkpoint()
         if not evaluate_path(leg.discriminant, box.t) > 0:
             return UNKNOWN, f"could not prove that the branches of {joint} stay apart: " \
                 f"{box.reason}", box.t
@@ -231,11 +232,13 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
     for box in undecided:
+        checkpoint()
         if leg.inside(leg.branches(box.t)[label], limits) is not True:
             return BranchFeasibility(joint, label, UNKNOWN,
                                      f"limit crossing of {joint} not decided: {box.reason}")
     events += [box.t for box in undecided]
     for point in gap_points(interval, events):
+        checkpoint()
         verdict = None
         for prec in _PRECISIONS:
             with working_precision(prec):
@@ -321,7 +324,8 @@ def working_modes(path: PathModel, tolerance: float = 1e-9) -> list[WorkingMode]
     starts = _start_values(path)
     joints = [leg.leg.joint for leg in path.legs]
     modes = []
-    for choice in product(*per_leg):
+    for choice in product(*per_leg):  # 2^legs
+        checkpoint()
         label = "".join(b.label for b in choice)
         statuses = {b.status for b in choice}
         if INFEASIBLE in statuses:

@@ -19,10 +19,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from flint import fmpq, fmpq_poly
+from flint import acb, fmpq, fmpq_poly
 
+from singcheck.algebra.intervals import fraction_ball, working_precision
 from singcheck.algebra.polynomials import constant_value
-from singcheck.model.robot import RobotModel, leg_coefficients
+from singcheck.certify.path import branches_at_pose, inside_limits
+from singcheck.model.robot import REVOLUTE, RobotModel, leg_coefficients
 from singcheck.roots.rational import to_fmpq
 from singcheck.spaces.cad import separated_roots
 
@@ -103,29 +105,20 @@ def _placement_by_balls(model: RobotModel, point, use_limits: bool):
     A revolute leg's entry is (0, inside, outside).  Raises ArithmeticError when even
     4096 bits decide nothing (a point on a surface).
     """
-    from singcheck.algebra.intervals import fraction_ball, working_precision
-    from singcheck.certify.path import branches_at_pose, inside_limits
-    from singcheck.model.robot import REVOLUTE
-
     limits = model.spec.joint_limits if use_limits else {}
     for prec in _PRECISIONS:
         with working_precision(prec):
             pose = [fraction_ball(q) for q in point]
             out = [_leg_placement(leg, branches_at_pose(model, leg, pose),
-                                  limits.get(leg.joint), inside_limits, leg.kind == REVOLUTE)
-                   for leg in model.legs]
+                                  limits.get(leg.joint)) for leg in model.legs]
         if None not in out:
             return tuple(out)
     raise ArithmeticError(f"the inverse kinematics at {list(point)} is not decided at "
                           f"{_PRECISIONS[-1]} bits (a point on a surface of the variety)")
 
 
-def _leg_placement(leg, branches: dict, limits, inside_limits, revolute: bool):
+def _leg_placement(leg, branches: dict, limits):
     """(below, inside, above) of one leg's real branches, or None if not decided."""
-    from flint import acb
-
-    from singcheck.algebra.intervals import fraction_ball
-
     below = inside = above = 0
     for value in branches.values():
         if value is None:
@@ -134,7 +127,7 @@ def _leg_placement(leg, branches: dict, limits, inside_limits, revolute: bool):
             continue  # a complex branch
         if limits is None:
             inside += 1
-        elif revolute:
+        elif leg.kind == REVOLUTE:
             where = inside_limits(leg, value, limits)
             if where is None:
                 return None

@@ -738,3 +738,29 @@ def test_a_touch_without_an_exact_time_stays_unknown_with_the_reason():
     assert all("no exact description" in why and f"t ≈ {float(tau):.9g}"[:12] in why
                for why in unknown.values())
     assert again.status == "unknown"
+
+
+def test_five_bar_elbows_sitting_on_their_limits_all_along_are_feasible_and_singular():
+    # P = (0, √3) + 2(cos t, sin t): one branch of each leg keeps its elbow at (0, √3),
+    # i.e. th1 = π/3 and th2 = 2π/3, exactly the (closed) limits, all along; there the
+    # distal links coincide: det A ≡ 0 in that mode
+    from tests.robot_oracles import five_bar
+
+    text = trajectory("1/4", "1", x="2*cos(t)", y="sqrt(3) + 2*sin(t)")
+
+    def pose_at(t):
+        return [2 * mpmath.cos(t), mpmath.sqrt(3) + 2 * mpmath.sin(t)]
+
+    samples = [Fraction(1, 4) + Fraction(3, 4) * Fraction(k, 8) for k in range(1, 8)]
+    path, zero = _five_bar_pose_zero_modes(pose_at, text, samples=samples)
+    [label] = zero
+    oracle = five_bar()
+    modes = _oracle_modes(path, oracle, pose_at, samples[0])
+    for q in samples:
+        th1, th2 = oracle.joints(modes[label], pose_at(mpmath.mpf(q.numerator) / q.denominator))
+        assert abs(th1 - mpmath.pi / 3) < 1e-40 and abs(th2 - 2 * mpmath.pi / 3) < 1e-40
+    report = certify_path(path)
+    assert label in [m.label for m in report.modes if m.feasible]
+    assert all(m.status != "unknown" for m in report.modes)
+    assert report.verdict == "singular" and "whole path" in report.reason
+    assert {m for c in report.candidates for m in c.singular_modes} == zero

@@ -200,9 +200,7 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
             certificate = certify_trajectory(robot.projection, trajectory, tolerance)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions or not robot.model.polynomial:
-            # the workspace decomposition (CAD) needs rational polynomials in the pose:
-            # robots with angles or square roots get the certificate without it
+        if not regions:
             return Report(trajectory, certificate)
         from singcheck.spaces.path_regions import path_in_workspace, pieces_in_workspace
 
@@ -349,7 +347,7 @@ def shared_regions(robot: Robot, head: list, options: dict, notify: Notify = _qu
     share, computed once (:func:`prepare_regions`); ``options["regions"]`` is turned off
     when that ran out of time."""
     specs = [t for t in head if isinstance(t, TrajectorySpec)]
-    if options["regions"] and robot.model.polynomial and specs and not prepare_regions(
+    if options["regions"] and specs and not prepare_regions(
             robot, specs, options["time_limit"], notify):
         options["regions"] = False
 

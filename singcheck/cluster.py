@@ -5,10 +5,10 @@ The robot's projection is computed once, here, and shipped to every worker
 calls the public API for each (:func:`singcheck.api.check_item`, i.e.
 :func:`singcheck.check` with the batch's failure handling; a document read but not
 parsed is parsed on the worker); results come back as the tasks finish, a bounded
-number of tasks in flight.  The transport, the
-scheduling and the worker processes are dask.distributed's (``pip install
-'singcheck[dask]'``): singcheck adds no protocol of its own.  python-flint's polynomials
-cross the wire through :mod:`singcheck.algebra.pickling`.
+number of tasks in flight.  The transport, the scheduling and the worker processes are
+dask.distributed's (``pip install 'singcheck[dask]'``): singcheck adds no protocol of
+its own.  python-flint's polynomials cross the wire through
+:mod:`singcheck.algebra.pickling`.
 """
 
 from __future__ import annotations

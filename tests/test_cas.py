@@ -236,3 +236,27 @@ def test_live_singular_over_its_memory_bound_is_a_backend_error(monkeypatch):
                                            "200 MiB"):
         backend.eliminate(XI)
     assert time.monotonic() - start < 60
+
+
+def test_programs_run_from_two_threads_do_not_kill_each_other():
+    """A call reaps its own strays only: another thread's program, started after it and
+    still running when it ends, is not one of them."""
+    import sys
+    import threading
+
+    results = {}
+
+    def run(name: str, seconds: float) -> None:
+        results[name] = run_program([sys.executable, "-c",
+                                     f"import time; time.sleep({seconds}); print('{name}')"],
+                                    timeout=120)
+
+    first = threading.Thread(target=run, args=("first", 1.0))
+    second = threading.Thread(target=run, args=("second", 3.0))
+    first.start()
+    time.sleep(0.3)
+    second.start()
+    first.join()
+    second.join()
+    assert [(results[k].returncode, results[k].stdout.strip()) for k in ("first", "second")] \
+        == [(0, "first"), (0, "second")]

@@ -122,6 +122,19 @@ def test_planar_robot_crossing_and_free():
     assert all(c["status"] == "spurious" for c in t["candidates"])
 
 
+def test_run_names_the_real_dimension_of_the_workspace_it_decomposes(tmp_path):
+    """A path of the biglide (pose x, y) moving in x and y lies in its 2-D workspace, one
+    with y fixed in a line of it: the progress line says so (it said "in 3-D")."""
+    for name, pose, where in (("plane", "{x: t/10, y: 1 + t/10}", "in 2-D"),
+                              ("line", "{x: t/10, y: 1}", "y = 1; 1-D")):
+        path = tmp_path / f"{name}.yaml"
+        path.write_text(f"name: {name}\nparameter: t\nrange: [0, 1]\npose: {pose}\n")
+        out = singcheck("run", str(ROBOTS / "biglide.yaml"), str(path), "--backend", "flint",
+                        env={"SINGCHECK_CACHE_DIR": str(tmp_path / name)})
+        assert out.returncode == 0, out.stderr
+        assert f"decomposing the workspace ({where}) into regions" in out.stderr
+
+
 BAD_CLI = [
     (["run", ORTHO, "missing.yaml"], "missing.yaml: cannot read the file"),
     (["run", "nowhere.yaml", "x.yaml"], "nowhere.yaml: cannot read the file"),

@@ -79,3 +79,41 @@ def test_project_command_prints_the_formulas():
     assert doc["joint_space_singularities"].startswith("rho1^4*rho2^2")
     bad = singcheck("project", ORTHO, "missing.yaml")
     assert bad.returncode == 2 and "cannot read the file" in bad.stderr
+
+
+def test_project_text_and_json_give_the_same_factors_of_xi():
+    """The 5-bar (flint): text and JSON list the same irreducible factors of ξ as
+    computed, with the same used/dropped marks; the dropped ones are the degenerate set
+    W = 0 of the legs, (x ± d)² + y² (W = 4·l1²·|P - A_i|², from the constraints), and
+    the product of the used ones is the ξ both print (SymPy, up to a constant)."""
+    import json
+    import re
+
+    import sympy
+
+    from tests.conftest import ROBOTS
+
+    robot = str(ROBOTS / "five-bar.yaml")
+    text = singcheck("project", robot, "--backend", "flint", "--no-epsilon")
+    js = singcheck("project", robot, "--backend", "flint", "--no-epsilon", "--format", "json")
+    assert text.returncode == 0 and js.returncode == 0, text.stderr + js.stderr
+    doc = json.loads(js.stdout)
+    x, y = sympy.symbols("x y")
+
+    def poly(s: str) -> sympy.Poly:
+        return sympy.Poly(sympy.sympify(s.replace("^", "**"), locals={"x": x, "y": y}), x, y)
+
+    listed = [(int(m.group(1)), m.group(2) is None, m.group(3)) for m in re.finditer(
+        r"^xi factor (\d+) \(degree \d+(, dropped)?\) = (.*)$", text.stdout, re.M)]
+    factors = doc["singularity_surface_factors"]
+    assert [(i, used, poly(f)) for i, used, f in listed] == \
+        [(i, g["used"], poly(g["factor"])) for i, g in enumerate(factors, 1)]
+    dropped = {poly(g["factor"]).monic() for g in factors if not g["used"]}
+    assert dropped == {poly("(x + 1)^2 + y^2").monic(), poly("(x - 1)^2 + y^2").monic()}
+    product = sympy.prod(poly(g["factor"]) for g in factors if g["used"])
+    xi = poly(doc["singularity_surface"])
+    assert product.monic() == xi.monic()
+    (xi_line,) = [s for s in text.stdout.splitlines() if s.startswith("xi(X) = ")]
+    assert poly(xi_line[len("xi(X) = "):]) == xi
+    used = ", ".join(str(i) for i, u, _ in listed if u)
+    assert f"xi(X) is the squarefree product of factors {used} (degree 10)" in text.stdout

@@ -258,3 +258,38 @@ def test_the_gough_stewart_yaml_is_what_its_generator_writes():
     spec.loader.exec_module(module)
     assert (ROBOTS / "gough-stewart.yaml").read_text(encoding="utf-8") == module.document()
     assert module.BASE == oracles.GS_BASE and module.PLATFORM == oracles.GS_PLATFORM
+
+
+def test_paths_compose_xi_reduced_on_the_circles_and_it_is_the_same_function(robots):
+    """The 3-PRR's ξ (24,389 terms, unreduced in cos φ, sin φ) is composed along a path
+    modulo cos² φ + sin² φ = 1: far fewer terms, and exactly the same values at rational
+    poses on the circle (Pythagorean points), so μ is the same."""
+
+    robot = robots("3-prr")
+    xi, reduced = robot.projection.singularity_surface, robot.projection.surface_on_circles
+    assert 9 * len(reduced) < len(xi)
+    assert min(reduced.degrees()[2:]) <= 1  # degree ≤ 1 in cos φ or in sin φ
+    rng = random.Random(3)
+    for _ in range(8):
+        x, y = (Fraction(rng.randint(-30, 30), rng.randint(1, 7)) for _ in range(2))
+        point = {"x": x, "y": y, **_angle_point("phi", Fraction(rng.randint(-9, 9),
+                                                                rng.randint(1, 5)))}
+        assert _value(reduced, point) == _value(xi, point)
+
+
+def test_the_path_wise_norm_reduces_sin_t_squared_exactly():
+    """_on_circle (FLINT's remainder by s² + c² - 1 in a ring ordering s before c) gives
+    degree ≤ 1 in s and the same values on the circle as the input."""
+    from flint import fmpq_mpoly_ctx
+
+    from singcheck.certify.path import _on_circle
+
+    ctx = fmpq_mpoly_ctx.get(("r", "t", "s", "c"), "lex")
+    r, t, s, c = ctx.gens()
+    p = (3 * r * s**3 - t * s**2 * c + s * c**4 - 5) ** 3 + r**2 * s**5
+    q = _on_circle(p)
+    assert q.degrees()[2] <= 1
+    for m in (Fraction(1, 3), Fraction(-7, 2), Fraction(5)):
+        cm, sm = _circle_point(m)
+        point = {"r": Fraction(2, 7), "t": Fraction(-3, 4), "s": sm, "c": cm}
+        assert _value(q, point) == _value(p, point)

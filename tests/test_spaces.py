@@ -436,7 +436,7 @@ def test_a_plane_shared_by_several_paths_is_decomposed_once_up_front(orthoglide_
     path_regions._SUBSPACES.clear()
     path_regions.prepare_region_maps(orthoglide_projection, specs, notify=notes.append)
     # the hearts share z = 1; the helix is alone in 3-D and left to its own run
-    assert notes == ["decomposing the workspace (z = 1) into regions, once"]
+    assert notes == ["decomposing the workspace (z = 1; 2-D) into regions, once"]
     heart2 = path_regions.path_in_workspace(_path(orthoglide_projection, "heart2"),
                                             notify=notes.append)
     assert heart2.region.startswith("R") and len(notes) == 1  # reused, not recomputed

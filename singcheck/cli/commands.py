@@ -126,6 +126,8 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     """Certify each TRAJECTORY of ROBOT (YAML spec files; - reads standard input; a
     trajectory may also be a CSV table of poses).  A YAML file may hold several
     trajectories as documents separated by ---; their names must be unique in a run.
+    They are read one at a time as the batch goes, so memory stays flat: a bad one
+    among the first 100 stops the run at once, a later one is that trajectory's error.
 
     For every trajectory it prints the candidate singular times (certified
     enclosures of the roots of μ(t)), the pose and joints there, which working
@@ -500,7 +502,10 @@ def _slices_by_space(robot, spaces, slices) -> dict[str, list[str]]:
     if not spaces:
         return {}
     model = build_model(load_robot(robot))
-    axes = {"workspace": model.pose, "jointspace": model.joints}
+    from singcheck.spaces.chart import Chart
+
+    axes = {"workspace": Chart.of(model.pose, model.angles).axes,
+            "jointspace": Chart.of(model.joints, model.angles).axes}
     out: dict[str, list[str]] = {space: [] for space in dict.fromkeys(spaces)}
     for text in slices:
         axis, _ = parse_slice(text)

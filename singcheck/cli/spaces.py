@@ -106,7 +106,7 @@ def _compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, bac
     from singcheck.api import elimination_engine, hard_time_limit
     from singcheck.budget import remaining
     from singcheck.elimination.projection import project_robot
-    from singcheck.model.robot import build_model, require_polynomial
+    from singcheck.model.robot import build_model
     from singcheck.spaces.analysis import (
         LIMIT,
         WORKSPACE,
@@ -118,7 +118,6 @@ def _compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, bac
 
     fixed = _slices(slices)
     model = build_model(load_robot(robot))
-    require_polynomial(model, f"the {space} analysis")
     engine = elimination_engine(backend, timeout, not no_cache, progress.note)
     axes = model.pose if space == WORKSPACE else model.joints
     with progress.status(f"computing the discriminant variety of the {space}"):

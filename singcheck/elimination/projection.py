@@ -188,7 +188,12 @@ def joint_limit_surfaces(model: RobotModel, pose_ctx) -> tuple[JointLimitSurface
         if limits is None:
             continue
         for bound, value in zip(("min", "max"), limits, strict=True):
-            poly = norm_radicals(limit_constraint(model, leg, value))
+            try:
+                poly = norm_radicals(limit_constraint(model, leg, value))
+            except UnsupportedRobotError as e:
+                raise UnsupportedRobotError(
+                    e.message, path=model.spec.path, line=model.spec.lines.get("joint_limits"),
+                    key=f"joint_limits.{leg.joint}") from None
             out.append(JointLimitSurface(leg.joint, bound, value, restrict(poly, pose_ctx)))
     return tuple(out)
 

@@ -133,16 +133,6 @@ class RobotModel:
         return not self.spec.angles and not self.spec.radicals
 
 
-def require_polynomial(model: RobotModel, what: str) -> None:
-    """Refuse, in one line, a step that handles only robots without angles or square
-    roots (the CAD-based workspace analysis, the figures)."""
-    if not model.polynomial:
-        uses = "angles (sin/cos)" if model.angles else "square roots"
-        raise UnsupportedRobotError(
-            f"{what} is not supported yet for robots whose constraints use {uses}; "
-            "`singcheck run` and `singcheck project` are", path=model.spec.path)
-
-
 def jacobian(polys: tuple[fmpq_mpoly, ...], variables: tuple[str, ...],
              angles: frozenset[str] = frozenset()):
     """The matrix ``∂polys/∂variables`` (rows: polys, columns: variables); for an angle

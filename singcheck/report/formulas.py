@@ -138,16 +138,32 @@ def latex(p: fmpq_mpoly) -> str:
     return text[2:] if text.startswith("+ ") else "-" + text[2:]
 
 
+DROPPED = "in the degenerate set W = 0 of a revolute leg (the leg does not depend on its angle)"
+
+
+def surface_factors(projection) -> list[dict]:
+    """The irreducible factors of ξ as the backend computed it, each with its degree and
+    multiplicity, and whether ξ (what singcheck uses: their squarefree product without
+    the factors of the degenerate set) keeps it; text and JSON both show this list."""
+    if not projection.expanded:
+        return []
+    xi = projection.singularity_surface
+    out = []
+    for f, m in projection.singularity_surface_as_computed.factor()[1]:
+        used = divmod(xi, f)[1].is_zero()
+        out.append({"factor": f, "degree": int(f.total_degree()), "multiplicity": int(m),
+                    "used": used, "dropped_because": None if used else DROPPED})
+    return out
+
+
 def robot_formulas(projection, epsilon: fmpq_mpoly | None) -> dict:
     """Every robot-level formula as plain text, keyed for JSON and display."""
     model = projection.model
-    factors = [(f, int(m)) for f, m in projection.singularity_surface_as_computed.factor()[1]] \
-        if projection.expanded else []
     return {
         "det_A": model.det_A,
         "det_B": model.det_B,
         "singularity_surface": projection.singularity_surface,
-        "singularity_surface_factors": factors,
+        "singularity_surface_factors": surface_factors(projection),
         "joint_space_singularities": epsilon,
         "workspace_boundary": {leg.joint: d for leg, d in
                                zip(model.legs, projection.workspace_boundary, strict=True)},
@@ -172,8 +188,8 @@ def render(projection, epsilon, path: PathModel | None, style: str) -> str:
             "singularity_surface_degree": int(f["singularity_surface"].total_degree())
             if projection.expanded else None,
             "singularity_surface_not_expanded": projection.not_expanded or None,
-            "singularity_surface_factors": [{"factor": str(p), "multiplicity": m}
-                                            for p, m in f["singularity_surface_factors"]],
+            "singularity_surface_factors": [{**g, "factor": str(g["factor"])}
+                                            for g in f["singularity_surface_factors"]],
             "joint_space_singularities": None if epsilon is None else str(epsilon),
             "workspace_boundary": {k: str(v) for k, v in f["workspace_boundary"].items()},
             "joint_limit_surfaces": {k: str(v) for k, v in f["joint_limit_surfaces"].items()},
@@ -195,6 +211,12 @@ def render(projection, epsilon, path: PathModel | None, style: str) -> str:
     lines = [f"det A{eq}{show(f['det_A'])}", f"det B{eq}{show(f['det_B'])}",
              f"xi(X){eq}{show(f['singularity_surface'])}" if projection.expanded else
              f"xi(X) not expanded: {projection.not_expanded}"]
+    factors = f["singularity_surface_factors"]
+    irreducible = len(factors) == 1 and factors[0]["used"] and factors[0]["multiplicity"] == 1
+    for i, g in enumerate([] if irreducible else factors, 1):  # one factor: ξ itself
+        power = f", power {g['multiplicity']}" if g["multiplicity"] > 1 else ""
+        kept = "" if g["used"] else ", dropped"
+        lines.append(f"xi factor {i} (degree {g['degree']}{power}{kept}){eq}{show(g['factor'])}")
     if epsilon is not None:
         lines.append(f"epsilon(rho){eq}{show(epsilon)}")
     lines += [f"workspace boundary ({j}){eq}{show(d)}"
@@ -207,13 +229,23 @@ def render(projection, epsilon, path: PathModel | None, style: str) -> str:
         body = nl.join(line.replace(" &= ", " &= ", 1) if " &= " in line
                        else line.replace(" = ", " &= ", 1) for line in lines)
         return ("% s = sin t, c = cos t\n\\begin{align*}\n" + body + "\n\\end{align*}\n")
-    degrees = ", ".join(f"degree {int(p.total_degree())}" + (f" (power {m})" if m > 1 else "")
-                        for p, m in f["singularity_surface_factors"])
+    used = [str(i) for i, g in enumerate(factors, 1) if g["used"]]
+    dropped = [str(i) for i, g in enumerate(factors, 1) if not g["used"]]
     header = f"robot {model.name}: joints {', '.join(model.joints)}; pose {', '.join(model.pose)}\n"
-    if projection.expanded:
-        header += (f"ξ as computed by {projection.backend}: factors of {degrees}; singcheck "
-                   "uses their squarefree product (degree "
+    source = ("ξ = det A (free of the joints, no elimination)" if projection.backend == "none"
+              else f"ξ as computed by {projection.backend}")
+    if projection.expanded and irreducible:
+        header += (f"{source} is irreducible: xi(X) below, made monic (degree "
                    f"{int(f['singularity_surface'].total_degree())})\n")
+    elif projection.expanded:
+        header += (f"{source}: {len(factors)} irreducible "
+                   f"factor{'s' if len(factors) != 1 else ''} (below); xi(X) is the squarefree "
+                   f"product of factor{'s' if len(used) != 1 else ''} {', '.join(used)} "
+                   f"(degree {int(f['singularity_surface'].total_degree())})")
+        if dropped:
+            header += (f"; factor{'s' if len(dropped) != 1 else ''} {', '.join(dropped)} "
+                       f"{'are' if len(dropped) != 1 else 'is'} dropped: {DROPPED}")
+        header += "\n"
     else:
         header += f"ξ(X) was not expanded: {projection.not_expanded}\n"
     if path:

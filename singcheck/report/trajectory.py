@@ -126,6 +126,7 @@ def workspace_json(w) -> dict[str, Any]:
         "undecided": w.undecided,
         "on_surfaces": [{"surface": surface, "t_range": where}
                         for surface, where in w.on_surfaces],
+        **({"region_not_named": w.region_reason} if w.region_reason else {}),
     }
 
 
@@ -148,8 +149,11 @@ def workspace_line(w: dict[str, Any]) -> str:
                        + " → ".join("?" if c is None else str(c) for c in counts))
     if w["one_region"]:
         where = f"region {w['region']}" if w["region"] else "one region of the workspace"
-        return (f"workspace: the whole path lies in {where} "
+        text = (f"workspace: the whole path lies in {where} "
                 f"({counts[0]} IK solution(s) inside the joint limits all along)")
+        if w.get("region_not_named"):
+            text += f"; {w['region_not_named']}"
+        return text
     text = (f"workspace: the path crosses the discriminant variety {len(w['crossings'])} "
             f"time(s); IK solutions inside the limits along it: "
             + " → ".join("?" if c is None else str(c) for c in counts))

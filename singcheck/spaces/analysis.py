@@ -32,9 +32,10 @@ from singcheck.algebra.polynomials import restrict, squarefree_part
 from singcheck.budget import checkpoint
 from singcheck.elimination.projection import RobotProjection, joint_space_singularities
 from singcheck.elimination.requests import EliminationRequest
-from singcheck.errors import SingcheckError
+from singcheck.errors import SingcheckError, UnsupportedRobotError
 from singcheck.model.robot import RobotModel
 from singcheck.spaces.cad import Cell, OpenCAD, open_cad
+from singcheck.spaces.chart import Chart
 from singcheck.spaces.regions import Region, Regions, connect_regions, factor_signs
 from singcheck.spaces.solution_counts import direct_kinematics_count, ik_count, ik_root_placement
 
@@ -88,34 +89,96 @@ class SpaceAnalysis:
 # the discriminant varieties
 
 
+#: The most axes a decomposition takes: a 6-D pose (Gough–Stewart) is refused.
+MAX_AXES = 3
+
+
+def space_chart(model: RobotModel, space: str) -> Chart:
+    """The axes of the space: the pose or the joints, each angle v as tan(v/2)."""
+    names = model.pose if space == WORKSPACE else model.joints
+    if len(names) > MAX_AXES:
+        raise UnsupportedRobotError(
+            f"the {space} of {model.name} has {len(names)} axes ({', '.join(names)}): too "
+            f"many variables for a cylindrical decomposition (at most {MAX_AXES}); "
+            "`singcheck run` still certifies its paths", path=model.spec.path)
+    return Chart.of(names, model.angles)
+
+
 def workspace_variety(projection: RobotProjection,
                       parallel: bool = True) -> list[VarietyComponent]:
-    """Serial singularities, ξ (unless ``parallel`` is False) and joint limits in X."""
+    """Serial singularities, ξ (unless ``parallel`` is False) and joint limits in X (in
+    the chart: an angle φ of the pose as tan(φ/2), :mod:`singcheck.spaces.chart`)."""
     model = projection.model
+    chart = space_chart(model, WORKSPACE)
     out = []
     for leg, disc in zip(model.legs, projection.workspace_boundary, strict=True):
         if not disc.is_constant():
             out.append(VarietyComponent(SERIAL, f"leg {leg.joint}: its two branches meet",
-                                        disc))
+                                        chart.polynomial(disc)))
     if parallel and projection.expanded:  # a ξ too big to expand is left out
         out.append(VarietyComponent(PARALLEL, "ξ(X): some working mode is singular",
-                                    projection.singularity_surface))
+                                    chart.polynomial(projection.singularity_surface)))
     for s in projection.joint_limit_surfaces:
-        out.append(VarietyComponent(LIMIT, f"{s.joint} = {s.value} ({s.bound})", s.polynomial))
+        out.append(VarietyComponent(LIMIT, f"{s.joint} = {s.value} ({s.bound})",
+                                    chart.polynomial(s.polynomial)))
     return out
 
 
 def serial_singularities_request(model: RobotModel, leg) -> EliminationRequest:
-    """Eliminate the pose from ``{F, ∂f_leg/∂ρ_leg}``: where that leg is serially singular."""
+    """Eliminate the pose from ``{F, ∂f_leg/∂ρ_leg}``: where that leg is serially singular
+    (for an angle joint the derivative along its circle, B's entry)."""
+    derivative = model.B[leg.constraint_index][model.joints.index(leg.joint)]
     return EliminationRequest("joint_space_serial_singularities", model.context,
-                              (*model.constraints, leg.constraint.derivative(leg.joint)),
-                              model.pose)
+                              (*model.constraints, derivative), model.pose)
+
+
+def refuse_jointspace(model: RobotModel) -> None:
+    """The joint space's direct-kinematics counts are exact over Q, for a pose without
+    angles: refuse the others in one line."""
+    why = ("square roots among its numbers (a count over Q(√p) is not implemented)"
+           if model.spec.radicals else
+           "angles in its pose (direct kinematics on the circle is not implemented)"
+           if any(v in model.angles for v in model.pose) else "")
+    if why:
+        raise UnsupportedRobotError(
+            f"the joint space of {model.name} is not decomposed: {why}; `singcheck "
+            "workspace` and `singcheck run` are supported", path=model.spec.path)
+
+
+def _limit_plane(model: RobotModel, chart: Chart, joint: str, value) -> fmpq_mpoly | None:
+    """The limit ``joint = value`` in the chart: ρ - value, or for an angle joint
+    w·(1 + cos L) - sin L (w = tan(θ/2)), normed over its square roots; None at L = ±π
+    (the chart's cut: no bound in the chart)."""
+    from singcheck.algebra.radicals import norm_radicals, radical_name, surd_polynomial
+    from singcheck.elimination.projection import angle_limit_values
+
+    axis = chart.axes[chart.names.index(joint)]
+    if joint not in model.angles:
+        gen = dict(zip(chart.axes, chart.context.gens(), strict=True))[axis]
+        return gen - fmpq(value.numerator, value.denominator)
+    try:
+        cos_l, sin_l = angle_limit_values(joint, value)
+    except UnsupportedRobotError as e:
+        raise UnsupportedRobotError(e.message, path=model.spec.path,
+                                    line=model.spec.lines.get("joint_limits"),
+                                    key=f"joint_limits.{joint}") from None
+    if (1 + cos_l).is_rational() and (1 + cos_l).rational_value() == 0:
+        return None
+    roots = tuple(radical_name(p) for p in sorted(cos_l.primes() | sin_l.primes()))
+    ctx = fmpq_mpoly_ctx.get((axis, *roots), "lex")
+    w = ctx.gens()[0]
+    plane = norm_radicals(w * surd_polynomial(1 + cos_l, ctx) - surd_polynomial(sin_l, ctx))
+    return chart.polynomial(plane)
 
 
 def jointspace_variety(model: RobotModel, backend,
                        parallel: bool = True) -> list[VarietyComponent]:
-    """Serial singularities projected, ε (unless ``parallel`` is False), limit planes."""
-    ctx = fmpq_mpoly_ctx.get(model.joints, "lex")
+    """Serial singularities projected, ε (unless ``parallel`` is False), limit planes (in
+    the chart: an angle joint θ as tan(θ/2))."""
+    from singcheck.algebra.radicals import reduce_relations
+
+    refuse_jointspace(model)
+    chart = space_chart(model, JOINTSPACE)
     out = []
     for leg in model.legs:
         if leg.degree < 2:
@@ -126,16 +189,19 @@ def jointspace_variety(model: RobotModel, backend,
         for p in polys[1:]:
             g = g.gcd(p)
         if g is not None and not g.is_constant():
-            out.append(VarietyComponent(SERIAL, f"leg {leg.joint}: two branches meet",
-                                        squarefree_part(g)))
+            g = chart.polynomial(reduce_relations(g))
+            if not g.is_constant():
+                out.append(VarietyComponent(SERIAL, f"leg {leg.joint}: two branches meet",
+                                            squarefree_part(g)))
     if parallel:
-        eps = joint_space_singularities(model, backend)
-        out.append(VarietyComponent(PARALLEL, "ε(ρ): a parallel singularity", eps))
-    gens = dict(zip(model.joints, ctx.gens(), strict=True))
+        eps = chart.polynomial(reduce_relations(joint_space_singularities(model, backend)))
+        out.append(VarietyComponent(PARALLEL, "ε(ρ): a parallel singularity",
+                                    squarefree_part(eps)))
     for joint, (lo, hi) in model.spec.joint_limits.items():
         for bound, value in (("min", lo), ("max", hi)):
-            plane = gens[joint] - fmpq(value.numerator, value.denominator)
-            out.append(VarietyComponent(LIMIT, f"{joint} = {value} ({bound})", plane))
+            plane = _limit_plane(model, chart, joint, value)
+            if plane is not None:
+                out.append(VarietyComponent(LIMIT, f"{joint} = {value} ({bound})", plane))
     return out
 
 
@@ -202,9 +268,33 @@ def _point(axes: tuple[str, ...], free: tuple[str, ...], sample, fixed) -> list[
 
 
 def _within(model: RobotModel, joints) -> bool:
+    """The joint vector (the model's joint variables: cos θ, sin θ of an angle joint,
+    rational) is strictly inside the limits; an angle's side is decided by ball
+    arithmetic (:func:`~singcheck.certify.path.inside_limits`), which ends off the limit
+    planes (a cell's sample)."""
+    from singcheck.algebra.intervals import fraction_ball, working_precision
+    from singcheck.certify.path import inside_limits
+
     limits = model.spec.joint_limits
-    return all(lo < q < hi for j, q in zip(model.joints, joints, strict=True)
-               if j in limits for lo, hi in [limits[j]])
+    values = iter(joints)
+    for leg in model.legs:
+        if leg.joint not in model.angles:
+            q = next(values)
+            if leg.joint in limits and not limits[leg.joint][0] < q < limits[leg.joint][1]:
+                return False
+            continue
+        c, s = next(values), next(values)
+        if leg.joint not in limits:
+            continue
+        for prec in (64, 256, 1024):
+            with working_precision(prec):
+                inside = inside_limits(leg, (fraction_ball(c), fraction_ball(s)),
+                                       limits[leg.joint])
+            if inside is not None:
+                break
+        if not inside:
+            return False
+    return True
 
 
 def decomposition(axes: tuple[str, ...], components: list[VarietyComponent],
@@ -225,7 +315,8 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     be among ``components``): every real solution counts.
     """
     fixed = dict(fixed or {})
-    axes = model.pose if space == WORKSPACE else model.joints
+    chart = space_chart(model, space)
+    axes = chart.axes
     timings = {}
     start = time.perf_counter()
     free, sliced, cad = decomposition(axes, components, fixed)
@@ -235,7 +326,7 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     invariants = {}  # cell index -> what is constant on a component (for proofs)
     for cell in cad.cells:  # up to tens of thousands in 3-D
         checkpoint()
-        point = _point(axes, free, cell.sample, fixed)
+        point = chart.values(_point(axes, free, cell.sample, fixed))
         if space == WORKSPACE:
             placement = ik_root_placement(model, point, use_limits)
             cells.append(CellCount(cell, ik_count(placement), "", True))

@@ -34,13 +34,15 @@ from flint import acb, arb
 
 from singcheck.algebra.intervals import fraction_ball, working_precision
 from singcheck.algebra.polynomials import constant_value
+from singcheck.algebra.radicals import cos_pi, sin_pi
 from singcheck.algebra.trig import uses_t, uses_trig
 from singcheck.budget import checkpoint
-from singcheck.certify.path import PathModel
+from singcheck.certify.path import PathModel, compose_pose
 from singcheck.certify.working_modes import gap_points
 from singcheck.roots.enclosures import IdenticallyZeroError
 from singcheck.roots.isolation import isolate_real_roots
 from singcheck.roots.rational import to_fmpq, to_fraction
+from singcheck.spaces.chart import Chart, chart_axis
 
 _PRECISIONS = (53, 128, 384)
 
@@ -64,6 +66,7 @@ class PathInWorkspace:
     undecided: list[str] = field(default_factory=list)
     exit_time: arb | None = None
     region: str | None = None  # e.g. "R21 of the workspace plane z = 1"
+    region_reason: str = ""  # why a path in one region gets no name (when known)
     #: (surface, time range) where the path lies on a surface (its polynomial ≡ 0)
     on_surfaces: list[tuple[str, str]] = field(default_factory=list)
 
@@ -101,10 +104,14 @@ def _leg_count(leg, t: arb, bounds) -> int | None:
     for value in leg.branches(t).values():
         if value is None:
             return None
-        if isinstance(value, acb):
+        if isinstance(value, acb) or (isinstance(value, tuple) and isinstance(value[0], acb)):
             continue  # a complex branch
-        inside = True if bounds is None else _inside(
-            value, fraction_ball(bounds[0]), fraction_ball(bounds[1]))
+        if bounds is None:
+            inside = True
+        elif leg.revolute:
+            inside = leg.inside(value, bounds)
+        else:
+            inside = _inside(value, fraction_ball(bounds[0]), fraction_ball(bounds[1]))
         if inside is None:
             return None
         n += inside
@@ -126,7 +133,7 @@ XI = "parallel singularity ξ"
 
 
 def _crossings(path: PathModel, tolerance: float, mu_roots: list[arb] | None
-               ) -> tuple[list[Crossing], list[str], list[str]]:
+               ) -> tuple[list[Crossing], list[str], list[tuple[str, str]]]:
     interval = path.trajectory.range
     events: list[tuple[arb, str]] = []
     undecided, on = [], []
@@ -145,6 +152,7 @@ def _crossings(path: PathModel, tolerance: float, mu_roots: list[arb] | None
     events.sort(key=lambda e: float(e[0].mid()))
     merged: list[Crossing] = []
     for t, label in events:
+        checkpoint()
         if merged and merged[-1].t.overlaps(t):
             last = merged[-1]
             merged[-1] = Crossing(last.t.union(t), (*last.surfaces, label))
@@ -169,8 +177,30 @@ def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: boo
     result = PathInWorkspace(crossings, stretches, undecided, on_surfaces=on)
     result.exit_time = _exit_time(result)
     if name_region and result.one_region:
-        result.region = locate_region(path, region_cache, notify)
+        _name_region(result, path, region_cache, notify)
     return result
+
+
+def _name_region(result: PathInWorkspace, path: PathModel, cache, notify) -> None:
+    """Set the region of a path crossing none of its surfaces, or the reason it has none."""
+    reason = region_refusal(path)
+    if reason:
+        result.region_reason = reason
+        return
+    result.region = locate_region(path, cache, notify)
+
+
+def region_refusal(path: PathModel) -> str:
+    """Why a path crossing none of its own surfaces gets no region name ("" if none):
+    a pose of more axes than a decomposition takes, an angle reaching π (the chart's
+    cut), or a conjugate surface crossed."""
+    from singcheck.spaces.analysis import MAX_AXES
+
+    pose = path.projection.model.pose
+    if len(pose) > MAX_AXES:
+        return (f"the workspace has {len(pose)} axes ({', '.join(pose)}): too many variables "
+                f"for a cylindrical decomposition (at most {MAX_AXES}); no region named")
+    return outside_chart(path, path.trajectory.range) or conjugate_crossing(path)
 
 
 def _exit_time(w: PathInWorkspace) -> arb | None:
@@ -226,11 +256,14 @@ def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
     result = PathInWorkspace(crossings, stretches, undecided, on_surfaces=on)
     result.exit_time = _exit_time(result)
     if result.one_region:
-        pose = report.path.projection.model.pose
-        subspaces = {tuple(_subspace(pose, [p.pose[v] for v in pose])[0].items())
-                     for p in spec.pieces}
+        model = report.path.projection.model
+        subspaces = {tuple(_subspace(model, p)[0].items()) for p in spec.pieces}
         if len(subspaces) == 1:
-            result.region = locate_region(report.pieces[0].path, region_cache, notify)
+            reasons = [region_refusal(r.path) for r in report.pieces]
+            if any(reasons):
+                result.region_reason = next(r for r in reasons if r)
+            else:
+                result.region = locate_region(report.pieces[0].path, region_cache, notify)
     return result
 
 
@@ -238,10 +271,75 @@ def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
 # naming the region of a path that stays in one
 
 
-def _rational_time_points(path: PathModel):
-    """Exact times with a rational pose: t = 2·atan(u) for rational u (sin/cos only),
-    or rational t (polynomial paths); yields (t ball, {s, c, t} rationals)."""
-    polys = path.phi
+def outside_chart(path: PathModel, interval) -> str:
+    """Why the path leaves the half-angle chart of a pose angle φ (it reaches φ = π, where
+    the decomposition is cut, or may: 1 + cos φ(t) has a root or an undecided box on the
+    range), or "" when 1 + cos φ(t) is proven non-zero all along (and the chart's regions
+    can name the path's)."""
+    model = path.projection.model
+    index = _coordinate_index(model)
+    for v in model.pose:
+        if v not in model.angles:
+            continue
+        one_plus_cos = path.coordinates[index[v][0]] + 1
+        why = (f"the angle {v} reaches π (mod 2π) on the path, where the decomposition in "
+               f"tan({v}/2) is cut: no region named")
+        try:
+            iso = isolate_real_roots(one_plus_cos, interval, 1e-9)
+        except IdenticallyZeroError:
+            return why
+        if iso.roots:
+            return why.replace("on the path", f"at t ≈ {float(iso.roots[0].t.mid()):.6g}")
+        if iso.undecided:
+            return why.replace("reaches", "may reach")
+    return ""
+
+
+def conjugate_crossing(path: PathModel) -> str:
+    """For a robot with square roots (parameters, or an angle joint's limits such as
+    cos(3π/4) = -√2/2): the decomposition's surfaces are norms, the robot's and its
+    conjugates' (√p ↦ -√p) together.  A path crossing none of the robot's own surfaces may
+    still cross a conjugate one: then it is not in one region of the decomposition.
+    Returns why ("" when no normed serial or limit surface meets the path; ξ is normed
+    already, and its crossings are μ's)."""
+    projection = path.projection
+    model = projection.model
+    if model.polynomial:
+        return ""
+    surfaces = [(f"the serial singularity of leg {leg.joint}", p)
+                for leg, p in zip(model.legs, projection.workspace_boundary, strict=True)]
+    surfaces += [(f"the limit {s.joint} = {s.value}", s.polynomial)
+                 for s in projection.joint_limit_surfaces]
+    for label, p in surfaces:
+        if p.is_constant():
+            continue
+        checkpoint()
+        along = compose_pose(p, path.coordinates, model.pose_variables)
+        try:
+            iso = isolate_real_roots(along, path.trajectory.range, 1e-9)
+        except IdenticallyZeroError:
+            return f"the path lies on a conjugate of {label} (a square root's other sign)"
+        if iso.roots or iso.undecided:
+            return (f"the path meets a conjugate of {label} (a square root's other sign), "
+                    "which cuts the decomposition (it is normed over the square roots): "
+                    "no region named")
+    return ""
+
+
+def _coordinate_index(model) -> dict[str, tuple[int, ...]]:
+    """Each pose variable's place among the model's pose variables (cos, sin of an angle)."""
+    out, i = {}, 0
+    for v in model.pose:
+        n = 2 if v in model.angles else 1
+        out[v] = tuple(range(i, i + n))
+        i += n
+    return out
+
+
+def _rational_time_points(path: PathModel, polys):
+    """Exact times at which ``polys`` (the path's coordinates) are rational: t = 2·atan(u)
+    for rational u (sin/cos only), or rational t (polynomial paths); yields the
+    {s, c} or {t} rationals."""
     trig = any(uses_trig(p) for p in polys)
     if trig and any(uses_t(p) for p in polys):
         return
@@ -261,14 +359,36 @@ def _rational_time_points(path: PathModel):
             yield values
 
 
-def _subspace(pose: tuple[str, ...], phi) -> tuple[dict[str, Fraction], tuple[int, ...]]:
-    """The fixed pose coordinates (rational constants of φ) and the free axes' indices."""
+def _fixed_value(p, offset) -> Fraction | None:
+    """The chart coordinate of a pose coordinate that is constant along the path, when
+    rational: the constant itself, or tan(φ/2) = sin φ/(1 + cos φ) for an angle
+    (``offset`` its multiple of π; φ = 0, ±π/2 give 0, ±1); None otherwise."""
+    if not p.is_constant():
+        return None
+    value = to_fraction(constant_value(p))
+    if offset is None:
+        return value
+    if value != 0:
+        return None  # tan of a non-zero rational half-angle is transcendental
+    c, s = cos_pi(offset), sin_pi(offset)
+    if c is None or not c.is_rational() or not s.is_rational() or c.rational_value() == -1:
+        return None
+    return s.rational_value() / (1 + c.rational_value())
+
+
+def _subspace(model, spec) -> tuple[dict[str, Fraction], tuple[int, ...]]:
+    """The fixed axes of the chart (pose coordinates constant along the trajectory
+    ``spec``, with a rational chart value) and the free axes' indices."""
+    chart = Chart.of(model.pose, model.angles)
     fixed, free = {}, []
-    for i, (name, p) in enumerate(zip(pose, phi, strict=True)):
-        if p.is_constant():
-            fixed[name] = to_fraction(constant_value(p))
-        else:
+    offsets = spec.angle_offsets
+    for i, (name, axis) in enumerate(zip(model.pose, chart.axes, strict=True)):
+        offset = offsets.get(name, Fraction(0)) if name in chart.angles else None
+        value = _fixed_value(spec.pose[name], offset)
+        if value is None:
             free.append(i)
+        else:
+            fixed[axis] = value
     return fixed, tuple(free)
 
 
@@ -277,10 +397,14 @@ def prepare_region_maps(projection, specs, cache=None, notify=None) -> None:
     trajectories lie in (forked workers then inherit it instead of each computing it)."""
     from collections import Counter
 
-    pose = projection.model.pose
+    from singcheck.spaces.analysis import MAX_AXES
+
+    model = projection.model
+    if len(model.pose) > MAX_AXES:
+        return
     shared = Counter()
     for spec in specs:
-        fixed, free = _subspace(pose, [spec.pose[v] for v in pose])
+        fixed, free = _subspace(model, spec)
         shared[tuple(fixed.items()), len(free)] += 1
     for (fixed, free), n in shared.items():
         if n > 1 and free:
@@ -291,8 +415,12 @@ def locate_region(path: PathModel, cache=None, notify=None) -> str | None:
     """The name of the region holding the path, in the smallest space that holds it
     (a line, a plane or the whole workspace: φ's constant coordinates are fixed); None
     when no rational point of the path could be located in an open cell.  ``cache``: a
-    :class:`~singcheck.region_map.RegionMapCache`, or None to compute without storing."""
-    fixed, free = _subspace(path.projection.model.pose, path.phi)
+    :class:`~singcheck.region_map.RegionMapCache`, or None to compute without storing.
+
+    With angles in the pose the space is the chart tan(φ/2) (:mod:`singcheck.spaces.chart`):
+    the caller has proven that the path stays off φ = π (:func:`outside_chart`)."""
+    model = path.projection.model
+    fixed, free = _subspace(model, path.trajectory)
     if not free:
         return None
     regions, left_out = _region_map(path.projection, fixed, len(free), cache, notify)
@@ -301,37 +429,69 @@ def locate_region(path: PathModel, cache=None, notify=None) -> str | None:
     space = f"the workspace {kind}{where}".replace("  ", " ").rstrip()
     if left_out:
         space += " cut by its serial-singularity and joint-limit surfaces only"
-    points = (point for values in _rational_time_points(path)
-              for point in [[_exact(path.phi[i], values) for i in free]])
-    for point in (*points, *_rational_points_near(path, free, regions.factors)):
+    angles = [v for v in model.pose if v in model.angles]
+    if angles:
+        space += (" (in the chart " + ", ".join(chart_axis(v) for v in angles) + ": cut along "
+                  + ", ".join(f"{v} = π" for v in angles) + ")")
+    index = _coordinate_index(model)
+    needed = [path.coordinates[k] for i in free for k in index[model.pose[i]]]
+    points = (point for values in _rational_time_points(path, needed)
+              for point in [_chart_point(path, free, index, values)] if point is not None)
+    for point in (*points, *_rational_points_near(path, free, index, regions.factors)):
         number = regions.region_at(point)
         if number is not None:
             return f"R{number} of {space}"
     return None
 
 
-def _rational_points_near(path: PathModel, free: tuple[int, ...], factors):
+def _chart_point(path: PathModel, free, index, values) -> list[Fraction] | None:
+    """The free chart coordinates of the path at exact time values, when rational."""
+    model = path.projection.model
+    out = []
+    for i in free:
+        coords = [_exact(path.coordinates[k], values) for k in index[model.pose[i]]]
+        if None in coords:
+            return None
+        if len(coords) == 2:  # an angle: tan(φ/2) = sin φ / (1 + cos φ)
+            c, s = coords
+            if c == -1:
+                return None
+            coords = [s / (1 + c)]
+        out += coords
+    return out
+
+
+def _rational_points_near(path: PathModel, free: tuple[int, ...], index, factors):
     """Rational points in the same component as a point of the path, for paths whose
     rational times give irrational poses (t mixed with sin t, cos t).
 
-    At a rational time t₀ the pose is enclosed in a box of balls; when every factor of
-    the decomposition excludes 0 on the whole box (ball arithmetic), the box is a
-    connected set avoiding the variety, so its rational centre lies in the path's
-    component.
+    At a rational time t₀ the pose is enclosed in a box of balls (an angle's chart
+    coordinate as sin φ/(1 + cos φ)); when every factor of the decomposition excludes 0 on
+    the whole box (ball arithmetic), the box is a connected set avoiding the variety, so
+    its rational centre lies in the path's component.
     """
     from singcheck.algebra.intervals import evaluate
     from singcheck.roots.rational import arb_to_fmpq
 
+    model = path.projection.model
     rng = path.trajectory.range
     lo, hi = rng.start.ball(), rng.end.ball()
     for k in range(1, 8):
         t = lo + (hi - lo) * k / 8
         with working_precision(128):
             t0 = t.mid()
-            pose = path.pose_at(t0)
-            box = [pose[i] for i in free]
-            if all(evaluate(f, box).contains(0) is False for f in factors):
-                yield [to_fraction(arb_to_fmpq(b.mid())) for b in box]
+            coordinates = path.pose_variables_at(t0)
+            box = []
+            for i in free:
+                balls = [coordinates[j] for j in index[model.pose[i]]]
+                if len(balls) == 2:
+                    if not balls[0] > -1:
+                        break
+                    balls = [balls[1] / (1 + balls[0])]
+                box += balls
+            else:
+                if all(evaluate(f, box).contains(0) is False for f in factors):
+                    yield [to_fraction(arb_to_fmpq(b.mid())) for b in box]
 
 
 _SUBSPACES: dict = {}
@@ -347,6 +507,7 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
         analyse,
         decomposition,
         select_surfaces,
+        space_chart,
         workspace_variety,
     )
     from singcheck.spaces.region_map import RegionMap
@@ -355,10 +516,13 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
     if memo_key not in _SUBSPACES:
         components, left_out = select_surfaces(workspace_variety(projection), WORKSPACE,
                                                "auto", free_axes)
+        if not projection.expanded:
+            left_out = [*left_out, "ξ(X) (not expanded)"]
         key = cache.key([c.polynomial for c in components], fixed) if cache else None
         regions = cache.load(key) if cache else None
         if regions is not None:  # checked against the inputs, not only by its HMAC
-            _, _, cad = decomposition(projection.model.pose, components, fixed)
+            axes = space_chart(projection.model, WORKSPACE).axes
+            _, _, cad = decomposition(axes, components, fixed)
             problem = regions.verify(cad)
             if problem:
                 if notify:
@@ -367,7 +531,8 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
                 regions = None
         if regions is None:
             if notify:
-                where = ", ".join(f"{k} = {v}" for k, v in fixed.items()) or "in 3-D"
+                where = ", ".join(f"{k} = {v}" for k, v in fixed.items())
+                where = f"{where}; {free_axes}-D" if where else f"in {free_axes}-D"
                 notify(f"decomposing the workspace ({where}) into regions, once"
                        + (" (then kept in the cache)" if cache else ""))
             regions = RegionMap.of(analyse(WORKSPACE, projection.model, components, fixed))
@@ -377,6 +542,8 @@ def _region_map(projection, fixed: dict[str, Fraction], free_axes: int, cache,
     return _SUBSPACES[memo_key][1:]
 
 
-def _exact(p, values: dict[str, Fraction]) -> Fraction:
+def _exact(p, values: dict[str, Fraction]) -> Fraction | None:
+    """``p`` at exact values of t or s, c; None when it is not rational there (square
+    roots or angle functions left)."""
     q = p.subs({k: to_fmpq(v) for k, v in values.items()})
-    return to_fraction(constant_value(q))
+    return to_fraction(constant_value(q)) if q.is_constant() else None

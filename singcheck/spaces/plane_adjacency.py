@@ -39,6 +39,13 @@ from singcheck.spaces.segments import segment_is_free
 
 WALL = "wall"  # the line x = α lies in the variety
 
+#: Critical values α of higher degree are not studied exactly: Euclid in Q(α)[y] grows
+#: too fast (a 3-RPR plane in the chart tan(φ/2) has α of degree 10 and did not finish
+#: in minutes; the Orthoglide's planes and the 5-bar's workspace reach 8 and 6).  Their
+#: cells are joined by free segments instead, and the regions are then not proven to be
+#: the components.
+MAX_EXACT_DEGREE = 8
+
 
 class NotDecided(ArithmeticError):
     """The fibre could not be certified at the precisions tried."""
@@ -212,6 +219,8 @@ def exact_joins(cad, base, i: int, brackets, memo: dict | None = None
     """
 
     try:
+        if minimal_polynomial(base[i]).degree() > MAX_EXACT_DEGREE:
+            return None
         points = fibre_points(cad.factors, base[i], memo)
     except NotDecided:
         return None

@@ -13,8 +13,8 @@ of the variety's polynomials, the slice and :data:`REGIONS_VERSION`, and carries
 of its payload under the cache's secret key (:mod:`singcheck.elimination.cache`): a
 damaged entry, or one forged by anyone who cannot read that key, is ignored and
 recomputed.  A loaded map is also checked against its inputs (:meth:`RegionMap.verify`,
-against the open CAD recomputed from the variety: about 2 % of the cost of joining the
-regions), so that even an entry sealed with the right key cannot relabel, renumber or
+against the open CAD recomputed from the variety: 2–6 % of the cost of computing the
+map), so that even an entry sealed with the right key cannot relabel, renumber or
 re-sign regions; a map that fails is recomputed.
 """
 

@@ -19,10 +19,12 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from flint import fmpq, fmpq_poly
+from flint import acb, fmpq, fmpq_poly
 
+from singcheck.algebra.intervals import fraction_ball, working_precision
 from singcheck.algebra.polynomials import constant_value
-from singcheck.model.robot import RobotModel, leg_coefficients
+from singcheck.certify.path import branches_at_pose, inside_limits
+from singcheck.model.robot import REVOLUTE, RobotModel, leg_coefficients
 from singcheck.roots.rational import to_fmpq
 from singcheck.spaces.cad import separated_roots
 
@@ -71,6 +73,8 @@ def ik_root_placement(model: RobotModel, pose_point,
     only where the discriminant vanishes and pass a limit only where the leg polynomial
     vanishes at it.  It refines the IK count (the product of the 'inside' entries).
     """
+    if not model.polynomial:
+        return _placement_by_balls(model, pose_point, use_limits)
     limits = model.spec.joint_limits if use_limits else {}
     out = []
     for leg in model.legs:
@@ -85,6 +89,63 @@ def ik_root_placement(model: RobotModel, pose_point,
     return tuple(out)
 
 
+_PRECISIONS = (64, 256, 1024, 4096)
+
+
+def _placement_by_balls(model: RobotModel, point, use_limits: bool):
+    """:func:`ik_root_placement` for a robot with square roots or angles, at a rational
+    point of its pose variables (cos φ, sin φ of an angle: rational in the chart).
+
+    Each branch is enclosed by ball arithmetic (√p exact to the working precision),
+    raising the precision until every decision is proven: a branch real or complex (the
+    sign of the discriminant), below, inside or above a prismatic joint's range, inside
+    or outside an angle joint's (:func:`~singcheck.certify.path.inside_limits`).  Off the
+    discriminant variety (a cell's sample) none of those quantities is zero — the
+    variety holds their norms over the square roots — so a precision decides them all.
+    A revolute leg's entry is (0, inside, outside).  Raises ArithmeticError when even
+    4096 bits decide nothing (a point on a surface).
+    """
+    limits = model.spec.joint_limits if use_limits else {}
+    for prec in _PRECISIONS:
+        with working_precision(prec):
+            pose = [fraction_ball(q) for q in point]
+            out = [_leg_placement(leg, branches_at_pose(model, leg, pose),
+                                  limits.get(leg.joint)) for leg in model.legs]
+        if None not in out:
+            return tuple(out)
+    raise ArithmeticError(f"the inverse kinematics at {list(point)} is not decided at "
+                          f"{_PRECISIONS[-1]} bits (a point on a surface of the variety)")
+
+
+def _leg_placement(leg, branches: dict, limits):
+    """(below, inside, above) of one leg's real branches, or None if not decided."""
+    below = inside = above = 0
+    for value in branches.values():
+        if value is None:
+            return None
+        if isinstance(value, acb) or (isinstance(value, tuple) and isinstance(value[0], acb)):
+            continue  # a complex branch
+        if limits is None:
+            inside += 1
+        elif leg.kind == REVOLUTE:
+            where = inside_limits(leg, value, limits)
+            if where is None:
+                return None
+            inside += where
+            above += not where
+        else:
+            lo, hi = (fraction_ball(v) for v in limits)
+            if value < lo:
+                below += 1
+            elif value > hi:
+                above += 1
+            elif value > lo and value < hi:
+                inside += 1
+            else:
+                return None
+    return below, inside, above
+
+
 @dataclass(frozen=True)
 class DirectCount:
     count: int | None
@@ -96,7 +157,7 @@ def direct_kinematics_count(model: RobotModel, joint_point) -> DirectCount:
     import sympy
 
     pose = sympy.symbols(model.pose)
-    values = {j: to_fmpq(q) for j, q in zip(model.joints, joint_point, strict=True)}
+    values = {j: to_fmpq(q) for j, q in zip(model.joint_variables, joint_point, strict=True)}
     system = [_to_sympy(f.subs(values), pose, model) for f in model.constraints]
     last = pose[-1]
     for change in _COORDINATE_CHANGES:

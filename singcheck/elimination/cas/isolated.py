@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 import time
 
 from singcheck.budget import TimeLimitExceeded
@@ -53,6 +54,9 @@ def _child(fn, argument, write: int, err: int, parent: int, limit: int) -> None:
         die_with_parent(parent)
         signal.setitimer(signal.ITIMER_REAL, 0)  # the parent's alarm is the parent's
         os.dup2(err, 2)  # what GMP or FLINT print before aborting: for the parent
+        # fresh streams: a thread of the parent (a progress display) may have held the
+        # old ones' locks at the fork, and it does not exist here to release them
+        sys.stdout = sys.stderr = open(2, "w", closefd=False)
         import faulthandler
 
         faulthandler.disable()  # an abort here is the parent's to report, in one line
@@ -143,6 +147,9 @@ def _outcome(message: bytes, status: int, said: str, limit: int, what: str):
     if kind == "raise":
         raise value
     if kind == "memory" or os.WIFEXITED(status) and os.WEXITSTATUS(status) == 3:
+        if not limit:
+            raise BackendError(f"{what} ran out of memory (no bound was set: "
+                               "SINGCHECK_MEMORY_LIMIT=none)")
         raise BackendError(f"{what} ran out of memory under {bound}; raise "
                            "SINGCHECK_MEMORY_LIMIT (or set it to none) if the robot needs more")
     how = (f"died of {signal.Signals(os.WTERMSIG(status)).name}" if os.WIFSIGNALED(status)

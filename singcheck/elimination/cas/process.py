@@ -77,6 +77,9 @@ class ProgramRun:
 
 
 _SUBREAPER: list[bool] = []
+#: the programs (their guards) running now, from any thread: not another call's strays
+_RUNNING: set[int] = set()
+_STARTING = threading.Lock()  # held while a program starts and while strays are reaped
 
 
 def _become_subreaper() -> bool:
@@ -94,18 +97,20 @@ def _reap_strays(known: set[int]) -> None:
 
     def keep(pid: int) -> bool:
         try:
-            return pid in known or os.getpgid(pid) == own_group
+            return pid in known or pid in _RUNNING or os.getpgid(pid) == own_group
         except OSError:
             return True  # gone already
 
-    reap_children(keep)
+    with _STARTING:
+        reap_children(keep)
 
 
 def _guarded(argv: list[str] | tuple[str, ...], limit: int) -> list[str]:
     """``argv`` started through :mod:`~singcheck.elimination.cas.guard` (a fresh
     interpreter that dies with this thread and takes the program's descendants with it);
-    ``argv`` itself where no interpreter path is known."""
-    if not sys.executable:
+    ``argv`` itself where there is no interpreter or script file to run (a frozen or
+    zipped install)."""
+    if not sys.executable or not os.path.isfile(SCRIPT):
         return list(argv)
     return [sys.executable, "-I", "-S", SCRIPT, str(os.getpid()), str(limit), "--",
             *argv]
@@ -162,8 +167,11 @@ def run_program(argv: list[str] | tuple[str, ...], timeout: float, *,
     with _terminate_as_interrupt(), tempfile.TemporaryFile() as out, \
             tempfile.TemporaryFile() as err:
         try:
-            proc = subprocess.Popen(_guarded(argv, limit), stdin=subprocess.DEVNULL, stdout=out,
-                                    stderr=err, cwd=cwd, env=env, start_new_session=True)
+            with _STARTING:
+                proc = subprocess.Popen(_guarded(argv, limit), stdin=subprocess.DEVNULL,
+                                        stdout=out, stderr=err, cwd=cwd, env=env,
+                                        start_new_session=True)
+                _RUNNING.add(proc.pid)
         except OSError as e:
             raise BackendError(f"could not start {argv[0]}: {e.strerror or e}") from None
         try:
@@ -178,6 +186,7 @@ def run_program(argv: list[str] | tuple[str, ...], timeout: float, *,
                 os.killpg(proc.pid, signal.SIGKILL)
             except (ProcessLookupError, PermissionError):
                 pass
+            _RUNNING.discard(proc.pid)
             if reaper:
                 _reap_strays(known)
         stderr = _read(err, MAX_OUTPUT_BYTES)

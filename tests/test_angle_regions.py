@@ -314,3 +314,11 @@ def test_a_chart_region_map_survives_the_cache(tmp_path):
     assert len(analysis.cells) == 3
     for c in analysis.cells:  # every cell's sample is located in its own region again
         assert back.region_at(list(c.cell.sample)) == c.region is not None
+
+
+def test_a_decomposition_too_costly_to_project_is_refused_up_front():
+    # the rotary Delta's 3-D workspace: normed surfaces of degree 8, projection bound 8⁴
+    result = singcheck("workspace", str(ROBOTS / "rotary-delta.yaml"), "--backend", "flint",
+                       "-q")
+    assert result.returncode == 2
+    assert "too costly" in result.stderr and len(result.stderr.strip().splitlines()) == 1

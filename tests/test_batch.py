@@ -636,7 +636,8 @@ def test_junit_validates_against_the_schema(tmp_path, monkeypatch):
     """A batch with every kind of result (singular, free, infeasible, unknown past its
     time limit, a bad document and a repeated name past the documents read up front)
     gives JUnit XML that the JUnit schema accepts, and that junitparser (the reader of the
-    GitHub test-report actions) reads back with the counts of the verdicts known here: 2 failures, 3 errors in 6 cases."""
+    GitHub test-report actions) reads back with the counts of the verdicts known here:
+    2 failures, 3 errors in 6 cases."""
     import sys
 
     import xmlschema

@@ -135,3 +135,62 @@ def test_space_commands_state_their_time_limit():
         option = text[text.index("--time-limit FLOAT"):text.index("--format [")]
         assert "past it the command ends with exit 3" in option
         assert option.endswith("[default: 300; x>0] ")
+
+
+# -- eliminating the joints along a path --------------------------------------------------
+
+ROTARY = ROBOTS / "rotary-delta.yaml"  # revolute legs and √3: ξ(X) is not expanded
+
+
+@pytest.fixture(scope="module")
+def rotary():
+    machine = api.load_robot(ROTARY, backend="flint", cache=False)
+    assert not machine.projection.expanded
+    return machine
+
+
+def test_a_hostile_path_wise_elimination_is_refused_up_front(rotary, tmp_path):
+    """High harmonics mixed with t: the bound on the norm chain's intermediates is over
+    its limit, so the path is refused at once (it ran 25 s to over 100 s before)."""
+    from singcheck.errors import SpecError
+
+    pose = {"x": "cos(6*t)/2", "y": "sin(5*t)/2", "z": "-2 + t/10"}
+    spec = api.load_trajectory(trajectory(tmp_path, pose), rotary)
+    start = time.monotonic()
+    with pytest.raises(SpecError) as refused:
+        api.check(rotary, spec, time_limit=60, regions=False)
+    assert time.monotonic() - start < 2
+    message = str(refused.value)
+    assert "too costly" in message and "eliminating the joints along the path" in message
+
+
+def test_a_costly_path_wise_elimination_stops_at_the_time_limit(rotary, tmp_path):
+    """cos 12t, sin 11t: within the bound, about a second of norms; a 0.2 s limit stops
+    it at a checkpoint inside the chain, not after it."""
+    pose = {"x": "cos(12*t)/2", "y": "sin(11*t)/2", "z": "-2"}
+    spec = api.load_trajectory(trajectory(tmp_path, pose), rotary)
+    start = time.monotonic()
+    report = api.check(rotary, spec, time_limit=0.2, regions=False)
+    elapsed = time.monotonic() - start
+    assert report.verdict == "unknown" and "time limit" in report.reason
+    assert elapsed < 1.5, elapsed
+
+
+@pytest.mark.parametrize("robot, pose", [
+    ("orthoglide", ("8/7*sin(t)^3", "13/14*cos(t) - 5/14*cos(2*t)", "1 + t/3")),
+    ("orthoglide", ("t^2 - sin(t)", "cos(3*t)", "t")),
+    ("skew-biglide", ("2*cos(t) + t/2", "sin(2*t)")),
+])
+def test_the_path_wise_size_bound_bounds_mu(robot, pose):
+    """The a-priori degrees hold for μ computed both ways: eliminated along the path,
+    and ξ(φ(t)) composed from the expanded ξ."""
+    from singcheck.algebra.trig import TRIG
+    from singcheck.certify.path import compose_pose, eliminate_along_path, pathwise_size_bound
+
+    machine = api.load_robot(ROBOTS / f"{robot}.yaml", backend="flint", cache=False)
+    phi = _coordinates(*pose)
+    deg_t, deg_sc, _ = pathwise_size_bound(machine.model, phi)
+    for mu in (eliminate_along_path(machine.model, phi),
+               compose_pose(machine.singularity_surface, phi, machine.model.pose)):
+        assert mu.context() is TRIG
+        assert mu.degrees()[0] <= deg_t and mu.degrees()[1] + mu.degrees()[2] <= deg_sc

@@ -6,7 +6,7 @@ past a 2 s time limit.  So the cost is estimated first, from the sizes alone (ex
 integer arithmetic on degrees, bit lengths and term counts, :func:`term_costs`):
 
 * above :data:`MAX_COMPOSE_WORK` the composition is refused before any work
-  (:class:`CompositionTooCostly`);
+  (:class:`TooCostly`);
 * up to :data:`PIECE_WORK` it is one FLINT call (the common case: heart 1, heart 2,
   the helix);
 * in between it is Horner's scheme in ``p``'s variables, each group of terms whose
@@ -42,13 +42,9 @@ PIECE_PAIRS = 2_000_000
 MAX_COMPOSE_WORK = 200_000_000_000
 
 
-class CompositionTooCostly(ValueError):
-    """A composition whose a-priori work exceeds :data:`MAX_COMPOSE_WORK`."""
-
-    def __init__(self, work: int, deg_t: int, deg_rest: int):
-        super().__init__(f"composing would cost {work:.3g} by its a-priori estimate "
-                         f"(at most {MAX_COMPOSE_WORK:.3g})")
-        self.work, self.deg_t, self.deg_rest = work, deg_t, deg_rest
+class TooCostly(ValueError):
+    """Work refused up front: its a-priori estimate is over a bound (the message says
+    both)."""
 
 
 def _bits(p: fmpq_mpoly) -> int:
@@ -152,11 +148,10 @@ def compose_in_pieces(p: fmpq_mpoly, args: list[fmpq_mpoly], ring: fmpq_mpoly_ct
     if work is None:
         if _small(p, args):
             return reduce(p.compose(*args, ctx=ring))
-        work, deg_t, deg_rest = composition_work(p, args)
-    else:
-        deg_t = deg_rest = -1
+        work = composition_work(p, args)[0]
     if work > MAX_COMPOSE_WORK:
-        raise CompositionTooCostly(work, deg_t, deg_rest)
+        raise TooCostly(f"composing would cost {work:.3g} by its a-priori estimate "
+                        f"(at most {MAX_COMPOSE_WORK:.3g})")
     if work <= PIECE_WORK:
         return reduce(p.compose(*args, ctx=ring))
     items = list(zip(p.monoms(), p.coeffs(), term_costs(p, args), strict=True))

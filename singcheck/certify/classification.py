@@ -221,10 +221,13 @@ def _decide(path, modes, root: RealRoot, by_elimination: bool = True):
     return pose, joints, decided
 
 
-def _decide_exactly(path, modes, root: RealRoot) -> dict[str, ModeAtCandidate]:
+def _decide_exactly(path, modes, root: RealRoot) -> tuple[dict[str, ModeAtCandidate], str]:
     """The modes that ball arithmetic left open, decided exactly (:mod:`.exact`, loaded
     only when balls did not decide): in Q(α) at an algebraic time, in the field of τ,
-    sin τ, cos τ at a transcendental one."""
+    sin τ, cos τ at a transcendental one; with why the others could not be."""
+    if root.exact is None:
+        return {}, ("the root's time has no exact description (a path whose angle is not "
+                    "k·t + qπ, or a zero met at a rational end of a branch-and-bound box)")
     from singcheck.certify.exact import (
         AlgebraicPoint,
         NotExact,
@@ -234,7 +237,7 @@ def _decide_exactly(path, modes, root: RealRoot) -> dict[str, ModeAtCandidate]:
 
     out = {}
     try:
-        point = exact_point(root.exact, root)
+        point = exact_point(root.exact, None if _periodic(path) else root)
         zero, nonzero = (BY_ALGEBRAIC_ZERO, BY_ALGEBRAIC_NONZERO) \
             if isinstance(point, AlgebraicPoint) else (BY_MIXED_ZERO, BY_MIXED_NONZERO)
         for mode in modes:
@@ -242,9 +245,9 @@ def _decide_exactly(path, modes, root: RealRoot) -> dict[str, ModeAtCandidate]:
                 out[mode.label] = ModeAtCandidate(mode.label, SINGULAR, zero)
             else:
                 out[mode.label] = ModeAtCandidate(mode.label, REGULAR, nonzero)
-    except NotExact:
-        pass
-    return out
+    except NotExact as why:
+        return out, f"the exact step failed: {why}"
+    return out, ""
 
 
 def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot,
@@ -266,12 +269,15 @@ def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot
             decided.setdefault(label, verdict)
         if len(decided) == len(modes):
             break
-    if len(decided) < len(modes) and root.exact is not None:
-        decided.update(_decide_exactly(path, [m for m in modes if m.label not in decided],
-                                       root))
+    why = ""
+    if len(decided) < len(modes):
+        exactly, why = _decide_exactly(path, [m for m in modes if m.label not in decided],
+                                       root)
+        decided.update(exactly)
     pose, joints = shown_at
     per_mode = [decided.get(m.label) or ModeAtCandidate(
-        m.label, UNKNOWN, "neither det A ≠ 0 nor a zero could be proven at this root")
+        m.label, UNKNOWN, "neither det A ≠ 0 nor a zero could be proven at this root"
+        + (f" near t ≈ {float(root.t.mid()):.9g}: {why}" if why else ""))
         for m in modes]
     feasible = {m.label for m in modes if m.status == FEASIBLE}
     states = {pm.status for pm in per_mode if pm.mode in feasible}
@@ -370,6 +376,7 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
         isolation = isolate_real_roots(zeros, interval, tolerance)
         method = isolation.method
         for r in isolation.roots:
+            checkpoint()
             c = classify_candidate(path, [mode], r, tolerance, by_elimination=False)
             candidates.append(c)
         undecided += [(b.t, b.reason) for b in isolation.undecided
@@ -393,6 +400,7 @@ def _mode_zeros(path: PathModel, mode: WorkingMode, samples: list):
 
     why = None
     for t0 in samples:
+        checkpoint()
         try:
             return mode_zero_polynomial(path, mode.label, t0)
         except NotExact as e:

@@ -57,7 +57,7 @@ from singcheck.roots.enclosures import AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t
 from singcheck.roots.rational import RationalRoot, rational_ball
-from singcheck.roots.transcendental import NotExact, TranscendentalPoint
+from singcheck.roots.transcendental import NotExact, TranscendentalPoint, TrigElements
 
 _MAX_BITS = 1 << 16
 
@@ -236,9 +236,6 @@ class AlgebraicPoint:
             g, inverse, _ = one_plus.xgcd(self.f)  # 1 + α² ≠ 0 for a real α: g = 1
             self._inverse = (inverse / g.leading_coefficient()) % self.f
 
-    def zero(self) -> fmpq_poly:
-        return fmpq_poly([])
-
     def of(self, p: fmpq_mpoly) -> fmpq_poly:
         """A trig polynomial's value at the root, as an element of Q(α)."""
         time = self.time
@@ -288,15 +285,15 @@ class TimeTranscendentalPoint:
     (in Q(α): t = 2·atan(α) + 2kπ, or t = kπ): τ itself is then transcendental
     (Lindemann–Weierstrass: e^{iτ} is algebraic), so an element Σ tⁱ·gᵢ(α) vanishes at
     the root exactly when every gᵢ is 0 in Q(α).  Elements are polynomials in t and α,
-    reduced modulo α's minimal polynomial; balls take τ from the root's own enclosure."""
+    reduced modulo α's minimal polynomial; balls take τ from the root's own enclosure
+    (refined in floating-point tolerances: hence the lower precision cap)."""
+
+    max_bits = 1024
 
     def __init__(self, time: ExactTime, root) -> None:
         self.inner = AlgebraicPoint(time)  # s, c (and α) without t
         self.root = root
         self.f = _T_ALPHA.from_dict({(0, i): c for i, c in enumerate(self.inner.f.coeffs())})
-
-    def zero(self) -> fmpq_mpoly:
-        return _T_ALPHA.from_dict({})
 
     def of(self, p: fmpq_mpoly) -> fmpq_mpoly:
         by_power: dict[int, dict] = {}
@@ -323,8 +320,9 @@ class TimeTranscendentalPoint:
 
 
 def exact_point(time: ExactTime, root=None):
-    """The base field of the exact decisions at a root (a
-    :class:`~singcheck.roots.enclosures.RealRoot`) with this exact time."""
+    """The base field of the exact decisions at a root with this exact time; ``root``
+    (its :class:`~singcheck.roots.enclosures.RealRoot`) only for a path that uses the
+    bare t, where sin t, cos t algebraic leave t itself transcendental."""
     if time.kind == IN_MIXED:
         return TranscendentalPoint(time)
     if time.kind in (IN_U, AT_POINT) and time.t_value is None and root is not None and \
@@ -333,21 +331,12 @@ def exact_point(time: ExactTime, root=None):
     return AlgebraicPoint(time)
 
 
-class PathFunctions:
+class PathFunctions(TrigElements):
     """The trig functions along the path (μ ≡ 0): elements are reduced trig polynomials,
     exact zero tests are polynomial ones, and balls are taken at a rational time."""
 
     def __init__(self, t0: fmpq) -> None:
         self.t0 = t0
-
-    def zero(self) -> fmpq_mpoly:
-        return TRIG.from_dict({})
-
-    def of(self, p: fmpq_mpoly) -> fmpq_mpoly:
-        return reduce_trig(p)
-
-    def mul(self, a: fmpq_mpoly, b: fmpq_mpoly) -> fmpq_mpoly:
-        return reduce_trig(a * b)
 
     def is_zero(self, a: fmpq_mpoly) -> bool:
         return a.is_zero()

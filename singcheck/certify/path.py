@@ -26,12 +26,12 @@ from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.composition import (
     MAX_COMPOSE_WORK,
-    CompositionTooCostly,
+    TooCostly,
     compose_in_pieces,
     composition_work,
 )
 from singcheck.algebra.intervals import evaluate, fraction_ball
-from singcheck.algebra.polynomials import memo_per_object, restrict
+from singcheck.algebra.polynomials import coefficient_in, memo_per_object, restrict
 from singcheck.algebra.radicals import (
     angle_function,
     cos_pi,
@@ -45,6 +45,7 @@ from singcheck.algebra.radicals import (
     surd_polynomial,
 )
 from singcheck.algebra.trig import TRIG, cos_multiple, reduce_trig, sin_multiple
+from singcheck.budget import checkpoint
 from singcheck.elimination.projection import (
     RobotProjection,
     angle_limit_values,
@@ -449,6 +450,12 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
             "ξ(X) was not expanded and this path has square roots or an angle that is not "
             "k*t + q*pi of its own: eliminating along it is not supported yet",
             **(where or {}))
+    deg_t, deg_sc, largest = pathwise_size_bound(model, coordinates)
+    if largest > MAX_PATHWISE_TERMS:
+        raise TooCostly(
+            f"eliminating the joints along the path could take intermediates of "
+            f"{largest:.3g} terms by an a-priori bound (at most {MAX_PATHWISE_TERMS:.3g}; "
+            f"μ of degree up to {deg_t} in t and {deg_sc} in sin t, cos t)")
     eliminated = model.eliminated
     ring = fmpq_mpoly_ctx.get((*eliminated, "t", "s", "c"), "lex")
     gens = dict(zip(ring.names(), ring.gens(), strict=True))
@@ -456,9 +463,96 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
     pose = model.pose_variables
     args = [gens[v] if v in gens else coordinates[pose.index(v)].compose(*tsc, ctx=ring)
             for v in model.context.names()]
-    det_a = model.det_A.compose(*args, ctx=ring)
-    legs = [(v, f.compose(*args, ctx=ring)) for v, f in norm_legs(model)]
+    det_a = _on_circle(model.det_A.compose(*args, ctx=ring))
+    checkpoint()
+    legs = [(v, _on_circle(f.compose(*args, ctx=ring))) for v, f in norm_legs(model)]
     return reduce_trig(restrict(norm_chain(det_a, legs, reduce=_on_circle), TRIG))
+
+
+#: The most terms an intermediate of the path-wise elimination may have by the bound of
+#: :func:`pathwise_size_bound`, which is loose (degree 160 for 18 on the rotary Delta's
+#: circle): its circle 18,850; x = t/2, y = sin t/2: 484,866 (0.65 s of CPU); a helix,
+#: 546,650 (about 1 s); cos 12t, sin 11t: 219,050 (1.3 s); cos 6t, sin 5t and t/10:
+#: 3.2·10⁶ (16 s), refused.  Between checkpoints one FLINT product or resultant runs.
+MAX_PATHWISE_TERMS = 2_000_000
+
+
+_DET_A_FACTORS: dict = {}
+
+
+def pathwise_size_bound(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
+                        ) -> tuple[int, int, int]:
+    """(degree in t, degree in sin/cos, terms) that the path-wise μ cannot exceed, and a
+    bound on the terms of the largest intermediate of its norm chain — predicted from
+    degrees alone, before any work.
+
+    Along the chain each polynomial carries bounds on its degree in every eliminated
+    variable, in each revolute leg's (cos, sin) together, in t and in (s, c) together.
+    For a weight w (one of those), ``deg_w Res_v(g, f) ≤ deg_v(g)·deg_w(f) +
+    deg_v(f)·deg_w(g)`` (the resultant is homogeneous of degree deg_v f in g's
+    coefficients and deg_v g in f's).  A revolute norm ``G₀² - Δ·G₁²`` over
+    f = a·cos + b·sin + d has ``deg_w ≤ 2·deg_w(g) + 2k·(α + max(α, δ))`` with k g's
+    degree in that cos and sin, α = deg_w of a and b, δ = deg_w d: each of cos, sin
+    becomes a numerator of that degree over W = a² + b² (:func:`revolute_norm`).
+    Replacing s² by 1 - c² keeps the degree in (s, c); squarefree parts only lower it.
+    The start, det A and the legs along the path, is bounded by the weighted degrees of
+    :func:`~singcheck.algebra.composition.composition_work`."""
+    names = model.context.names()
+    pose = model.pose_variables
+    zero = TRIG.from_dict({})
+    args = [coordinates[pose.index(v)] if v in pose else zero for v in names]
+    pairs = [v for v, _ in norm_legs(model) if isinstance(v, tuple)]
+
+    def bounds(p: fmpq_mpoly) -> dict:
+        _, deg_t, deg_sc = composition_work(p, args)
+        degrees = [max(0, int(d)) for d in p.degrees()]
+        out = {v: d for v, d in zip(names, degrees, strict=True) if v not in pose}
+        for c, s in pairs:
+            ci, si = names.index(c), names.index(s)
+            out[c, s] = max((int(e[ci]) + int(e[si]) for e in p.monoms()), default=0)
+        out.update(t=deg_t, sc=deg_sc)
+        return out
+
+    def size(b: dict) -> int:
+        n = (b["t"] + 1) * 2 * (b["sc"] + 1)
+        for v, d in b.items():
+            if isinstance(v, str) and v not in ("t", "sc"):
+                n *= d + 1
+        return n
+
+    legs = []
+    for v, f in norm_legs(model):
+        if isinstance(v, tuple):
+            ci, si = names.index(v[0]), names.index(v[1])
+            a, b = bounds(coefficient_in(f, ci, 1)), bounds(coefficient_in(f, si, 1))
+            d = bounds(coefficient_in(coefficient_in(f, ci, 0), si, 0))
+            legs.append((v, {w: max(a[w], b[w]) for w in a}, d))
+        else:
+            legs.append((v, bounds(f), None))
+    # (the legs along the path are composed too: their size counts)
+    largest = max((size(bounds(f)) for _, f in norm_legs(model)), default=0)
+    total_t = total_sc = 0
+    for factor in memo_per_object(_DET_A_FACTORS, model,
+                                  lambda m: [g for g, _ in m.det_A.factor()[1]]):
+        acc = bounds(factor)
+        largest = max(largest, size(acc))
+        for v, f, d in legs:
+            variables = v if isinstance(v, tuple) else (v,)
+            if all(acc[x] == 0 for x in variables):
+                continue
+            if d is not None:
+                k = acc[v]
+                acc = {w: 2 * acc[w] + 2 * k * (f[w] + max(f[w], d[w])) for w in acc}
+                acc[v] = 0
+            else:
+                m, n = acc[v], f[v]
+                acc = {w: m * f[w] + n * acc[w] for w in acc}
+            for x in variables:
+                acc[x] = 0
+            largest = max(largest, size(acc))
+        total_t += acc["t"]
+        total_sc += acc["sc"]
+    return total_t, total_sc, largest
 
 
 def _on_circle(p: fmpq_mpoly) -> fmpq_mpoly:
@@ -530,12 +624,15 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
         # ξ modulo the pose angles' circles: μ is the same (φ's cos, sin lie on them)
         mu = _compose_mu(projection.surface_on_circles, coordinates, pose_vars, trajectory)
     else:
-        mu = eliminate_along_path(model, coordinates, where)
+        try:
+            mu = eliminate_along_path(model, coordinates, where)
+        except TooCostly as e:
+            raise _too_costly(str(e), trajectory) from None
     try:
         legs = _legs_along(model, coordinates)
         degenerate = tuple(compose_pose(w, coordinates, pose_vars)
                            for w in degenerate_set(model))
-    except CompositionTooCostly as e:
+    except TooCostly as e:
         raise _too_costly(f"a leg's constraint along the path: {e}", trajectory) from None
     return PathModel(projection, trajectory, phi, mu, legs, coordinates, degenerate)
 

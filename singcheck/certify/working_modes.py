@@ -180,6 +180,7 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when)
         return INFEASIBLE, f"the two branches of {joint} meet at t ≈ {when(t)} " \
             "(serial singularity: the path reaches the workspace boundary)", t
     for box in iso.undecided:
+        checkpoint()
         if not evaluate_path(leg.discriminant, box.t) > 0:
             return UNKNOWN, f"could not prove that the branches of {joint} stay apart: " \
                 f"{box.reason}", box.t
@@ -216,10 +217,6 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
             crossings[value] = _isolate(leg.limit_polynomial(value), interval, tolerance)
         iso = crossings[value]
         if iso is None:
-            if leg.revolute:
-                return BranchFeasibility(joint, label, UNKNOWN,
-                                         f"a branch of {joint} sits on its limit {value} "
-                                         "all along")
             if leg.leg.degree == 1:  # the only branch is the limit all along: inside
                 return BranchFeasibility(joint, label, FEASIBLE)
             w = _switch_polynomial(leg, value)
@@ -231,11 +228,13 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
     for box in undecided:
+        checkpoint()
         if leg.inside(leg.branches(box.t)[label], limits) is not True:
             return BranchFeasibility(joint, label, UNKNOWN,
                                      f"limit crossing of {joint} not decided: {box.reason}")
     events += [box.t for box in undecided]
     for point in gap_points(interval, events):
+        checkpoint()
         verdict = None
         for prec in _PRECISIONS:
             with working_precision(prec):
@@ -262,9 +261,22 @@ def _switch_polynomial(leg: LegAlongPath, value) -> object:
     (a L² + b L + c ≡ 0).  Then D = b² - 4ac = w², so √D = |w| and the branch with sign
     σ is exactly L where σ·w ≥ 0 and L - w/a (≠ L) where σ·w < 0: the roots of w are
     where a branch gets on or off the limit, the events that replace the limit's
-    crossings."""
+    crossings.
+
+    For a revolute leg a·cos θ + b·sin θ + d with a·cos L + b·sin L + d ≡ 0,
+    w = b·cos L - a·sin L: then Δ = a² + b² - d² = w², and the branch σ
+    (W·cos θ = -a·d + σ·b·√Δ, W·sin θ = -b·d - σ·a·√Δ) is exactly L where σ·√Δ = w,
+    i.e. where σ·w ≥ 0 — the same rule."""
     from flint import fmpq
 
+    if leg.revolute:
+        from singcheck.algebra.radicals import surd_polynomial
+        from singcheck.elimination.projection import angle_limit_values
+
+        a, b, _ = leg.coefficients
+        cos_l, sin_l = angle_limit_values(leg.leg.joint, value)
+        ring = a.context()
+        return b * surd_polynomial(cos_l, ring) - a * surd_polynomial(sin_l, ring)
     a, b, _ = leg.coefficients
     return b + 2 * a * fmpq(value.numerator, value.denominator)
 
@@ -321,7 +333,8 @@ def working_modes(path: PathModel, tolerance: float = 1e-9) -> list[WorkingMode]
     starts = _start_values(path)
     joints = [leg.leg.joint for leg in path.legs]
     modes = []
-    for choice in product(*per_leg):
+    for choice in product(*per_leg):  # 2^legs
+        checkpoint()
         label = "".join(b.label for b in choice)
         statuses = {b.status for b in choice}
         if INFEASIBLE in statuses:

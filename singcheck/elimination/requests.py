@@ -16,6 +16,7 @@ from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import coefficient_in, squarefree_part
 from singcheck.algebra.radicals import radical_prime
+from singcheck.budget import checkpoint
 
 
 @dataclass(frozen=True)
@@ -126,6 +127,7 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly, reduce=None) -> 
     depend on its angle) it may vanish too: the degenerate set, handled by the caller.
     ``reduce`` (optional, as for :func:`norm_chain`) is applied to every intermediate
     product, which keeps them small; the result is then the same modulo its relations.
+    A :func:`~singcheck.budget.checkpoint` is reached before every product.
     """
     red = reduce or (lambda x: x)
     ctx = g.context()
@@ -139,6 +141,7 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly, reduce=None) -> 
     delta = red(w - d * d)
 
     def mul(x, y):
+        checkpoint()
         return red(x[0] * y[0] + red(delta * x[1]) * y[1]), red(x[0] * y[1] + x[1] * y[0])
 
     groups: dict[tuple[int, int], dict] = {}
@@ -157,8 +160,10 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly, reduce=None) -> 
     for (i, j), terms in groups.items():
         coefficient = red(ctx.from_dict(terms) * wpow[k - i - j])
         x = mul(cpow[i], spow[j])
+        checkpoint()
         g0 += red(coefficient * x[0])
         g1 += red(coefficient * x[1])
+    checkpoint()
     return red(g0 * g0) - red(delta * red(g1 * g1))
 
 
@@ -185,6 +190,7 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
             variables = v if isinstance(v, tuple) else (v,)
             if all(acc.degrees()[names.index(x)] <= 0 for x in variables):
                 continue  # a leg that does not touch this factor only raises its power
+            checkpoint()
             acc = revolute_norm(acc, v[0], v[1], f, reduce) if isinstance(v, tuple) else \
                 acc.resultant(f, v)
             acc, reduced = squarefree_part(reduce(acc) if reduce else acc), True

@@ -211,7 +211,9 @@ def render(projection, epsilon, path: PathModel | None, style: str) -> str:
     lines = [f"det A{eq}{show(f['det_A'])}", f"det B{eq}{show(f['det_B'])}",
              f"xi(X){eq}{show(f['singularity_surface'])}" if projection.expanded else
              f"xi(X) not expanded: {projection.not_expanded}"]
-    for i, g in enumerate(f["singularity_surface_factors"], 1):
+    factors = f["singularity_surface_factors"]
+    irreducible = len(factors) == 1 and factors[0]["used"] and factors[0]["multiplicity"] == 1
+    for i, g in enumerate([] if irreducible else factors, 1):  # one factor: ξ itself
         power = f", power {g['multiplicity']}" if g["multiplicity"] > 1 else ""
         kept = "" if g["used"] else ", dropped"
         lines.append(f"xi factor {i} (degree {g['degree']}{power}{kept}){eq}{show(g['factor'])}")
@@ -227,12 +229,16 @@ def render(projection, epsilon, path: PathModel | None, style: str) -> str:
         body = nl.join(line.replace(" &= ", " &= ", 1) if " &= " in line
                        else line.replace(" = ", " &= ", 1) for line in lines)
         return ("% s = sin t, c = cos t\n\\begin{align*}\n" + body + "\n\\end{align*}\n")
-    factors = f["singularity_surface_factors"]
     used = [str(i) for i, g in enumerate(factors, 1) if g["used"]]
     dropped = [str(i) for i, g in enumerate(factors, 1) if not g["used"]]
     header = f"robot {model.name}: joints {', '.join(model.joints)}; pose {', '.join(model.pose)}\n"
-    if projection.expanded:
-        header += (f"ξ as computed by {projection.backend}: {len(factors)} irreducible "
+    source = ("ξ = det A (free of the joints, no elimination)" if projection.backend == "none"
+              else f"ξ as computed by {projection.backend}")
+    if projection.expanded and irreducible:
+        header += (f"{source} is irreducible: xi(X) below, made monic (degree "
+                   f"{int(f['singularity_surface'].total_degree())})\n")
+    elif projection.expanded:
+        header += (f"{source}: {len(factors)} irreducible "
                    f"factor{'s' if len(factors) != 1 else ''} (below); xi(X) is the squarefree "
                    f"product of factor{'s' if len(used) != 1 else ''} {', '.join(used)} "
                    f"(degree {int(f['singularity_surface'].total_degree())})")

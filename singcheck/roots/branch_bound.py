@@ -78,6 +78,7 @@ def _bisect_root(p, lo: fmpq, hi: fmpq, s_lo: int, width: fmpq) -> tuple[fmpq, f
     """Shrink a bracketing box (sign s_lo at lo, opposite at hi) to ``width``."""
     bits = 53
     while hi - lo > width:
+        checkpoint()
         mid = (lo + hi) / 2
         with working_precision(bits):
             s = sign(_point(p, mid))
@@ -232,6 +233,7 @@ def _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambigu
                              exact_roots):
     roots, undecided = list(exact_roots), []
     for lo, hi, s_lo in found:
+        checkpoint()
         bracket = {"lo": lo, "hi": hi}
 
         def make(tol: float, bracket=bracket, s_lo=s_lo) -> arb:

@@ -93,6 +93,7 @@ def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
     out = []
     # k even: u^k = v has no real root for v < 0, so only v ≥ 0 is isolated
     for rr, mult in real_roots_exact(fmpq_poly(deflated), nonnegative_only=k % 2 == 0):
+        checkpoint()
         for q in (fmpq(0), fmpq(1), fmpq(-1)):  # u = 0, ±1 (t = 0, ±π/2) are exact
             rr.pin(q)
         if rr.lo == rr.hi == 0:  # u = 0 exactly: t = 0 (Arb's k-th root of 0 is NaN)
@@ -161,6 +162,7 @@ def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
         bits = bits_for(tol)
         rr.bisect_to(width)
         while k > 1 and rr.lo != rr.hi and float(u_bounds(bits).rad()) > tol / 8:
+            checkpoint()
             width /= 16
             rr.bisect_to(width)
         with working_precision(bits):

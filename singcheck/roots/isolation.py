@@ -28,6 +28,7 @@ from singcheck.algebra.radicals import (
     reduce_relations,
 )
 from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig, uses_t, uses_trig
+from singcheck.budget import checkpoint
 from singcheck.roots.branch_bound import branch_and_bound, vanishes_at_multiple_of_pi
 from singcheck.roots.enclosures import (
     AT_POINT,
@@ -73,7 +74,8 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
     poly = as_univariate_t(p)
     if len(ends) == 2 and (nonzero_on(poly, *ends) or no_root_between(poly, *ends)):
         return RootIsolation((), (), EXACT)  # quick proofs: ball arithmetic, Descartes on [a, b]
-    for rr, mult in real_roots_exact(poly):
+    for rr, mult in real_roots_exact(poly):  # up to the degree of μ
+        checkpoint()
         for q in ends:
             rr.pin(q)
 
@@ -109,14 +111,27 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
     for f, mult in factors:
         if f.is_constant():
             continue
+        checkpoint()
         iso = isolate_real_roots(f, interval, tolerance)
         roots += [(r, int(mult)) for r in iso.roots]
         undecided += list(iso.undecided)
-    roots.sort(key=lambda item: float(item[0].t.mid()))
+    merged, apart = _merge_apart(
+        [RealRoot(r.t, None if r.multiplicity is None else r.multiplicity * mult, r._refine,
+                  exact=r.exact) for r, mult in roots], tolerance,
+        "two factors of the function have roots that could not be separated")
+    return RootIsolation(tuple(merged), tuple(undecided + apart), BRANCH_AND_BOUND)
+
+
+def _merge_apart(roots: list[RealRoot], tolerance: float, why: str
+                 ) -> tuple[list[RealRoot], list[Undecided]]:
+    """Roots of different functions, in time order: balls that overlap are refined
+    apart; a root both have (proven only for the same exact point: equal exact balls, or
+    the same t = kπ) is kept once; two balls that stay overlapping otherwise become an
+    undecided stretch, with the reason ``why``."""
     merged: list[RealRoot] = []
-    for r, mult in roots:
-        r = RealRoot(r.t, None if r.multiplicity is None else r.multiplicity * mult,
-                     r._refine, exact=r.exact)
+    undecided: list[Undecided] = []
+    for r in sorted(roots, key=lambda r: float(r.t.mid())):
+        checkpoint()
         if merged and merged[-1].t.overlaps(r.t):
             prev, tol = merged[-1], tolerance
             for _ in range(6):
@@ -125,17 +140,18 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
                 tol /= 1e4
                 prev, r = prev.refined(tol), r.refined(tol)
             if prev.t.overlaps(r.t):
-                if prev.t.is_exact() and r.t.is_exact() and prev.t == r.t:
+                if (prev.t.is_exact() and r.t.is_exact() and prev.t == r.t) or \
+                        (prev.exact is not None and prev.exact.kind == AT_POINT
+                         and prev.exact == r.exact):
                     merged[-1] = RealRoot(prev.t, None, prev._refine,
                                           exact=prev.exact or r.exact)
                     continue
                 merged.pop()
-                undecided.append(Undecided(prev.t.union(r.t), "two factors of the function "
-                                           "have roots that could not be separated"))
+                undecided.append(Undecided(prev.t.union(r.t), why))
                 continue
             merged[-1] = prev
         merged.append(r)
-    return RootIsolation(tuple(merged), tuple(undecided), BRANCH_AND_BOUND)
+    return merged, undecided
 
 
 def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
@@ -164,6 +180,7 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
     for k, _ in norm.factor()[1]:
         if k.is_constant():
             continue
+        checkpoint()
         iso = branch_and_bound(k, interval, tolerance)
         undecided += [Undecided(b.t, "possible tangency: the zeros of μ there are zeros of "
                                 "a factor of its norm over sin t, which could not be "
@@ -171,6 +188,7 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
                                 f"{float(b.t.upper()):.9g}] ({b.reason})")
                       for b in iso.undecided]
         for r in iso.roots:
+            checkpoint()
             zero = _vanishes_at(p, r)
             if zero is None:
                 undecided.append(Undecided(r.t, "possible tangency: could not decide exactly "
@@ -178,29 +196,9 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
                                            f"its norm at t ≈ {float(r.t.mid()):.9g}"))
             elif zero:
                 roots.append(r)
-    roots.sort(key=lambda r: float(r.t.mid()))
-    kept: list[RealRoot] = []
-    for r in roots:  # two factors' zeros: apart, or one exact point t = kπ both have
-        if kept and kept[-1].t.overlaps(r.t):
-            prev, tol = kept.pop(), tolerance
-            for _ in range(6):
-                tol /= 1e4
-                prev, r = prev.refined(tol), r.refined(tol)
-                if not prev.t.overlaps(r.t):
-                    break
-            if prev.t.overlaps(r.t):
-                if prev.exact is not None and prev.exact.kind == AT_POINT and \
-                        prev.exact == r.exact:
-                    kept.append(prev)
-                else:
-                    undecided.append(Undecided(prev.t.union(r.t), "two zeros of factors of "
-                                               "the norm of μ over sin t could not be "
-                                               "separated"))
-                continue
-            kept.append(prev)
-        kept.append(r)
-    roots = kept
-    return RootIsolation(tuple(roots), tuple(undecided), BRANCH_AND_BOUND)
+    roots, apart = _merge_apart(roots, tolerance, "two zeros of factors of the norm of μ "
+                                "over sin t could not be separated")
+    return RootIsolation(tuple(roots), tuple(undecided + apart), BRANCH_AND_BOUND)
 
 
 def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
@@ -259,6 +257,7 @@ def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Root
     sigmas = conjugates(p)
     roots, undecided = [], list(iso.undecided)
     for root in iso.roots:
+        checkpoint()
         r, verdict = root, None
         for step, bits in enumerate((53, 128, 256, 512)):
             if step:

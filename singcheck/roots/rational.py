@@ -129,6 +129,7 @@ class RationalRoot:
             return
         retry_below = self.hi - self.lo  # after a failed Newton step, bisect 4 times first
         while self.hi - self.lo > width:
+            checkpoint()
             if self.hi - self.lo <= retry_below:
                 if self._newton_step(width):
                     # f is monotone on the old interval, which held the one root: the
@@ -238,7 +239,8 @@ class RationalRoot:
     def compare(self, q: fmpq) -> int:
         """-1, 0, 1 as the root is below, at, above the rational q (exact: the interval
         is bisected until it lies on one side of q, or q is found to be the root)."""
-        while True:
+        while True:  # (a root 2^-k from q takes about k/2 rounds)
+            checkpoint()
             if self.hi < q:
                 return -1
             if self.lo > q:

@@ -61,6 +61,7 @@ def irreducible_factors(polys) -> list[fmpq_mpoly]:
     for p in polys:
         if p.is_zero() or p.is_constant():
             continue
+        checkpoint()
         for f, _ in p.factor()[1]:
             if f.is_constant():
                 continue
@@ -98,9 +99,11 @@ def project(polys: list[fmpq_mpoly], var_index: int) -> list[fmpq_mpoly]:
         upper.append(p)
         lower.append(coefficient_in(p, var_index, d))
         if d >= 2:
+            checkpoint()
             lower.append(p.discriminant(p.context().names()[var_index]))
     name = polys[0].context().names()[var_index] if polys else None
-    for p, q in combinations(upper, 2):
+    for p, q in combinations(upper, 2):  # a resultant each
+        checkpoint()
         lower.append(p.resultant(q, name))
     return irreducible_factors(lower)
 
@@ -209,6 +212,7 @@ def _bisect_apart(roots: list[RationalRoot], rounds: int = 60) -> list[RationalR
     """The roots sorted with pairwise disjoint closed intervals, or None when two of
     them could not be separated (they may be one root of two factors)."""
     for _ in range(rounds):
+        checkpoint()
         roots.sort(key=lambda r: r.lo)
         clash = set()
         for i, r in enumerate(roots):

@@ -133,7 +133,7 @@ XI = "parallel singularity ξ"
 
 
 def _crossings(path: PathModel, tolerance: float, mu_roots: list[arb] | None
-               ) -> tuple[list[Crossing], list[str], list[str]]:
+               ) -> tuple[list[Crossing], list[str], list[tuple[str, str]]]:
     interval = path.trajectory.range
     events: list[tuple[arb, str]] = []
     undecided, on = [], []
@@ -152,6 +152,7 @@ def _crossings(path: PathModel, tolerance: float, mu_roots: list[arb] | None
     events.sort(key=lambda e: float(e[0].mid()))
     merged: list[Crossing] = []
     for t, label in events:
+        checkpoint()
         if merged and merged[-1].t.overlaps(t):
             last = merged[-1]
             merged[-1] = Crossing(last.t.union(t), (*last.surfaces, label))

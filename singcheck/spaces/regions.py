@@ -213,6 +213,7 @@ def _join_across(cad: OpenCAD, fibre, indices: set, over: dict, prefix_index: tu
     for round_ in range(_ROUNDS):
         a, b = _brackets(base, i, round_)
         for rest in _candidate_rests(cad, fibre, prefix_sample, a, b):
+            checkpoint()  # (the candidates multiply with the levels above)
             point = (*prefix_sample, a, *rest)
             if not segment_is_free(cad, point, level, a, b):
                 continue

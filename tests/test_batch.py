@@ -620,7 +620,14 @@ def test_a_dead_worker_fails_its_tasks_and_the_batch_goes_on(orthoglide_robot, t
     assert docs[1]["error"]["message"].startswith("the worker process failed")
     expected = [api.check(orthoglide_robot, d.parse(orthoglide_robot.spec),
                           regions=False).verdict for d in read_documents([stream])]
-    assert [d["verdict"] for d in docs[4:]] == expected[4:]  # after the pool was renewed
+    # the trajectories in flight when p1's worker died fail with it (which ones depends on
+    # the scheduling: at most the window of tasks then submitted); every other one is
+    # certified, and those read after the renewal of the pool certainly are
+    failed = [i for i, d in enumerate(docs) if d["verdict"] == "error"]
+    assert all(docs[i]["error"]["message"].startswith("the worker process failed")
+               for i in failed)
+    assert 1 in failed and max(failed) < 8
+    assert all(d["verdict"] == expected[i] for i, d in enumerate(docs) if i not in failed)
 
 
 # -- JUnit against the schema CI tools check reports with -------------------------------
@@ -636,7 +643,8 @@ def test_junit_validates_against_the_schema(tmp_path, monkeypatch):
     """A batch with every kind of result (singular, free, infeasible, unknown past its
     time limit, a bad document and a repeated name past the documents read up front)
     gives JUnit XML that the JUnit schema accepts, and that junitparser (the reader of the
-    GitHub test-report actions) reads back with the counts of the verdicts known here: 2 failures, 3 errors in 6 cases."""
+    GitHub test-report actions) reads back with the counts of the verdicts known here:
+    2 failures, 3 errors in 6 cases."""
     import sys
 
     import xmlschema

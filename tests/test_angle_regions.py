@@ -298,3 +298,27 @@ def test_joint_spaces_without_an_exact_direct_kinematics_count_are_refused(robot
     result = singcheck("jointspace", str(ROBOTS / f"{robot}.yaml"), "--backend", "flint", "-q")
     assert result.returncode == 2
     assert why in result.stderr and len(result.stderr.strip().splitlines()) == 1
+
+
+def test_a_chart_region_map_survives_the_cache(tmp_path):
+    from singcheck.spaces.region_map import RegionMap, RegionMapCache
+
+    projection = _projection("3-rpr")
+    fixed = {"x": Fraction(2), "y": Fraction(1)}
+    analysis = analyse(WORKSPACE, projection.model, workspace_variety(projection), fixed)
+    cache = RegionMapCache(tmp_path)
+    key = cache.key([c.polynomial for c in analysis.components], fixed)
+    cache.store(key, RegionMap.of(analysis))
+    back = cache.load(key)
+    assert back is not None and back.variables == ("tan(phi/2)",)
+    assert len(analysis.cells) == 3
+    for c in analysis.cells:  # every cell's sample is located in its own region again
+        assert back.region_at(list(c.cell.sample)) == c.region is not None
+
+
+def test_a_decomposition_too_costly_to_project_is_refused_up_front():
+    # the rotary Delta's 3-D workspace: normed surfaces of degree 8, projection bound 8⁴
+    result = singcheck("workspace", str(ROBOTS / "rotary-delta.yaml"), "--backend", "flint",
+                       "-q")
+    assert result.returncode == 2
+    assert "too costly" in result.stderr and len(result.stderr.strip().splitlines()) == 1

@@ -620,23 +620,31 @@ def test_a_dead_worker_fails_its_tasks_and_the_batch_goes_on(orthoglide_robot, t
     assert docs[1]["error"]["message"].startswith("the worker process failed")
     expected = [api.check(orthoglide_robot, d.parse(orthoglide_robot.spec),
                           regions=False).verdict for d in read_documents([stream])]
-    assert [d["verdict"] for d in docs[4:]] == expected[4:]  # after the pool was renewed
+    # the trajectories in flight when p1's worker died fail with it (which ones depends on
+    # the scheduling: at most the window of tasks then submitted); every other one is
+    # certified, and those read after the renewal of the pool certainly are
+    failed = [i for i, d in enumerate(docs) if d["verdict"] == "error"]
+    assert all(docs[i]["error"]["message"].startswith("the worker process failed")
+               for i in failed)
+    assert 1 in failed and max(failed) < 8
+    assert all(d["verdict"] == expected[i] for i, d in enumerate(docs) if i not in failed)
 
 
 # -- JUnit against the schema CI tools check reports with -------------------------------
 
-JUNIT_XSD = ROOT / "tests" / "data" / "junit-10.xsd"  # Jenkins xUnit's, vendored (MIT)
+JUNIT_XSD = ROOT / "tests" / "data" / "junit-report.xsd"  # ours: the format CI readers accept
 
 #: x² + z² = 10 > l² = 4 all along: the second leg's equation x² + (y − ρ2)² + z² = l²
 #: has no real root, so no working mode is feasible anywhere on the path
 OUTSIDE = "name: outside\nparameter: t\nrange: [0, 1]\npose:\n  x: 3\n  y: t\n  z: 1\n"
 
 
-def test_junit_validates_against_the_jenkins_schema(tmp_path, monkeypatch):
+def test_junit_validates_against_the_schema(tmp_path, monkeypatch):
     """A batch with every kind of result (singular, free, infeasible, unknown past its
     time limit, a bad document and a repeated name past the documents read up front)
-    gives JUnit XML that Jenkins' junit-10.xsd accepts, and whose counts read back are
-    those of the verdicts known here: 2 failures, 3 errors in 6 cases."""
+    gives JUnit XML that the JUnit schema accepts, and that junitparser (the reader of the
+    GitHub test-report actions) reads back with the counts of the verdicts known here:
+    2 failures, 3 errors in 6 cases."""
     import sys
 
     import xmlschema
@@ -676,8 +684,8 @@ def test_junit_validates_against_the_jenkins_schema(tmp_path, monkeypatch):
 
 
 def test_the_schema_test_can_fail():
-    """The vendored schema refuses what CI tools would: a testcase without a name, and a
-    time with more decimals than Surefire writes."""
+    """The schema refuses what CI readers would: a testcase without a name, a time with
+    more decimals than Surefire writes, an attribute they do not know, a negative count."""
     import xmlschema
 
     schema = xmlschema.XMLSchema(str(JUNIT_XSD))
@@ -686,3 +694,5 @@ def test_the_schema_test_can_fail():
     assert schema.is_valid(good)
     assert not schema.is_valid(good.replace(' name="c"', ""))
     assert not schema.is_valid(good.replace('time="0.5">', 'time="0.123456">'))
+    assert not schema.is_valid(good.replace('<testcase name="c"', '<testcase file="f" name="c"'))
+    assert not schema.is_valid(good.replace('failures="0"', 'failures="-1"'))

@@ -523,6 +523,17 @@ def test_five_bar_resting_where_the_distal_links_align_is_singular_all_along():
     assert report.verdict == "singular" and "whole path" in report.reason
     assert [m.label for m in report.modes if m.feasible] == ["+-"]
     assert {m for c in report.candidates for m in c.singular_modes} == expected
+    # the workspace line: on ξ all along, with the oracle's IK count inside the limits
+    from singcheck.report.trajectory import workspace_json, workspace_line
+    from singcheck.spaces.path_regions import path_in_workspace
+    from tests.robot_oracles import five_bar
+
+    count = 1
+    for leg in five_bar().legs:  # angles in [lo, lo + 2π): inside when ≤ hi
+        count *= sum(1 for q in leg.branches([0, mpmath.sqrt(3)]) if q <= leg.hi + 1e-30)
+    line = workspace_line(workspace_json(path_in_workspace(path, name_region=False)))
+    assert line == ("workspace: the path lies on parallel singularity ξ for t ∈ [0, 1] "
+                    f"({count} IK solution(s) inside the joint limits all along)")
 
 
 def test_five_bar_on_the_surface_of_an_infeasible_mode_only_is_free():
@@ -727,3 +738,29 @@ def test_a_touch_without_an_exact_time_stays_unknown_with_the_reason():
     assert all("no exact description" in why and f"t ≈ {float(tau):.9g}"[:12] in why
                for why in unknown.values())
     assert again.status == "unknown"
+
+
+def test_five_bar_elbows_sitting_on_their_limits_all_along_are_feasible_and_singular():
+    # P = (0, √3) + 2(cos t, sin t): one branch of each leg keeps its elbow at (0, √3),
+    # i.e. th1 = π/3 and th2 = 2π/3, exactly the (closed) limits, all along; there the
+    # distal links coincide: det A ≡ 0 in that mode
+    from tests.robot_oracles import five_bar
+
+    text = trajectory("1/4", "1", x="2*cos(t)", y="sqrt(3) + 2*sin(t)")
+
+    def pose_at(t):
+        return [2 * mpmath.cos(t), mpmath.sqrt(3) + 2 * mpmath.sin(t)]
+
+    samples = [Fraction(1, 4) + Fraction(3, 4) * Fraction(k, 8) for k in range(1, 8)]
+    path, zero = _five_bar_pose_zero_modes(pose_at, text, samples=samples)
+    [label] = zero
+    oracle = five_bar()
+    modes = _oracle_modes(path, oracle, pose_at, samples[0])
+    for q in samples:
+        th1, th2 = oracle.joints(modes[label], pose_at(mpmath.mpf(q.numerator) / q.denominator))
+        assert abs(th1 - mpmath.pi / 3) < 1e-40 and abs(th2 - 2 * mpmath.pi / 3) < 1e-40
+    report = certify_path(path)
+    assert label in [m.label for m in report.modes if m.feasible]
+    assert all(m.status != "unknown" for m in report.modes)
+    assert report.verdict == "singular" and "whole path" in report.reason
+    assert {m for c in report.candidates for m in c.singular_modes} == zero

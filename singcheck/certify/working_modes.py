@@ -217,10 +217,6 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
             crossings[value] = _isolate(leg.limit_polynomial(value), interval, tolerance)
         iso = crossings[value]
         if iso is None:
-            if leg.revolute:
-                return BranchFeasibility(joint, label, UNKNOWN,
-                                         f"a branch of {joint} sits on its limit {value} "
-                                         "all along")
             if leg.leg.degree == 1:  # the only branch is the limit all along: inside
                 return BranchFeasibility(joint, label, FEASIBLE)
             w = _switch_polynomial(leg, value)
@@ -265,9 +261,22 @@ def _switch_polynomial(leg: LegAlongPath, value) -> object:
     (a L² + b L + c ≡ 0).  Then D = b² - 4ac = w², so √D = |w| and the branch with sign
     σ is exactly L where σ·w ≥ 0 and L - w/a (≠ L) where σ·w < 0: the roots of w are
     where a branch gets on or off the limit, the events that replace the limit's
-    crossings."""
+    crossings.
+
+    For a revolute leg a·cos θ + b·sin θ + d with a·cos L + b·sin L + d ≡ 0,
+    w = b·cos L - a·sin L: then Δ = a² + b² - d² = w², and the branch σ
+    (W·cos θ = -a·d + σ·b·√Δ, W·sin θ = -b·d - σ·a·√Δ) is exactly L where σ·√Δ = w,
+    i.e. where σ·w ≥ 0 — the same rule."""
     from flint import fmpq
 
+    if leg.revolute:
+        from singcheck.algebra.radicals import surd_polynomial
+        from singcheck.elimination.projection import angle_limit_values
+
+        a, b, _ = leg.coefficients
+        cos_l, sin_l = angle_limit_values(leg.leg.joint, value)
+        ring = a.context()
+        return b * surd_polynomial(cos_l, ring) - a * surd_polynomial(sin_l, ring)
     a, b, _ = leg.coefficients
     return b + 2 * a * fmpq(value.numerator, value.denominator)
 

@@ -3,8 +3,8 @@
 singularity-free passes; singular and infeasible are ``<failure>`` (the message gives the
 singular times of the feasible modes); unknown and per-trajectory errors are ``<error>``.
 ``time`` attributes are the seconds each trajectory took.  Built with ElementTree, so the
-text is escaped; the tests validate it against the JUnit schema that Jenkins' xUnit
-plugin checks reports with (``tests/data/junit-10.xsd``).
+text is escaped; the tests validate it against the JUnit schema in
+``tests/data/junit-report.xsd`` (three-decimal times, known attributes only).
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ def _details(t: dict[str, Any]) -> str:
 
 
 def testcase(robot: dict[str, Any], t: dict[str, Any]) -> ET.Element:
-    # no ``file`` attribute: the JUnit schema (Jenkins' junit-10.xsd) has none; the file
+    # no ``file`` attribute: CI readers' JUnit schemas have none; the file
     # is named in the failure or error text
     case = ET.Element("testcase", name=t["name"], classname=f"singcheck.{robot['name']}",
                       time=_seconds(t.get("time_s", 0)))

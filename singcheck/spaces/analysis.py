@@ -297,6 +297,32 @@ def _within(model: RobotModel, joints) -> bool:
     return True
 
 
+#: For robots with angles or square roots (normed, charted surfaces of higher degree): the
+#: most a decomposition's last projection degree may reach by the bound d^(2^(n-1))
+#: (n free axes, d the surfaces' largest total degree).  The 3-RPR's 3-D workspace
+#: (d = 4: 256) is decomposed, in tens of seconds; the rotary Delta's (d = 8: 4096) would
+#: spend minutes in single FLINT resultants that no time limit can interrupt.
+MAX_PROJECTION_DEGREE = 256
+
+
+class CostlyDecomposition(UnsupportedRobotError):
+    """A decomposition refused up front: its projection would be too large."""
+
+
+def refuse_costly(components: list[VarietyComponent], axes: tuple[str, ...],
+                  fixed: dict[str, Fraction]) -> None:
+    """Refuse, before any resultant, a decomposition whose projection degree could pass
+    :data:`MAX_PROJECTION_DEGREE` (a bound from the degrees alone, in microseconds)."""
+    free, sliced = fix_axes(components, axes, fixed)
+    d = max((c.polynomial.total_degree() for c in sliced), default=0)
+    bound = d ** (2 ** (len(free) - 1)) if d else 0
+    if bound > MAX_PROJECTION_DEGREE:
+        raise CostlyDecomposition(
+            f"decomposing {len(free)} axes ({', '.join(free)}) with surfaces of degree up to "
+            f"{d} could reach projection degree {bound} (over {MAX_PROJECTION_DEGREE}): too "
+            "costly; fix an axis with --slice")
+
+
 def decomposition(axes: tuple[str, ...], components: list[VarietyComponent],
                   fixed: dict[str, Fraction]) -> tuple[tuple[str, ...],
                                                        list[VarietyComponent], OpenCAD]:
@@ -317,6 +343,8 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     fixed = dict(fixed or {})
     chart = space_chart(model, space)
     axes = chart.axes
+    if not model.polynomial:
+        refuse_costly(components, axes, fixed)
     timings = {}
     start = time.perf_counter()
     free, sliced, cad = decomposition(axes, components, fixed)

@@ -133,7 +133,7 @@ XI = "parallel singularity ξ"
 
 
 def _crossings(path: PathModel, tolerance: float, mu_roots: list[arb] | None
-               ) -> tuple[list[Crossing], list[str], list[str]]:
+               ) -> tuple[list[Crossing], list[str], list[tuple[str, str]]]:
     interval = path.trajectory.range
     events: list[tuple[arb, str]] = []
     undecided, on = [], []
@@ -187,7 +187,12 @@ def _name_region(result: PathInWorkspace, path: PathModel, cache, notify) -> Non
     if reason:
         result.region_reason = reason
         return
-    result.region = locate_region(path, cache, notify)
+    from singcheck.spaces.analysis import CostlyDecomposition
+
+    try:
+        result.region = locate_region(path, cache, notify)
+    except CostlyDecomposition as e:
+        result.region_reason = f"no region named: {e.message}"
 
 
 def region_refusal(path: PathModel) -> str:
@@ -263,7 +268,7 @@ def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
             if any(reasons):
                 result.region_reason = next(r for r in reasons if r)
             else:
-                result.region = locate_region(report.pieces[0].path, region_cache, notify)
+                _name_region(result, report.pieces[0].path, region_cache, notify)
     return result
 
 
@@ -397,7 +402,7 @@ def prepare_region_maps(projection, specs, cache=None, notify=None) -> None:
     trajectories lie in (forked workers then inherit it instead of each computing it)."""
     from collections import Counter
 
-    from singcheck.spaces.analysis import MAX_AXES
+    from singcheck.spaces.analysis import MAX_AXES, CostlyDecomposition
 
     model = projection.model
     if len(model.pose) > MAX_AXES:
@@ -408,7 +413,10 @@ def prepare_region_maps(projection, specs, cache=None, notify=None) -> None:
         shared[tuple(fixed.items()), len(free)] += 1
     for (fixed, free), n in shared.items():
         if n > 1 and free:
-            _region_map(projection, dict(fixed), free, cache, notify)
+            try:
+                _region_map(projection, dict(fixed), free, cache, notify)
+            except CostlyDecomposition:
+                continue  # each path then says why it has no region name
 
 
 def locate_region(path: PathModel, cache=None, notify=None) -> str | None:

@@ -15,7 +15,6 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from fractions import Fraction
 
-import yaml
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import restrict
@@ -31,6 +30,8 @@ from singcheck.spec.grammar import (
     parse,
 )
 from singcheck.spec.paths import csv_name, multi_piece, parse_csv
+from singcheck.spec.plainyaml import compose_all as compose_plain
+from singcheck.spec.plainyaml import kind
 from singcheck.spec.trajectory import (
     TrajectorySpec,
     exactly_less,
@@ -124,12 +125,13 @@ class _Doc:
             else node_or_line.start_mark.line + 1
         return SpecError(message, path=self.path, line=line, key=key)
 
-    def mapping(self, node, key: str | None) -> dict[str, tuple[yaml.Node, yaml.Node]]:
-        if not isinstance(node, yaml.MappingNode):
+    def mapping(self, node, key: str | None) -> dict[str, tuple]:
+        """{key: (key node, value node)} of a mapping node."""
+        if kind(node) != "mapping":
             raise self.error(node, key, f"expected a mapping (key: value), got {_kind(node)}")
-        out: dict[str, tuple[yaml.Node, yaml.Node]] = {}
+        out: dict[str, tuple] = {}
         for k, v in node.value:
-            if not isinstance(k, yaml.ScalarNode):
+            if kind(k) != "scalar":
                 raise self.error(k, key, "keys must be plain names")
             if k.value in out:
                 raise self.error(k, key, f"duplicate key {k.value!r}")
@@ -148,7 +150,7 @@ class _Doc:
         return m
 
     def scalar(self, node, key: str) -> str:
-        if not isinstance(node, yaml.ScalarNode):
+        if kind(node) != "scalar":
             raise self.error(node, key, f"expected a single value, got {_kind(node)}")
         return str(node.value)
 
@@ -159,7 +161,7 @@ class _Doc:
         return value
 
     def names(self, node, key: str) -> tuple[str, ...]:
-        if not isinstance(node, yaml.SequenceNode) or not node.value:
+        if kind(node) != "sequence" or not node.value:
             raise self.error(node, key, "expected a non-empty list of names, e.g. [x, y]")
         out = []
         for i, item in enumerate(node.value):
@@ -211,17 +213,19 @@ def _excerpt(text: str) -> str:
 
 
 def _kind(node) -> str:
-    return {yaml.MappingNode: "a mapping", yaml.SequenceNode: "a list",
-            yaml.ScalarNode: "a single value"}.get(type(node), "nothing")
+    return {"mapping": "a mapping", "sequence": "a list",
+            "scalar": "a single value"}.get(kind(node), "nothing")
 
 
 def _check_depth(text: str, path: str, offset: int = 0) -> None:
     """Refuse YAML nested deeper than MAX_YAML_DEPTH, from the event stream (PyYAML's
     parser is a state machine; its composer, and our walks, recurse once per level).
     ``offset``: lines of the file before ``text`` (for the line an error names)."""
+    import yaml
+
     depth = 0
     try:
-        for event in yaml.parse(text, Loader=_LOADER):
+        for event in yaml.parse(text, Loader=_loader()):
             if isinstance(event, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
                 depth += 1
                 if depth > MAX_YAML_DEPTH:
@@ -234,7 +238,9 @@ def _check_depth(text: str, path: str, offset: int = 0) -> None:
         raise _yaml_error(e, path, offset) from None
 
 
-def _yaml_error(e: yaml.YAMLError, path: str, offset: int = 0) -> SpecError:
+def _yaml_error(e, path: str, offset: int = 0) -> SpecError:
+    import yaml
+
     if isinstance(e, yaml.MarkedYAMLError):
         mark = e.problem_mark or e.context_mark
         line = mark.line + 1 + offset if mark else None
@@ -243,19 +249,29 @@ def _yaml_error(e: yaml.YAMLError, path: str, offset: int = 0) -> SpecError:
     return SpecError(f"not valid YAML: {str(e).splitlines()[0]}", path=path)
 
 
-#: libyaml's safe loader when PyYAML was built with it (the same nodes and marks, parsed
-#: in C), else the pure-Python one
-_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+def _loader():
+    """libyaml's safe loader when PyYAML was built with it (the same nodes and marks,
+    parsed in C), else the pure-Python one."""
+    import yaml
+
+    return getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 
 def _compose(text: str, path: str, first_line: int = 1, empty_ok: bool = False):
     """The node tree of one YAML document, ``text`` starting at line ``first_line`` of
     ``path`` (the lines its nodes and errors name); None for an empty one when
-    ``empty_ok``, else an error."""
+    ``empty_ok``, else an error.  Composed (never constructed) by the quick reader of
+    plain specs (:mod:`singcheck.spec.plainyaml`) when the text is in its subset, else
+    by PyYAML (imported only then)."""
     offset = first_line - 1
+    plain = compose_plain(text, MAX_YAML_DEPTH, offset)
+    if plain is not None and len(plain) == 1:
+        return plain[0]
+    import yaml
+
     _check_depth(text, path, offset)
     try:
-        node = yaml.compose(text, Loader=_LOADER)
+        node = yaml.compose(text, Loader=_loader())
     except yaml.YAMLError as e:
         raise _yaml_error(e, path, offset) from None
     if node is None or (isinstance(node, yaml.ScalarNode) and node.value == ""
@@ -279,15 +295,17 @@ def _refuse_tags(node, doc: _Doc, seen: set[int], offset: int = 0) -> None:
         raise doc.error(node, None, "YAML aliases (*name) are not allowed in specs")
     seen.add(id(node))
     if offset:
+        import yaml
+
         m = node.start_mark
         node.start_mark = yaml.Mark(m.name, m.index, m.line + offset, m.column, None, None)
     if node.tag not in _PLAIN_TAGS:
         raise doc.error(node, None, f"YAML tags like {node.tag} are not allowed")
     children = []
-    if isinstance(node, yaml.MappingNode):
+    if kind(node) == "mapping":
         for k, v in node.value:
             children += [k, v]
-    elif isinstance(node, yaml.SequenceNode):
+    elif kind(node) == "sequence":
         children = node.value
     for child in children:
         _refuse_tags(child, doc, seen, offset)
@@ -344,7 +362,7 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                 raise doc.error(knode, key, f"{pname!r} is already a joint or pose variable")
             parameters[pname] = doc.value(vnode, key, parameters)
     cnode = top["constraints"][1]
-    if not isinstance(cnode, yaml.SequenceNode) or not cnode.value:
+    if not kind(cnode) == "sequence" or not cnode.value:
         raise doc.error(cnode, "constraints", "expected a non-empty list of polynomials")
     trees = [doc.expression(item, f"constraints[{i}]", lambda n: n)
              for i, item in enumerate(cnode.value)]
@@ -383,7 +401,7 @@ def parse_robot(text: str, path: str) -> RobotSpec:
             if jname not in joints:
                 raise doc.error(knode, key, f"{jname!r} is not a joint (joints: "
                                             f"{', '.join(joints)})")
-            if not isinstance(vnode, yaml.SequenceNode) or len(vnode.value) != 2:
+            if not kind(vnode) == "sequence" or len(vnode.value) != 2:
                 raise doc.error(vnode, key, "expected [min, max]")
             if jname in angles:
                 lo, hi = (doc.expression(v, key, compile_constant) for v in vnode.value)
@@ -416,8 +434,8 @@ def _drawing(doc: _Doc, node, ctx, variables, parameters,
 
     def point(pnode, key):
         nonlocal count
-        if not isinstance(pnode, yaml.SequenceNode) or not 2 <= len(pnode.value) <= 3 or \
-                not all(isinstance(v, yaml.ScalarNode) for v in pnode.value):
+        if not kind(pnode) == "sequence" or not 2 <= len(pnode.value) <= 3 or \
+                not all(kind(v) == "scalar" for v in pnode.value):
             raise doc.error(pnode, key, "expected a point: a list of 2 or 3 coordinates, "
                                         "e.g. [x, y, z]")
         if "dim" not in shape:
@@ -437,16 +455,16 @@ def _drawing(doc: _Doc, node, ctx, variables, parameters,
         key = f"drawing.{bname}"
         if not _IDENTIFIER.match(bname):
             raise doc.error(knode, key, f"{bname!r} is not a valid body name")
-        if not isinstance(bnode, yaml.SequenceNode) or not bnode.value:
+        if not kind(bnode) == "sequence" or not bnode.value:
             raise doc.error(bnode, key, "expected a non-empty list of segments "
                                         "[[x1, y1], [x2, y2]] or points [x, y]")
         chains, points = [], []
         for i, item in enumerate(bnode.value):
             ikey = f"{key}[{i}]"
-            if not isinstance(item, yaml.SequenceNode) or not item.value:
+            if not kind(item) == "sequence" or not item.value:
                 raise doc.error(item, ikey, "expected a segment [[x1, y1], [x2, y2]] or a "
                                             "point [x, y]")
-            if all(isinstance(v, yaml.ScalarNode) for v in item.value):
+            if all(kind(v) == "scalar" for v in item.value):
                 points.append(point(item, ikey))
             elif len(item.value) < 2:
                 raise doc.error(item, ikey, "a segment needs two end points")
@@ -643,10 +661,10 @@ def _documents(stream, path: str, limit: int = MAX_BYTES) -> Iterator[Document]:
 
 def _name(node) -> dict:
     """A trajectory document's name and its line, when its top is a mapping with one."""
-    if isinstance(node, yaml.MappingNode):
+    if kind(node) == "mapping":
         for k, v in node.value:
-            if isinstance(k, yaml.ScalarNode) and k.value == "name" and \
-                    isinstance(v, yaml.ScalarNode) and str(v.value).strip():
+            if kind(k) == "scalar" and k.value == "name" and \
+                    kind(v) == "scalar" and str(v.value).strip():
                 return {"name": str(v.value).strip(), "name_line": _line(k)}
     return {}
 

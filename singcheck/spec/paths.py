@@ -24,7 +24,6 @@ from __future__ import annotations
 import re
 from fractions import Fraction
 
-import yaml
 from flint import fmpq, fmpq_mpoly
 
 from singcheck.algebra.intervals import working_precision
@@ -32,6 +31,7 @@ from singcheck.algebra.trig import TRIG, LinearInPi, T, TimeRange, evaluate_trig
 from singcheck.algebra.trig_values import sum_is_zero
 from singcheck.budget import checkpoint
 from singcheck.errors import SpecError
+from singcheck.spec.plainyaml import kind
 from singcheck.spec.trajectory import TrajectorySpec, pose_nodes, time_range, trajectory_piece
 
 INTERPOLATIONS = ("linear", "cubic")
@@ -82,7 +82,7 @@ def _whole(path: str, name: str, parameter: str, pieces, lines) -> TrajectorySpe
 
 
 def _segments(doc, node, name: str, parameter: str, robot):
-    if not isinstance(node, yaml.SequenceNode) or not node.value:
+    if not kind(node) == "sequence" or not node.value:
         raise doc.error(node, "segments", "expected a non-empty list of "
                                           "{range: [a, b], pose: {...}}")
     pieces, nodes = [], []
@@ -146,7 +146,7 @@ def check_joins(pieces, path: str, lines: list[int | None]) -> None:
 
 
 def _waypoints(doc, node, parameter: str, robot):
-    if not isinstance(node, yaml.SequenceNode):
+    if not kind(node) == "sequence":
         fields = ", ".join(f"{v}: .." for v in (parameter, *robot.pose))
         raise doc.error(node, "waypoints", f"expected a list of {{{fields}}}")
     names = (parameter, *robot.pose)

@@ -12,7 +12,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from fractions import Fraction
 
-import yaml
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import restrict
@@ -28,6 +27,7 @@ from singcheck.spec.grammar import (
     compile_value,
     pi_multiples,
 )
+from singcheck.spec.plainyaml import kind
 
 
 @dataclass(frozen=True)
@@ -118,7 +118,7 @@ def exactly_less(a: LinearInPi, b: LinearInPi) -> bool:
 
 def time_range(doc, rnode, key: str) -> TimeRange:
     """``[start, end]`` with start < end, exact (a + b·π)."""
-    if not isinstance(rnode, yaml.SequenceNode) or len(rnode.value) != 2:
+    if not kind(rnode) == "sequence" or len(rnode.value) != 2:
         raise doc.error(rnode, key, "expected [start, end], e.g. [-pi, pi]")
     start, end = (doc.expression(item, f"{key}[{i}]", compile_constant)
                   for i, item in enumerate(rnode.value))

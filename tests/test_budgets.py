@@ -195,3 +195,30 @@ def test_the_path_wise_size_bound_bounds_mu(robot, pose):
                compose_pose(machine.singularity_surface, phi, machine.model.pose)):
         assert mu.context() is TRIG
         assert mu.degrees()[0] <= deg_t and mu.degrees()[1] + mu.degrees()[2] <= deg_sc
+
+
+def test_plot_stops_at_the_time_limit_and_draws_nothing_for_that_figure(
+        tmp_path, monkeypatch, capsys, cache_env):  # noqa: F811
+    """plot bounds its region analysis as the space commands do (the big-constant joint
+    space takes seconds without a limit): exit 3, one line naming the limit, no figure."""
+    path = tmp_path / "big.yaml"
+    path.write_text(BIG_CONSTANT)
+    out_dir = tmp_path / "figures"
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, "plot", str(path), "--regions",
+                             "jointspace", "--out", str(out_dir), "--backend", "flint",
+                             "-q", "--time-limit", "1")
+    elapsed = time.monotonic() - start
+    assert code == 3, err
+    assert "unknown: time limit (1 s)" in err and "no figure" in err, err
+    assert out == "" and not list(out_dir.glob("*.png"))
+    assert elapsed < 4, elapsed
+
+
+def test_plot_states_its_time_limit():
+    from click.testing import CliRunner
+
+    from singcheck.cli.commands import plot
+
+    text = CliRunner().invoke(plot, ["--help"], terminal_width=100).output
+    assert "--time-limit" in text and "exit 3" in text

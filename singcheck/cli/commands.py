@@ -224,7 +224,8 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
             advance(doc["name"], doc["verdict"])
         sink.finish(code, tolerance, verbose)
     if plot_dir:
-        _plot_all(machine, _parsed(kept, spec), tolerance, plot_dir, progress)
+        _plot_all(_certificates(machine, _parsed(kept, spec), time_limit, tolerance),
+                  plot_dir, progress)
     return code
 
 
@@ -385,23 +386,37 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon, segment) -> N
                           "latex" if as_latex else "text"), nl=False)
 
 
-def _plot_all(machine, specs, tolerance: float, out_dir: str, progress) -> list:
+def _certificates(machine, specs, time_limit: float, tolerance: float = 1e-9) -> list:
+    """Each trajectory's certificate within ``time_limit`` seconds; one that runs past it
+    is left out (no figure), noted on stderr, and makes the command end with exit 3."""
+    from singcheck import api
+
+    out = []
+    for spec in specs:
+        report = api.check(machine, spec, tolerance=tolerance, regions=False,
+                           time_limit=time_limit)
+        if report.certificate is None:
+            click.echo(f"singcheck: {spec.name}: {report.reason} (--time-limit): no "
+                       "figure", err=True)
+        else:
+            out.append(report.certificate)
+    return out
+
+
+def _plot_all(certificates, out_dir: str, progress) -> list:
     try:
         from singcheck.report.plots import write_figures
     except ImportError as e:
         raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
                         "missing): pip install 'singcheck[plot]'") from None
-    from singcheck import api
-
     written = []
-    for spec in specs:
-        report = api.check(machine, spec, tolerance=tolerance, regions=False)
-        written += write_figures(report.certificate, out_dir)
+    for certificate in certificates:
+        written += write_figures(certificate, out_dir)
     progress.note(f"wrote {len(written)} figure files to {out_dir}")
     return written
 
 
-def _plot_html(machine, specs, out_dir: str):
+def _plot_html(certificates, out_dir: str):
     try:
         import plotly  # noqa: F401
 
@@ -409,10 +424,7 @@ def _plot_html(machine, specs, out_dir: str):
     except ImportError as e:
         raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
                         "pip install 'singcheck[html]'") from None
-    from singcheck import api
-
-    reports = [api.check(machine, s, regions=False).certificate for s in specs]
-    return write_html(reports, os.path.join(out_dir, "singcheck.html"))
+    return write_html(certificates, os.path.join(out_dir, "singcheck.html"))
 
 
 @cli.command(epilog="""\b
@@ -437,8 +449,14 @@ Examples:
 @click.option("--slice", "slices", multiple=True, metavar="AXIS=VALUE",
               help="For --regions: fix an axis to an exact rational (repeatable); a pose "
               "axis slices the workspace, a joint the joint space.")
+@click.option("--time-limit", type=click.FloatRange(min=0, min_open=True), default=300,
+              show_default=True,
+              help="Seconds allowed to each trajectory's certification and to each region "
+              "analysis; past it that figure is not drawn and the command ends with exit "
+              "3, unknown: time limit.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
-def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> None:
+def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, time_limit,
+         quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
     and the working modes in joint space with the joint-limit box (PNG and SVG); when
@@ -451,21 +469,27 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, quiet) -> N
     with exit_codes():
         if not trajectories and not spaces:
             raise click.UsageError("give at least one TRAJECTORY, or --regions SPACE")
+        complete = True
         for space, own in _slices_by_space(robot, spaces, slices).items():
-            for path in _plot_regions(space, robot, own, backend, out_dir, progress):
+            paths = _plot_regions(space, robot, own, backend, out_dir, progress, time_limit)
+            complete &= paths is not None
+            for path in paths or []:
                 click.echo(str(path))
-        if not trajectories:
-            return
-        from singcheck import api
-        from singcheck.spec.files import load_trajectory
+        if trajectories:
+            from singcheck import api
+            from singcheck.spec.files import load_trajectory
 
-        machine = api.load_robot(robot, backend, notify=progress.note)
-        specs = [load_trajectory(p, machine.spec) for p in trajectories]
-        if fmt == "html":
-            click.echo(str(_plot_html(machine, specs, out_dir)))
-            return
-        for path in _plot_all(machine, specs, 1e-9, out_dir, progress):
-            click.echo(str(path))
+            machine = api.load_robot(robot, backend, notify=progress.note)
+            specs = [load_trajectory(p, machine.spec) for p in trajectories]
+            certificates = _certificates(machine, specs, time_limit)
+            complete &= len(certificates) == len(specs)
+            if fmt == "html":
+                click.echo(str(_plot_html(certificates, out_dir)))
+            else:
+                for path in _plot_all(certificates, out_dir, progress):
+                    click.echo(str(path))
+    if not complete:
+        sys.exit(int(ExitCode.UNKNOWN))
 
 
 #: The optional extras: the modules each needs, and the package that provides each.
@@ -519,7 +543,11 @@ def _slices_by_space(robot, spaces, slices) -> dict[str, list[str]]:
     return out
 
 
-def _plot_regions(space, robot, slices, backend, out_dir, progress) -> list:
+def _plot_regions(space, robot, slices, backend, out_dir, progress,
+                  time_limit: float) -> list | None:
+    """The region figure of ``space`` (its paths), or None (noted on stderr) when the
+    analysis runs past ``time_limit`` seconds."""
+    from singcheck.budget import TimeLimitExceeded
     from singcheck.cli.spaces import compute
     from singcheck.spaces.analysis import SliceError
 
@@ -530,9 +558,13 @@ def _plot_regions(space, robot, slices, backend, out_dir, progress) -> list:
                         "pip install 'singcheck[plot]'") from None
     try:
         analysis, _ = compute(space, robot, slices, "auto", False, backend, 600, False,
-                              progress)
+                              progress, time_limit)
     except SliceError as e:
         raise click.BadParameter(str(e), param_hint="--slice") from None
+    except TimeLimitExceeded as e:
+        click.echo(f"singcheck: unknown: {e} (the {space} regions; --time-limit): no "
+                   "figure", err=True)
+        return None
     if len(analysis.axes) != 2:
         raise click.BadParameter(f"the {space} has {len(analysis.axes)} free axes; fix all "
                                  "but two with --slice", param_hint="--slice")

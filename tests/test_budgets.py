@@ -222,3 +222,22 @@ def test_plot_states_its_time_limit():
 
     text = CliRunner().invoke(plot, ["--help"], terminal_width=100).output
     assert "--time-limit" in text and "exit 3" in text
+
+
+@pytest.mark.parametrize("plain", [True, False])
+def test_reading_a_large_polynomial_stops_at_the_time_limit(plain):
+    """A cached ξ of many terms is read by a Python loop: it checks the deadline, so an
+    expired limit stops it (both readers: the cache's own form and the general one)."""
+    from flint import fmpq_mpoly_ctx
+
+    from singcheck.budget import TimeLimitExceeded, deadline
+    from singcheck.elimination.cas.polytext import CHECK_EVERY, parse_polynomial
+
+    ctx = fmpq_mpoly_ctx.get(("x", "y"), "lex")
+    sep = "+" if plain else " + "
+    text = sep.join(f"{k}*v1^{k}*v2" for k in range(1, 3 * CHECK_EVERY))
+    assert parse_polynomial(text, ctx).coeffs()[-1] == 1  # reads whole without a limit
+    with deadline(1e-9):
+        time.sleep(1e-3)
+        with pytest.raises(TimeLimitExceeded):
+            parse_polynomial(text, ctx)

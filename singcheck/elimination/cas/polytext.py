@@ -23,6 +23,8 @@ import re
 
 from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
 
+from singcheck.budget import checkpoint
+
 _TOKEN = re.compile(r"\s*(?:([0-9]+)|(v)([0-9]+)|([-+*/^()]))")
 #: Bounds on what a CAS may print (its output is untrusted): the digits of one integer
 #: in a coefficient, and an exponent.  Real results are far below both (the stacked
@@ -55,7 +57,11 @@ def format_polynomial(p: fmpq_mpoly) -> str:
 def _tokens(text: str):
     pos = 0
     n = len(text)
+    count = 0
     while pos < n:
+        count += 1
+        if count % (4 * CHECK_EVERY) == 0:
+            checkpoint()
         m = _TOKEN.match(text, pos)
         if not m or m.end() == pos:
             if text[pos:].strip() == "":
@@ -91,7 +97,11 @@ def parse_polynomial(text: str, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
 
     if not toks:
         raise PolynomialSyntaxError("empty polynomial")
+    read = 0
     while i < len(toks):
+        read += 1
+        if read % CHECK_EVERY == 0:
+            checkpoint()  # a large polynomial (a cached ξ) is read within the time limit
         sign = 1
         kind, _ = peek()
         if kind in ("+", "-"):
@@ -135,6 +145,9 @@ def parse_polynomial(text: str, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
     return from_terms(ctx, {k: v for k, v in terms.items() if v != 0})
 
 
+#: terms read between two checks of the time limit
+CHECK_EVERY = 2048
+
 #: one term of :func:`format_polynomial`'s own form: ``±n[/m]*v_i[^e]*…`` without spaces
 #: or parentheses (possessive quantifiers: no backtracking)
 _PLAIN_TERM = re.compile(r"([-+]?)(?:([0-9]++)(?:/([0-9]++))?(\*)?)?"
@@ -151,7 +164,11 @@ def _parse_plain(text: str, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly | None:
     nvars = ctx.nvars()
     terms: dict[tuple[int, ...], fmpq] = {}
     pos, n = 0, len(text)
+    read = 0
     while pos < n:
+        read += 1
+        if read % CHECK_EVERY == 0:
+            checkpoint()  # a large polynomial (a cached ξ) is read within the time limit
         m = _PLAIN_TERM.match(text, pos)
         sign, num, den, star, factors = m.groups()
         if m.end() == pos or (pos and not sign) or (num is None and factors is None) or \

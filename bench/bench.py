@@ -33,6 +33,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 
 from contender import contender  # noqa: E402
 from generate import waypoints_yaml, write, write_stream  # noqa: E402
+from peak_rss import run_measured  # noqa: E402
 
 from singcheck.certify.classification import certify_path  # noqa: E402
 from singcheck.certify.path import build_path  # noqa: E402
@@ -315,23 +316,22 @@ def cli_rows() -> list[dict]:
 
 def _timed_run(cmd: list[str], stdin_path: Path, env: dict) -> dict:
     """One singcheck process: wall time, the jsonl lines it streamed, its verdicts, and
-    the CPU seconds and peak resident memory of it and its forked workers (wait4's
-    rusage; a Dask cluster's workers are not its children: their CPU is not counted)."""
+    the CPU seconds and peak resident memory of it and its forked workers (measured from
+    a small launcher, bench/peak_rss.py: a child of this big process would report at
+    least this process's size; a Dask cluster's workers are not its children: their CPU
+    is not counted)."""
     with stdin_path.open("rb") as stdin, tempfile.TemporaryFile() as out:
         start = time.perf_counter()
-        proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdin=stdin, stdout=out,
-                                stderr=subprocess.DEVNULL)
-        _, status, usage = os.wait4(proc.pid, 0)
+        code, peak_mb, cpu = run_measured(cmd, cwd=ROOT, env=env, stdin=stdin, stdout=out,
+                                          stderr=subprocess.DEVNULL)
         wall = time.perf_counter() - start
-        proc.returncode = os.waitstatus_to_exitcode(status)
         out.seek(0)
         verdicts: dict[str, int] = {}
         for line in out:
             v = json.loads(line)["verdict"]
             verdicts[v] = verdicts.get(v, 0) + 1
-    return {"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime,
-            "exit_code": proc.returncode, "verdicts": verdicts,
-            "peak_rss_mb": usage.ru_maxrss / 1024}
+    return {"wall_s": wall, "cpu_s": cpu, "exit_code": code, "verdicts": verdicts,
+            "peak_rss_mb": peak_mb}
 
 
 BATCH_COUNTS = tuple(int(n) for n in os.environ.get("BENCH_BATCH", "1000,10000").split(","))

@@ -241,3 +241,21 @@ def test_reading_a_large_polynomial_stops_at_the_time_limit(plain):
         time.sleep(1e-3)
         with pytest.raises(TimeLimitExceeded):
             parse_polynomial(text, ctx)
+
+
+def test_a_six_axis_workspace_is_decomposed_once_sliced_to_three(tmp_path, monkeypatch,
+                                                                 capsys, cache_env):  # noqa: F811
+    """The stacked Orthoglide's 6-D workspace is refused up front (one line, exit 2,
+    naming --slice); with three axes sliced it is a 3-D decomposition like any other,
+    bounded by --time-limit."""
+    robot = str(ROBOTS / "stacked-orthoglide.yaml")
+    code, out, err = run_cli(monkeypatch, capsys, "workspace", robot, "--backend", "flint",
+                             "-q")
+    assert code == 2 and "6 free axes" in err and "--slice" in err, err
+    assert err.count("\n") == 1 and out == ""
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, "workspace", robot, "--backend", "flint",
+                             "-q", "--time-limit", "1", "--slice", "x2=0", "--slice", "y2=0",
+                             "--slice", "z2=0")
+    assert code == 3 and "unknown: time limit (1 s)" in err, err
+    assert time.monotonic() - start < 15  # the projection (cached after) and the limit

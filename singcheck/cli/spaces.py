@@ -111,6 +111,7 @@ def _compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, bac
         LIMIT,
         WORKSPACE,
         analyse,
+        check_free_axes,
         jointspace_variety,
         select_surfaces,
     )
@@ -120,6 +121,7 @@ def _compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, bac
     model = build_model(load_robot(robot))
     engine = elimination_engine(backend, timeout, not no_cache, progress.note)
     axes = model.pose if space == WORKSPACE else model.joints
+    check_free_axes(model, space, fixed)  # before the work, not after the projection
     with progress.status(f"computing the discriminant variety of the {space}"):
         if space == WORKSPACE:
             from singcheck.spaces.analysis import workspace_variety

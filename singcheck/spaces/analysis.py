@@ -95,13 +95,20 @@ MAX_AXES = 3
 
 def space_chart(model: RobotModel, space: str) -> Chart:
     """The axes of the space: the pose or the joints, each angle v as tan(v/2)."""
+    return Chart.of(model.pose if space == WORKSPACE else model.joints, model.angles)
+
+
+def check_free_axes(model: RobotModel, space: str, fixed=()) -> None:
+    """Refuse up front a decomposition of more than :data:`MAX_AXES` free axes (those
+    left once the ``fixed`` axes are sliced): a 6-D pose needs three slices."""
     names = model.pose if space == WORKSPACE else model.joints
-    if len(names) > MAX_AXES:
+    free = [n for n in names if n not in fixed]
+    if len(free) > MAX_AXES:
         raise UnsupportedRobotError(
-            f"the {space} of {model.name} has {len(names)} axes ({', '.join(names)}): too "
-            f"many variables for a cylindrical decomposition (at most {MAX_AXES}); "
-            "`singcheck run` still certifies its paths", path=model.spec.path)
-    return Chart.of(names, model.angles)
+            f"the {space} of {model.name} has {len(free)} free axes ({', '.join(free)}): "
+            f"too many variables for a cylindrical decomposition (at most {MAX_AXES}); "
+            "fix some with --slice; `singcheck run` still certifies its paths",
+            path=model.spec.path)
 
 
 def workspace_variety(projection: RobotProjection,
@@ -341,6 +348,7 @@ def analyse(space: str, model: RobotModel, components: list[VarietyComponent],
     be among ``components``): every real solution counts.
     """
     fixed = dict(fixed or {})
+    check_free_axes(model, space, fixed)
     chart = space_chart(model, space)
     axes = chart.axes
     if not model.polynomial:

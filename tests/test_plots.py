@@ -76,3 +76,17 @@ def test_html_page_is_self_contained_and_holds_every_figure(tmp_path):
     assert "<script src=" not in page.replace('<script src="data', "")  # JS inlined
     assert "s3 real" in page and "s1 spurious" in page
     assert (tmp_path / "singcheck.html").stat().st_mode & 0o044  # readable by others
+
+
+def test_region_figure_names_need_no_quoting_in_a_shell(tmp_path):
+    """A slice of an angle axis, tan(phi/2) = 1/2, names its figure files with letters,
+    digits, '.', '_', '-' and '=' only (no parentheses or slashes)."""
+    import re
+
+    out = singcheck("plot", str(HERE.parent / "robots" / "3-rpr.yaml"), "--regions",
+                    "workspace", "--slice", "tan(phi/2)=1/2", "--out", str(tmp_path),
+                    "--backend", "flint", "-q")
+    assert out.returncode == 0, out.stderr
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert names == ["3-rpr-workspace-tan-phi_2=1_2.png", "3-rpr-workspace-tan-phi_2=1_2.svg"]
+    assert all(re.fullmatch(r"[A-Za-z0-9._=-]+", n) for n in names)

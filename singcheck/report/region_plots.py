@@ -195,7 +195,7 @@ def write_region_figure(analysis: SpaceAnalysis, out_dir: str | Path,
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     stem = f"{analysis.robot}-{analysis.space}" + "".join(
-        f"-{k}={v}".replace("/", "_") for k, v in analysis.fixed.items())
+        f"-{_file_safe(k)}={_file_safe(v)}" for k, v in analysis.fixed.items())
     written = []
     for fmt in formats:
         target = out / f"{stem}.{fmt}"
@@ -204,3 +204,10 @@ def write_region_figure(analysis: SpaceAnalysis, out_dir: str | Path,
         written.append(target)
     plt.close(fig)
     return written
+
+
+def _file_safe(text) -> str:
+    """An axis or value as a file-name part a shell takes unquoted: tan(phi/2) -> tan-phi_2,
+    1/2 -> 1_2 (letters, digits, '.', '_', '-' only)."""
+    out = str(text).replace("/", "_").replace("(", "-").replace(")", "")
+    return "".join(c if c.isalnum() or c in "._-" else "_" for c in out)

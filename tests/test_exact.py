@@ -764,3 +764,33 @@ def test_five_bar_elbows_sitting_on_their_limits_all_along_are_feasible_and_sing
     assert all(m.status != "unknown" for m in report.modes)
     assert report.verdict == "singular" and "whole path" in report.reason
     assert {m for c in report.candidates for m in c.singular_modes} == zero
+
+
+@pytest.mark.parametrize("scale, start, end, tau, kind", [
+    ("1 - (t - 1/2)^2/4", "0", "1", Fraction(1, 2), "touches"),  # |X| ≤ 2, = 2 at 1/2
+    ("3/4 + t/2", "0", "1", Fraction(1, 2), "crosses"),  # radial: |X| = 2 at t = 1/2
+])
+def test_the_workspace_line_tells_a_tangency_from_a_crossing(scale, start, end, tau, kind):
+    """The path meets the sphere |X| = 2 (a component of ξ) once, at t = 1/2: the sign of
+    4 - |X(t)|², computed here exactly on either side, says whether it crosses or only
+    touches; the workspace line must say the same (and never 'crosses' for a touch)."""
+    from singcheck.report.trajectory import workspace_json, workspace_line
+    from singcheck.spaces.path_regions import XI, path_in_workspace
+
+    cert = certify(orthoglide("-1"), trajectory(start, end, **along(X0_TEXT, scale)))
+    w = path_in_workspace(cert.path, name_region=False)
+    (meeting,) = [c for c in w.crossings if XI in c.surfaces]
+    assert meeting.t.contains(float(tau))  # 1/2: exact as a float
+
+    def slack(t: Fraction) -> Fraction:  # 4 - |X(t)|², X = scale(t)·X0, |X0| = 2
+        s = 1 - (t - Fraction(1, 2)) ** 2 / 4 if kind == "touches" else Fraction(3, 4) + t / 2
+        return 4 - 4 * s * s
+
+    before, after = slack(tau - Fraction(1, 100)), slack(tau + Fraction(1, 100))
+    assert (before * after > 0) == (kind == "touches")
+    assert meeting.kind == kind
+    line = workspace_line(workspace_json(w))
+    if kind == "touches":
+        assert "crosses" not in line and "touching it 1" in line, line
+    (item,) = [c for c in workspace_json(w)["crossings"] if XI in c["surfaces"]]
+    assert item["kind"] == kind

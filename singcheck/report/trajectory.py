@@ -119,8 +119,8 @@ def workspace_json(w) -> dict[str, Any]:
     return {
         "one_region": w.one_region,
         "region": w.region,
-        "crossings": [{"t_interval": _interval(c.t), "surfaces": list(c.surfaces)}
-                      for c in w.crossings],
+        "crossings": [{"t_interval": _interval(c.t), "surfaces": list(c.surfaces),
+                       "kind": c.kind} for c in w.crossings],
         "ik_counts": [s.count for s in w.stretches],
         "exit_time_interval": None if w.exit_time is None else _interval(w.exit_time),
         "undecided": w.undecided,
@@ -128,6 +128,20 @@ def workspace_json(w) -> dict[str, Any]:
                         for surface, where in w.on_surfaces],
         **({"region_not_named": w.region_reason} if w.region_reason else {}),
     }
+
+
+def _meets(crossings: list[dict[str, Any]]) -> str:
+    """"crosses the discriminant variety 4 time(s)", or, when some meeting is a proven
+    tangency or not judged, "meets … (crossing it 1, touching it 1, 1 not judged)"."""
+    n = len(crossings)
+    kinds = [c.get("kind") for c in crossings]
+    if all(k == "crosses" for k in kinds):
+        return f"crosses the discriminant variety {n} time(s)"
+    parts = [f"{verb} it {kinds.count(kind)}" for verb, kind in
+             (("crossing", "crosses"), ("touching", "touches")) if kind in kinds]
+    if None in kinds:
+        parts.append(f"{kinds.count(None)} not judged (a range end, or signs not proven)")
+    return f"meets the discriminant variety {n} time(s) ({', '.join(parts)})"
 
 
 def workspace_line(w: dict[str, Any]) -> str:
@@ -144,9 +158,8 @@ def workspace_line(w: dict[str, Any]) -> str:
         if not w["crossings"]:
             return text + (f" ({counts[0]} IK solution(s) inside the joint limits all along)"
                            if counts and counts[0] is not None else "")
-        return text + (f"; it crosses the discriminant variety {len(w['crossings'])} "
-                       "time(s); IK solutions inside the limits along it: "
-                       + " → ".join("?" if c is None else str(c) for c in counts))
+        return text + (f"; it {_meets(w['crossings'])}; IK solutions inside the limits "
+                       "along it: " + " → ".join("?" if c is None else str(c) for c in counts))
     if w["one_region"]:
         where = f"region {w['region']}" if w["region"] else "one region of the workspace"
         text = (f"workspace: the whole path lies in {where} "
@@ -154,9 +167,8 @@ def workspace_line(w: dict[str, Any]) -> str:
         if w.get("region_not_named"):
             text += f"; {w['region_not_named']}"
         return text
-    text = (f"workspace: the path crosses the discriminant variety {len(w['crossings'])} "
-            f"time(s); IK solutions inside the limits along it: "
-            + " → ".join("?" if c is None else str(c) for c in counts))
+    text = (f"workspace: the path {_meets(w['crossings'])}; IK solutions inside the limits "
+            "along it: " + " → ".join("?" if c is None else str(c) for c in counts))
     if w["exit_time_interval"]:
         lo, hi = w["exit_time_interval"]
         text += f"; it leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"

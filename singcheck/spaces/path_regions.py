@@ -34,7 +34,7 @@ from flint import acb, arb
 
 from singcheck.algebra.intervals import fraction_ball, working_precision
 from singcheck.algebra.polynomials import constant_value
-from singcheck.algebra.radicals import cos_pi, sin_pi
+from singcheck.algebra.radicals import cos_pi, evaluate_path, sin_pi
 from singcheck.algebra.trig import uses_t, uses_trig
 from singcheck.budget import checkpoint
 from singcheck.certify.path import PathModel, compose_pose
@@ -49,8 +49,12 @@ _PRECISIONS = (53, 128, 384)
 
 @dataclass(frozen=True)
 class Crossing:
+    """Where the path meets the variety: ``kind`` is "crosses" when some surface's sign
+    is proven to differ on the two sides, "touches" when every surface met there is
+    proven to keep its sign (a tangency), None when not decided (or at a range end)."""
     t: arb
     surfaces: tuple[str, ...]
+    kind: str | None = None
 
 
 @dataclass(frozen=True)
@@ -174,11 +178,46 @@ def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: boo
     crossings, undecided, on = _crossings(path, tolerance, mu_roots)
     points = gap_points(path.trajectory.range, [c.t for c in crossings])
     stretches = [Stretch(p, ik_count_at(path, p)) for p in points]
+    crossings = _crossing_kinds(path, crossings, stretches)
     result = PathInWorkspace(crossings, stretches, undecided, on_surfaces=on)
     result.exit_time = _exit_time(result)
     if name_region and result.one_region:
         _name_region(result, path, region_cache, notify)
     return result
+
+
+def _crossing_kinds(path: PathModel, crossings: list[Crossing],
+                    stretches: list[Stretch]) -> list[Crossing]:
+    """Each crossing with its kind, from the signs of its surfaces at the exact points
+    of the stretches on either side (ball signs; a sign not proven leaves it None).
+    Only a crossing with a stretch on both sides and each surface met once is judged."""
+    polys = dict(path_surfaces(path))
+    timeline = sorted([*crossings, *stretches], key=lambda x: float(
+        (x.t if isinstance(x, Crossing) else x.point).mid()))
+    out = []
+    for j, item in enumerate(timeline):
+        if not isinstance(item, Crossing):
+            continue
+        kind = None
+        if 0 < j < len(timeline) - 1 and isinstance(timeline[j - 1], Stretch) and \
+                isinstance(timeline[j + 1], Stretch) and \
+                len(set(item.surfaces)) == len(item.surfaces):
+            kind = _kind(polys, item.surfaces, timeline[j - 1].point, timeline[j + 1].point)
+        out.append(Crossing(item.t, item.surfaces, kind))
+    return out
+
+
+def _kind(polys: dict, surfaces: tuple[str, ...], left: arb, right: arb) -> str | None:
+    signs = []
+    for label in surfaces:
+        checkpoint()
+        a, b = evaluate_path(polys[label], left), evaluate_path(polys[label], right)
+        sa = 1 if a > 0 else -1 if a < 0 else 0
+        sb = 1 if b > 0 else -1 if b < 0 else 0
+        if sa * sb < 0:
+            return "crosses"
+        signs.append(sa * sb)
+    return "touches" if all(x > 0 for x in signs) else None
 
 
 def _name_region(result: PathInWorkspace, path: PathModel, cache, notify) -> None:
@@ -242,7 +281,7 @@ def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
                for surface, _ in w.on_surfaces]
         own = sorted([*w.crossings, *w.stretches],
                      key=lambda x: float((x.t if isinstance(x, Crossing) else x.point).mid()))
-        own = [Crossing(piece.to_global(x.t), x.surfaces) if isinstance(x, Crossing)
+        own = [Crossing(piece.to_global(x.t), x.surfaces, x.kind) if isinstance(x, Crossing)
                else Stretch(piece.to_global(x.point), x.count) for x in own]
         if items and own:
             at = piece.global_range.start

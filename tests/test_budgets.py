@@ -12,7 +12,12 @@ import pytest
 
 from singcheck import api
 from tests.conftest import ROBOTS
-from tests.test_hardening import cache_env, run_cli, trajectory  # noqa: F401
+from tests.test_hardening import (  # noqa: F401
+    BIG_CONSTANT,
+    cache_env,
+    run_cli,
+    trajectory,
+)
 
 STACKED = ROBOTS / "stacked-orthoglide.yaml"
 #: each coordinate a cube: ξ (57,855 terms) composed with it took 4 s of CPU in one
@@ -95,16 +100,6 @@ def test_a_composition_beyond_the_work_bound_is_refused_up_front(stacked, tmp_pa
 
 
 # -- workspace and joint space ------------------------------------------------------------
-
-BIG_CONSTANT = """\
-name: big
-joints: [p, q]
-pose: [x, y]
-constraints:
-  - (x - p)^2 + y^2 - 4
-  - (x - q)^2 + y^2 - (2147483648-364349)^8
-joint_limits: {p: [-4, 4], q: [-4, 4]}
-"""
 
 
 @pytest.mark.parametrize("space, robot", [("workspace", "orthoglide"),

@@ -939,3 +939,19 @@ def test_a_triple_root_at_t_0_of_the_half_angle_polynomial(tmp_path, monkeypatch
     assert len(intervals) == 3
     for (lo, hi), root in zip(intervals, (0.0, math.pi, 2 * math.pi), strict=True):
         assert lo <= root <= hi and hi - lo < 1e-8
+
+
+def test_an_angle_with_a_huge_multiple_of_t_is_refused(tmp_path, monkeypatch, capsys,
+                                                       cache_env):
+    """Found by the campaign: the 3-PRR's angle phi = -t/1e-49 (an integer multiple of t
+    of 50 digits) reached FLINT's Chebyshev polynomial of that degree (OverflowError, an
+    internal error). It gets the bound of sin(k*t) in a coordinate: exit 2, one line."""
+    spec = trajectory(tmp_path, {"x": "1", "y": "0",
+                                 "phi": "-t / 0." + "0" * 48 + "1"})
+    code, out, err = run_cli(monkeypatch, capsys, "run", str(ROBOTS / "3-prr.yaml"), spec,
+                             "-q", "--backend", "flint", "--format", "json")
+    assert code == 2, err
+    (doc,) = json.loads(out)["trajectories"]
+    assert doc["verdict"] == "error"
+    assert "multiple of t above 256" in doc["reason"] and "pose.phi" in doc["reason"]
+    assert "OverflowError" not in out + err

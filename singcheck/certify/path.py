@@ -63,6 +63,7 @@ from singcheck.model.robot import (
     leg_discriminant,
 )
 from singcheck.spec.files import TrajectorySpec
+from singcheck.spec.grammar import MAX_DEGREE
 
 
 def _reduce(p: fmpq_mpoly) -> fmpq_mpoly:
@@ -604,7 +605,14 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
                 primes |= cos_l.primes() | sin_l.primes()
     functions = []
     for v, x in zip(model.pose, phi, strict=True):
-        if v in model.angles and _angle_k(x, offsets.get(v, 0)) is None:
+        k = _angle_k(x, offsets.get(v, 0)) if v in model.angles else None
+        if k is not None and abs(k) > MAX_DEGREE:
+            raise SpecError(f"the angle {v} is {k:.3g}*t: cos and sin of a multiple of t "
+                            f"above {MAX_DEGREE} are not supported (the bound of sin(k*t) "
+                            "in a coordinate)", path=trajectory.path,
+                            line=trajectory.lines.get(f"pose.{v}", where["line"]),
+                            key=f"pose.{v}")
+        if v in model.angles and k is None:
             if x.context() is not TRIG:
                 raise UnsupportedRobotError(
                     f"the angle {v} is neither k*t plus a multiple of pi/12 nor free of square "

@@ -254,3 +254,24 @@ def test_a_six_axis_workspace_is_decomposed_once_sliced_to_three(tmp_path, monke
                              "--slice", "z2=0")
     assert code == 3 and "unknown: time limit (1 s)" in err, err
     assert time.monotonic() - start < 15  # the projection (cached after) and the limit
+
+
+def test_the_exact_zeros_at_multiples_of_pi_stop_at_the_time_limit():
+    """Found by the campaign: over [6.912, 2^31] the branch-and-bound tests each of the
+    683 million multiples of π for an exact zero, with no check of the time limit (a
+    fuzz case ran 15 minutes past its 2 s). Over [0, 3·10^6] (a million multiples: 2.7 s
+    past a 0.5 s deadline before, without noticing it) the deadline now stops it."""
+    from fractions import Fraction
+
+    from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
+    from singcheck.budget import TimeLimitExceeded, deadline
+    from singcheck.roots.branch_bound import _exact_zeros
+
+    t, s, c = TRIG.gens()
+    p = t / 10 + s + 2  # never 0 at t = kπ (s = 0 there): nothing to find, all to test
+    interval = TimeRange(LinearInPi(Fraction(0), Fraction(0)),
+                         LinearInPi(Fraction(3 * 10**6), Fraction(0)))
+    start = time.monotonic()
+    with deadline(0.5), pytest.raises(TimeLimitExceeded):
+        _exact_zeros(p, interval)
+    assert time.monotonic() - start < 3

@@ -111,6 +111,7 @@ def _exact_zeros(p: fmpq_mpoly, interval: TimeRange) -> list[tuple[int, int, fmp
     start, end = float(interval.start), float(interval.end)
     out = []
     for k in range(math.floor(start / math.pi) - 1, math.ceil(end / math.pi) + 2):
+        checkpoint()  # a long range has a multiple of π every 3.14: as many exact tests
         if not vanishes_at_multiple_of_pi(p, k):
             continue
         with working_precision(128):

@@ -32,7 +32,7 @@ from fractions import Fraction
 
 from flint import acb, arb
 
-from singcheck.algebra.intervals import fraction_ball, working_precision
+from singcheck.algebra.intervals import fraction_ball, sign, working_precision
 from singcheck.algebra.polynomials import constant_value
 from singcheck.algebra.radicals import cos_pi, evaluate_path, sin_pi
 from singcheck.algebra.trig import uses_t, uses_trig
@@ -136,12 +136,13 @@ def ik_count_at(path: PathModel, t: arb) -> int | None:
 XI = "parallel singularity ξ"
 
 
-def _crossings(path: PathModel, tolerance: float, mu_roots: list[arb] | None
+def _crossings(path: PathModel, surfaces: list[tuple[str, object]], tolerance: float,
+               mu_roots: list[arb] | None
                ) -> tuple[list[Crossing], list[str], list[tuple[str, str]]]:
     interval = path.trajectory.range
     events: list[tuple[arb, str]] = []
     undecided, on = [], []
-    for label, poly in path_surfaces(path):
+    for label, poly in surfaces:
         checkpoint()
         if label == XI and mu_roots is not None:
             events += [(t, label) for t in mu_roots]
@@ -175,10 +176,11 @@ def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: boo
     where region maps are kept between runs (None: computed in this process only);
     ``notify(message)`` is told before a decomposition is computed (it takes seconds).
     """
-    crossings, undecided, on = _crossings(path, tolerance, mu_roots)
+    surfaces = path_surfaces(path)
+    crossings, undecided, on = _crossings(path, surfaces, tolerance, mu_roots)
     points = gap_points(path.trajectory.range, [c.t for c in crossings])
     stretches = [Stretch(p, ik_count_at(path, p)) for p in points]
-    crossings = _crossing_kinds(path, crossings, stretches)
+    crossings = _crossing_kinds(dict(surfaces), crossings, stretches)
     result = PathInWorkspace(crossings, stretches, undecided, on_surfaces=on)
     result.exit_time = _exit_time(result)
     if name_region and result.one_region:
@@ -186,12 +188,12 @@ def path_in_workspace(path: PathModel, tolerance: float = 1e-9, name_region: boo
     return result
 
 
-def _crossing_kinds(path: PathModel, crossings: list[Crossing],
+def _crossing_kinds(polys: dict[str, object], crossings: list[Crossing],
                     stretches: list[Stretch]) -> list[Crossing]:
-    """Each crossing with its kind, from the signs of its surfaces at the exact points
-    of the stretches on either side (ball signs; a sign not proven leaves it None).
-    Only a crossing with a stretch on both sides and each surface met once is judged."""
-    polys = dict(path_surfaces(path))
+    """Each crossing with its kind, from the signs of its surfaces (``polys``: label ->
+    polynomial along the path) at the exact points of the stretches on either side (ball
+    signs; a sign not proven leaves it None).  Only a crossing with a stretch on both
+    sides and each surface met once is judged."""
     timeline = sorted([*crossings, *stretches], key=lambda x: float(
         (x.t if isinstance(x, Crossing) else x.point).mid()))
     out = []
@@ -208,16 +210,15 @@ def _crossing_kinds(path: PathModel, crossings: list[Crossing],
 
 
 def _kind(polys: dict, surfaces: tuple[str, ...], left: arb, right: arb) -> str | None:
-    signs = []
+    kept = []  # per surface: its sign proven the same on both sides
     for label in surfaces:
         checkpoint()
-        a, b = evaluate_path(polys[label], left), evaluate_path(polys[label], right)
-        sa = 1 if a > 0 else -1 if a < 0 else 0
-        sb = 1 if b > 0 else -1 if b < 0 else 0
-        if sa * sb < 0:
+        before = sign(evaluate_path(polys[label], left))
+        after = sign(evaluate_path(polys[label], right))
+        if before is not None and after is not None and before != after:
             return "crosses"
-        signs.append(sa * sb)
-    return "touches" if all(x > 0 for x in signs) else None
+        kept.append(before is not None and before == after)
+    return "touches" if all(kept) else None
 
 
 def _name_region(result: PathInWorkspace, path: PathModel, cache, notify) -> None:

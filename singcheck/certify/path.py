@@ -34,6 +34,7 @@ from singcheck.algebra.intervals import evaluate, fraction_ball
 from singcheck.algebra.polynomials import coefficient_in, memo_per_object, restrict
 from singcheck.algebra.radicals import (
     angle_function,
+    angle_function_of,
     cos_pi,
     evaluate_path,
     into_ring,
@@ -618,6 +619,11 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
                     f"the angle {v} is neither k*t plus a multiple of pi/12 nor free of square "
                     "roots: not supported", **where)
             functions.append(angle_function(x, offsets.get(v, 0)))
+    for x in phi:  # cos(g(t)), sin(g(t)) written in a coordinate (x: cos(t^2))
+        names = x.context().names()
+        functions += [(n, "sin(" + n[4:]) for n in names if n.startswith("cos(")
+                      and angle_function_of(n) is not None
+                      and (n, "sin(" + n[4:]) not in functions]
     ring = path_ring(primes, functions)
     phi = tuple(into_ring(x, ring) for x in phi)
     coordinates = []

@@ -146,12 +146,17 @@ def evaluate_trig(p: fmpq_mpoly, t: arb, tight: bool = False) -> arb:
     returned: each contains every value.
     """
     split = _split(p)
-    if isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
+    if type(split) is tuple:  # free of t: P₀(c) + s·P₁(c)
+        s, c = _sin_cos_multiple(t, 1)
+        p0, p1 = split
+        total = p0(c) if p1 is None else p0(c) + s * p1(c)
+    elif isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
         return split(t)
-    s, c = _sin_cos_multiple(t, 1)
-    total = arb(0)
-    for p0, p1 in reversed(split):
-        total = total * t + p0(c) + s * p1(c)
+    else:
+        s, c = _sin_cos_multiple(t, 1)
+        total = arb(0)
+        for p0, p1 in reversed(split):
+            total = total * t + p0(c) + s * p1(c)
     if tight and t.rad() > _WIDE:
         fourier = _fourier_value(p, t)
         if fourier is not None:  # each of the three balls holds every value: the narrowest
@@ -282,9 +287,10 @@ _SPLITS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, list]] = OrderedDict()
 _SPLITS_KEPT = 512
 
 
-def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | arb_poly:
-    """[(P₀ᵢ, P₁ᵢ) for i = 0 … deg_t p] as ball polynomials at the current precision
-    (a polynomial free of sin and cos: one ball polynomial in t)."""
+def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | tuple | arb_poly:
+    """[(P₀ᵢ, P₁ᵢ) for i = 0 … deg_t p] as ball polynomials at the current precision;
+    a polynomial free of t: the pair (P₀, P₁) itself (P₁ None when p is free of s, whose
+    term s·P₁(c) is then an exact 0); free of sin and cos: one ball polynomial in t."""
     key = (id(p), ctx.prec)
     hit = _SPLITS.get(key)
     if hit is not None and hit[0] is p:  # the entry holds p, so its id is not reused
@@ -305,6 +311,8 @@ def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | arb_poly:
     for (i, j, k), a in q.terms():
         coeffs[i][j][k] = a
     split = [tuple(arb_poly([arb(a) for a in row]) for row in by_t) for by_t in coeffs]
+    if dt == 0:
+        split = (split[0][0], split[0][1] if ds > 0 else None)
     _SPLITS[key] = (p, split)
     if len(_SPLITS) > _SPLITS_KEPT:
         _SPLITS.popitem(last=False)

@@ -198,21 +198,24 @@ class LegAlongPath:
             out = out * q + c
         return out
 
-    def branches(self, t: arb, tight: bool = False) -> dict[str, arb | acb | tuple | None]:
+    def branches(self, t: arb, tight: bool = False,
+                 discriminant: arb | None = None) -> dict[str, arb | acb | tuple | None]:
         """Enclosures of each branch's joint value for every t in the ball ``t``.
 
         A quadratic leg's branches are real where D > 0 (proven) and complex
         conjugate where D < 0; where the sign of D is not proven both are None.  A
         revolute branch is the pair (cos θ, sin θ).  ``tight`` spends more on a wide
-        ball (:func:`~singcheck.algebra.trig.evaluate_trig`)."""
+        ball (:func:`~singcheck.algebra.trig.evaluate_trig`); ``discriminant``, D's
+        enclosure over the same ball (and ``tight``) when the caller has it already."""
         if self.leg.kind != REVOLUTE and self.leg.degree == 2:
             # ρ = (-b ± √D)/(2a) needs a, b and D only: c is in D already
             a, b = (evaluate_path(c, t, tight=tight) for c in self.coefficients[:2])
             values = [a, b, None]
         else:
             values = [evaluate_path(c, t, tight=tight) for c in self.coefficients]
-        d = evaluate_path(self.discriminant, t, tight=tight) \
-            if self.discriminant is not None else None
+        d = discriminant
+        if d is None and self.discriminant is not None:
+            d = evaluate_path(self.discriminant, t, tight=tight)
         return branch_values(self.leg, values, d)
 
     def inside(self, value, limits) -> bool | None:

@@ -16,8 +16,7 @@ True
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from fractions import Fraction
 
 from flint import acb, arb, ctx, fmpq, fmpq_mpoly
@@ -91,12 +90,20 @@ def endpoints(x: arb) -> tuple[float, float]:
     return lo, hi
 
 
-@contextmanager
-def working_precision(bits: int) -> Iterator[None]:
-    """Run a block with FLINT's ball precision raised to at least ``bits``; restore after."""
-    old = ctx.prec
-    ctx.prec = max(old, int(bits))
-    try:
-        yield
-    finally:
-        ctx.prec = old
+class working_precision:  # noqa: N801 (used as a function: ``with working_precision(b):``)
+    """Run a block with FLINT's ball precision raised to at least ``bits``; restore after
+    (also on an exception).  A plain class rather than a generator context manager: it
+    is entered dozens of times per certificate, and contextlib's machinery cost more
+    than the block."""
+
+    __slots__ = ("bits", "old")
+
+    def __init__(self, bits: int) -> None:
+        self.bits = int(bits)
+
+    def __enter__(self) -> None:
+        self.old = ctx.prec
+        ctx.prec = max(self.old, self.bits)
+
+    def __exit__(self, *exc) -> None:
+        ctx.prec = self.old

@@ -22,6 +22,7 @@ from __future__ import annotations
 from collections import OrderedDict
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import cached_property
 
 from flint import (
     arb,
@@ -90,13 +91,26 @@ class LinearInPi:
     pi_coefficient: Fraction = Fraction(0)
 
     def ball(self) -> arb:
-        """A rigorous enclosure at the current working precision."""
-        return arb(fmpq(self.rational.numerator, self.rational.denominator)) + arb(
-            fmpq(self.pi_coefficient.numerator, self.pi_coefficient.denominator)
-        ) * arb.pi()
+        """A rigorous enclosure at the current working precision (remembered per number
+        and precision, outside the instance, which stays picklable: range ends are
+        asked for their balls dozens of times per certificate)."""
+        key = (id(self), ctx.prec)
+        hit = _END_BALLS.get(key)
+        if hit is None or hit[0] is not self:  # the entry holds self: its id is not reused
+            if len(_END_BALLS) > 512:
+                _END_BALLS.clear()
+            hit = _END_BALLS[key] = (self, arb(fmpq(self.rational.numerator,
+                                                    self.rational.denominator)) + arb(
+                fmpq(self.pi_coefficient.numerator, self.pi_coefficient.denominator)
+            ) * arb.pi())
+        return hit[1]
+
+    @cached_property
+    def _float(self) -> float:
+        return float(self.rational) + float(self.pi_coefficient) * 3.141592653589793
 
     def __float__(self) -> float:
-        return float(self.rational) + float(self.pi_coefficient) * 3.141592653589793
+        return self._float
 
     def __str__(self) -> str:
         parts = []
@@ -107,6 +121,9 @@ class LinearInPi:
             term = "pi" if k == 1 else "-pi" if k == -1 else f"{k}*pi"
             parts.append(term if not parts or term.startswith("-") else "+" + term)
         return "".join(parts)
+
+
+_END_BALLS: dict[tuple[int, int], tuple[LinearInPi, arb]] = {}
 
 
 @dataclass(frozen=True)

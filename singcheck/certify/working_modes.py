@@ -158,6 +158,7 @@ class _Cover:
         self.range = one_period(interval, _leg_polys(leg))
         self.retry_tight = _high_degree(leg)
         self.start = interval.start.ball()
+        self.budget = _budget(self.range)
         self._pieces: list[arb] | None = None
         self._halves: dict[int, tuple[arb, arb, arb]] = {}
         self._seen: dict[tuple[int, bool, int], list] = {}  # -> [ball, D, branches]
@@ -212,7 +213,7 @@ def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True,
     enclosures."""
     todo = cover.pieces() if cover is not None else _pieces(interval)
     halves = cover.halves if cover is not None else _halves
-    budget = _budget(interval)
+    budget = cover.budget if cover is not None else _budget(interval)
     spent = 0
     while todo:
         piece = todo.pop()

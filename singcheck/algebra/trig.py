@@ -300,37 +300,44 @@ def _chebyshev_change(n: int, part: int) -> arb_mat:
     return hit
 
 
-_SPLITS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, list]] = OrderedDict()
+#: id(p) -> (p, {precision: split}); the entry holds p, so its id is not reused
+_SPLITS: OrderedDict[int, tuple[fmpq_mpoly, dict]] = OrderedDict()
 _SPLITS_KEPT = 512
 
 
 def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | tuple | arb_poly:
     """[(P₀ᵢ, P₁ᵢ) for i = 0 … deg_t p] as ball polynomials at the current precision;
     a polynomial free of t: the pair (P₀, P₁) itself (P₁ None when p is free of s, whose
-    term s·P₁(c) is then an exact 0); free of sin and cos: one ball polynomial in t."""
-    key = (id(p), ctx.prec)
-    hit = _SPLITS.get(key)
-    if hit is not None and hit[0] is p:  # the entry holds p, so its id is not reused
-        _SPLITS.move_to_end(key)
-        return hit[1]
+    term s·P₁(c) is then an exact 0); free of sin and cos: one ball polynomial in t.
+    Memoised per polynomial and precision (the oldest polynomial dropped past
+    :data:`_SPLITS_KEPT`)."""
+    hit = _SPLITS.get(id(p))
+    if hit is not None and hit[0] is p:
+        split = hit[1].get(ctx.prec)
+        if split is not None:
+            return split
+    else:
+        hit = (p, {})
+    split = hit[1][ctx.prec] = _split_at_precision(p)
+    _SPLITS[id(p)] = hit
+    _SPLITS.move_to_end(id(p))
+    if len(_SPLITS) > _SPLITS_KEPT:
+        _SPLITS.popitem(last=False)
+    return split
+
+
+def _split_at_precision(p: fmpq_mpoly):
     q = reduce_trig(p)
     dt, ds, dc = q.degrees()
     if ds == 0 and dc == 0:
         by_t = [fmpq(0)] * (dt + 1)
         for (i, _, _), a in q.terms():
             by_t[i] = a
-        split = arb_poly(fmpq_poly(by_t))
-        _SPLITS[key] = (p, split)
-        if len(_SPLITS) > _SPLITS_KEPT:
-            _SPLITS.popitem(last=False)
-        return split
+        return arb_poly(fmpq_poly(by_t))
     coeffs = [[[fmpq(0)] * (dc + 1) for _ in range(2)] for _ in range(dt + 1)]
     for (i, j, k), a in q.terms():
         coeffs[i][j][k] = a
     split = [tuple(arb_poly([arb(a) for a in row]) for row in by_t) for by_t in coeffs]
     if dt == 0:
-        split = (split[0][0], split[0][1] if ds > 0 else None)
-    _SPLITS[key] = (p, split)
-    if len(_SPLITS) > _SPLITS_KEPT:
-        _SPLITS.popitem(last=False)
+        return (split[0][0], split[0][1] if ds > 0 else None)
     return split

@@ -355,18 +355,32 @@ class PathModel:
 
     def pose_at(self, t: arb) -> list[arb]:
         """The pose coordinates (an angle in radians, its π offset included)."""
-        out = []
-        offsets = self.trajectory.angle_offsets
-        for v, x in zip(self.projection.model.pose, self.phi, strict=True):
-            value = evaluate_path(x, t)
-            if v in offsets:
-                value += arb.pi() * fraction_ball(offsets[v])
-            out.append(value)
-        return out
+        return self.pose_and_variables_at(t)[0]
 
     def pose_variables_at(self, t: arb) -> list[arb]:
         """Balls of the model's pose variables (cos φ, sin φ for an angle)."""
         return [evaluate_path(x, t) for x in self.coordinates]
+
+    def pose_and_variables_at(self, t: arb) -> tuple[list[arb], list[arb]]:
+        """:meth:`pose_at` and :meth:`pose_variables_at` together, each polynomial
+        evaluated once: a coordinate that is not an angle is its own pose variable (the
+        same polynomial object, hence the same ball)."""
+        seen: dict[int, arb] = {}
+
+        def value(x: fmpq_mpoly) -> arb:
+            hit = seen.get(id(x))
+            if hit is None:
+                hit = seen[id(x)] = evaluate_path(x, t)
+            return hit
+
+        pose = []
+        offsets = self.trajectory.angle_offsets
+        for v, x in zip(self.projection.model.pose, self.phi, strict=True):
+            ball = value(x)
+            if v in offsets:
+                ball = ball + arb.pi() * fraction_ball(offsets[v])
+            pose.append(ball)
+        return pose, [value(x) for x in self.coordinates]
 
     def det_A(self, joints: list, pose: list[arb], signs: dict[int, int] | None = None):
         """Enclosure of det A at the given joint values (a revolute joint's as a (cos,

@@ -151,7 +151,9 @@ class _Cover:
     proof fails, and the range start.  Each ball's enclosures of a, b and D (and the
     branches made from them) are computed the first time a proof asks and then shared:
     the same enclosures of the same balls as evaluating them each time, so every proof
-    is the one it was, at a fraction of the evaluations."""
+    is the one it was, at a fraction of the evaluations.  A leg whose polynomials are
+    all constants along the path (the Orthoglide's z leg on a planar path) has the same
+    enclosures on every ball: they are computed once."""
 
     def __init__(self, leg: LegAlongPath, interval: TimeRange) -> None:
         self.leg = leg
@@ -159,6 +161,7 @@ class _Cover:
         self.retry_tight = _high_degree(leg)
         self.start = interval.start.ball()
         self.budget = _budget(self.range)
+        self.constant = all(p is None or p.is_constant() for p in _leg_polys(leg))
         self._pieces: list[arb] | None = None
         self._halves: dict[int, tuple[arb, arb, arb]] = {}
         self._seen: dict[tuple[int, bool, int], list] = {}  # -> [ball, D, branches]
@@ -177,6 +180,12 @@ class _Cover:
         return hit[1], hit[2]
 
     def _entry(self, t: arb, tight: bool) -> list:
+        if self.constant:  # one entry for every ball
+            key = (0, False, ctx.prec)
+            hit = self._seen.get(key)
+            if hit is None:
+                hit = self._seen[key] = [t, None, None]
+            return hit
         key = (id(t), tight, ctx.prec)
         hit = self._seen.get(key)
         if hit is None or hit[0] is not t:  # the entry holds t: its id is not reused
@@ -194,10 +203,9 @@ class _Cover:
         """:meth:`LegAlongPath.branches` over the ball ``t`` (D's enclosure shared)."""
         entry = self._entry(t, tight)
         if entry[2] is None:
-            d = None
-            if self.leg.discriminant is not None:
-                d = self.discriminant(t, tight)
-            entry[2] = self.leg.branches(t, tight, discriminant=d)
+            if self.leg.discriminant is not None and entry[1] is None:
+                entry[1] = evaluate_path(self.leg.discriminant, t, tight=tight)
+            entry[2] = self.leg.branches(t, tight, discriminant=entry[1])
         return entry[2]
 
 
@@ -269,11 +277,10 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
     the leg equals it (one polynomial serves both branches); ``cover`` shares the quick
     proofs' enclosures with the leg's other proofs."""
     joint = leg.leg.joint
-    bounds = f"[{limits[0]}, {limits[1]}]"
     cover = cover or _Cover(leg, interval)
     if leg.inside(cover.branches(cover.start)[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
-                                 f"{joint} is outside {bounds} from the start")
+                                 f"{joint} is outside {_bounds(limits)} from the start")
     if _everywhere(lambda t, tight: leg.inside(cover.branches(t, tight)[label], limits) is True,
                    cover.range, cover.retry_tight, cover):
         return BranchFeasibility(joint, label, FEASIBLE)
@@ -318,10 +325,15 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         if verdict is False:
             crossing = max((e for e in events if e < point), key=lambda b: b.mid(),
                            default=None)
-            reason = f"{joint} is outside {bounds} from the start" if crossing is None else \
-                f"{joint} leaves {bounds} at t ≈ {when(crossing)}"
+            reason = f"{joint} is outside {_bounds(limits)} from the start" \
+                if crossing is None else \
+                f"{joint} leaves {_bounds(limits)} at t ≈ {when(crossing)}"
             return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing)
     return BranchFeasibility(joint, label, FEASIBLE)
+
+
+def _bounds(limits) -> str:
+    return f"[{limits[0]}, {limits[1]}]"
 
 
 def _switch_polynomial(leg: LegAlongPath, value) -> object:

@@ -327,7 +327,7 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     term is g(1)) and, when it is split, one more for the right half; halving,
     2^m g(x/2), is a shift of each coefficient.
     """
-    cs = [int(c) for c in f.coeffs()]
+    cs = f.coeffs()  # FLINT integers: bit lengths and shifts as for Python ints
     n = len(cs) - 1
     if cs[-1] < 0:
         cs = [-c for c in cs]
@@ -340,7 +340,7 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
         return []  # no sign variation: no positive root (Descartes)
     spare = len(negative).bit_length() + 1 - cs[-1].bit_length()
     b = max(0, max(-(-(spare + (-c).bit_length()) // (n - i)) for i, c in negative))
-    g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)])  # g(x) = f(2^b x)
+    g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)]) if b else fmpz_poly(cs)  # f(2^b x)
     out: list[tuple[int, int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
     stack = [(g, 0, 0)]
     while stack:
@@ -408,9 +408,9 @@ def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
     out = []
     for factor, mult in factors:
         f = fmpq_poly(factor)
-        cs = [int(c) for c in factor.coeffs()]
-        shift = next(i for i, c in enumerate(cs) if c != 0)
-        if shift:  # a root at 0 (squarefree: simple)
+        cs = factor.coeffs()
+        if cs[0] == 0:  # a root at 0 (squarefree: simple)
+            shift = next(i for i, c in enumerate(cs) if c != 0)
             out.append((RationalRoot(f, fmpq(0), fmpq(0)), mult))
             factor = fmpz_poly(cs[shift:])
             f = fmpq_poly(factor)  # the other roots: f no longer vanishes at 0
@@ -420,8 +420,7 @@ def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
             out.append((RationalRoot(f, lo, hi), mult))
         if nonnegative_only:
             continue
-        mirrored = fmpz_poly([c if i % 2 == 0 else -c
-                              for i, c in enumerate(int(c) for c in factor.coeffs())])
+        mirrored = fmpz_poly([c if i % 2 == 0 else -c for i, c in enumerate(factor.coeffs())])
         for lo, hi in _positive_root_intervals(mirrored):
             out.append((RationalRoot(f, -hi, -lo), mult))
     out.sort(key=lambda item: item[0].lo)

@@ -245,13 +245,14 @@ class LegAlongPath:
         enclosure over the same ball (and ``tight``) when the caller has it already."""
         if self.leg.kind != REVOLUTE and self.leg.degree == 2:
             # ρ = (-b ± √D)/(2a) needs a, b and D only: c is in D already
-            a, b = (evaluate_path(c, t, tight=tight) for c in self.coefficients[:2])
-            values = [a, b, None]
+            coefficients = self.coefficients
+            values = [evaluate_path(coefficients[0], t, None, tight),
+                      evaluate_path(coefficients[1], t, None, tight), None]
         else:
-            values = [evaluate_path(c, t, tight=tight) for c in self.coefficients]
+            values = [evaluate_path(c, t, None, tight) for c in self.coefficients]
         d = discriminant
         if d is None and self.discriminant is not None:
-            d = evaluate_path(self.discriminant, t, tight=tight)
+            d = evaluate_path(self.discriminant, t, None, tight)
         return branch_values(self.leg, values, d)
 
     def inside(self, value, limits) -> bool | None:

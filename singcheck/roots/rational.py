@@ -340,7 +340,18 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
         return []  # no sign variation: no positive root (Descartes)
     spare = len(negative).bit_length() + 1 - cs[-1].bit_length()
     b = max(0, max(-(-(spare + (-c).bit_length()) // (n - i)) for i, c in negative))
-    g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)]) if b else fmpz_poly(cs)  # f(2^b x)
+    # A bound that is loose by a power of two costs two nodes per power (the top node
+    # split, its empty right half).  f(2^(b-1)) ≠ 0 and no sign variation of
+    # f(x + 2^(b-1)) prove no root ≥ 2^(b-1) (Descartes): the bisection then starts at
+    # the top node's left half, whose polynomial is the same up to a positive factor,
+    # so it finds exactly the same intervals.
+    f_plain = fmpz_poly(cs)
+    while b > 0:
+        shifted = f_plain(fmpz_poly([1 << (b - 1), 1])).coeffs()
+        if shifted[0] == 0 or _variations_up_to_two(shifted) != 0:
+            break
+        b -= 1
+    g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)]) if b else f_plain  # f(2^b x)
     out: list[tuple[int, int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
     stack = [(g, 0, 0)]
     while stack:

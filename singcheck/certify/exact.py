@@ -45,7 +45,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
+from flint import acb, arb, arb_poly, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 
 from singcheck.algebra.intervals import evaluate, excludes_zero, working_precision
 from singcheck.algebra.polynomials import constant_value, memo_per_object
@@ -56,7 +56,7 @@ from singcheck.certify.path import PathModel
 from singcheck.roots.enclosures import AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t
-from singcheck.roots.rational import RationalRoot, rational_ball
+from singcheck.roots.rational import RationalRoot, minimal_polynomial, rational_ball
 from singcheck.roots.transcendental import NotExact, TranscendentalPoint, TrigElements
 
 _MAX_BITS = 1 << 16
@@ -229,12 +229,13 @@ class AlgebraicPoint:
             self.f = fmpq_poly([0, 1])
             self.root = RationalRoot(self.f, fmpq(0), fmpq(0))
             return
-        rr = time.locate()
-        self.f, self.root = _minimal_polynomial(rr)
+        self.root = minimal_polynomial(time.locate())
+        self.f = self.root.poly
         if time.kind == IN_U:
             one_plus = fmpq_poly([1, 0, 1]) % self.f
             g, inverse, _ = one_plus.xgcd(self.f)  # 1 + α² ≠ 0 for a real α: g = 1
             self._inverse = (inverse / g.leading_coefficient()) % self.f
+            self._inverse_powers = [fmpq_poly([1])]  # (1 + α²)^-d for d = 0, 1, …
 
     def of(self, p: fmpq_mpoly) -> fmpq_poly:
         """A trig polynomial's value at the root, as an element of Q(α)."""
@@ -255,10 +256,10 @@ class AlgebraicPoint:
         if p.is_zero():
             return fmpq_poly([])
         m, d = half_angle_polynomial(p)
-        value = m % self.f
-        for _ in range(d):
-            value = (value * self._inverse) % self.f
-        return value
+        powers = self._inverse_powers
+        while len(powers) <= d:
+            powers.append((powers[-1] * self._inverse) % self.f)
+        return ((m % self.f) * powers[d]) % self.f
 
     def mul(self, a: fmpq_poly, b: fmpq_poly) -> fmpq_poly:
         return (a * b) % self.f
@@ -271,10 +272,7 @@ class AlgebraicPoint:
         if self.root.lo != self.root.hi:
             self.root.bisect_to(fmpq(1, 2**bits))
         alpha = rational_ball(self.root.lo, self.root.hi)
-        total = arb(0)
-        for c in reversed(a.coeffs()):
-            total = total * alpha + arb(c)
-        return total
+        return arb_poly(a)(alpha)  # coefficients rounded outward, Horner's rule in Arb
 
 
 _T_ALPHA = fmpq_mpoly_ctx.get(("t", "a"), "lex")
@@ -347,26 +345,6 @@ class PathFunctions(TrigElements):
 
 def _q(x: Fraction) -> fmpq:
     return fmpq(x.numerator, x.denominator)
-
-
-def _minimal_polynomial(rr: RationalRoot) -> tuple[fmpq_poly, RationalRoot]:
-    """The irreducible factor of ``rr.poly`` that vanishes at its isolated root.
-
-    The interval isolates one root of the squarefree polynomial, so exactly one
-    irreducible factor has a root there: the one that vanishes at a point interval, or
-    changes sign between the ends (roots of a squarefree polynomial are simple, and the
-    ends of an isolating interval are not roots).
-    """
-    _, factors = rr.poly.numer().factor()
-    for h, _e in factors:
-        f = fmpq_poly(h)
-        f = f / f.leading_coefficient()
-        if rr.lo == rr.hi:
-            if f(rr.lo) == 0:
-                return f, RationalRoot(f, rr.lo, rr.hi)
-        elif f(rr.lo) * f(rr.hi) < 0:
-            return f, RationalRoot(f, rr.lo, rr.hi)
-    raise AssertionError("no factor of an isolated root's polynomial vanishes there")
 
 
 # ---------------------------------------------------------------------------------

@@ -16,6 +16,7 @@ from fractions import Fraction
 from flint import arb, arb_poly, ctx, fmpq, fmpq_poly, fmpz_poly
 
 from singcheck.algebra.intervals import working_precision
+from singcheck.algebra.polynomials import memo_per_object
 from singcheck.budget import checkpoint
 
 
@@ -426,3 +427,118 @@ def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
             out.append((RationalRoot(f, -hi, -lo), mult))
     out.sort(key=lambda item: item[0].lo)
     return out
+
+
+# ---------------------------------------------------------------------------------
+# minimal polynomials of isolated roots, and roots of their k-th powers
+
+_FACTORS: dict = {}
+_POWERS: dict = {}
+
+
+def irreducible_factors(poly: fmpq_poly) -> list[fmpq_poly]:
+    """The monic irreducible factors of ``poly`` over Q, once per polynomial object: the
+    roots of one squarefree factor hold the same object, so the exact decisions at
+    several of its roots factor it once."""
+    def factor(p: fmpq_poly) -> list[fmpq_poly]:
+        return [fmpq_poly(h) / fmpq_poly(h).leading_coefficient()
+                for h, _ in p.numer().factor()[1]]
+    return memo_per_object(_FACTORS, poly, factor)
+
+
+def minimal_polynomial(rr: RationalRoot) -> RationalRoot:
+    """The same root on the irreducible factor of ``rr.poly`` that vanishes there (its
+    minimal polynomial, monic; the same interval).
+
+    The interval isolates one root of the squarefree polynomial, so exactly one
+    irreducible factor has a root there: the one that vanishes at a point interval, or
+    changes sign between the ends (roots of a squarefree polynomial are simple, and the
+    ends of an isolating interval are not roots).
+    """
+    for f in irreducible_factors(rr.poly):
+        if rr.lo == rr.hi:
+            if f(rr.lo) == 0:
+                return RationalRoot(f, rr.lo, rr.hi)
+        elif f(rr.lo) * f(rr.hi) < 0:
+            return RationalRoot(f, rr.lo, rr.hi)
+    raise AssertionError("no factor of an isolated root's polynomial vanishes there")
+
+
+def _power_substituted(h: fmpq_poly, k: int) -> fmpq_poly:
+    """h(u^k), one object per (h, k): its own factorisation is then shared by the roots
+    that need it."""
+    per_h = memo_per_object(_POWERS, h, lambda _: {})
+    if k not in per_h:
+        coeffs = [fmpq(0)] * (k * h.degree() + 1)
+        for i, c in enumerate(h.coeffs()):
+            coeffs[k * i] = c
+        per_h[k] = fmpq_poly(coeffs)
+    return per_h[k]
+
+
+def root_of_power(rr: RationalRoot, k: int, sign: int) -> RationalRoot:
+    """u = sign·|v|^(1/k) for the root v ≠ 0 isolated by ``rr`` (sign = the sign of v when
+    k is odd), as a root of g(u) = h(u^k), h the minimal polynomial of v, with an
+    isolating rational interval: found from v's own interval, without isolating g.
+
+    The roots of g of u's sign are the u' = sign·|v'|^(1/k) for the roots v' of h of v's
+    sign, and u' ↦ v' = u'^k is monotone there.  With [lo, hi] v's isolating interval
+    (refined off 0), rationals x₋ ≥ |e₁|^(1/k) and x₊ ≤ |e₂|^(1/k) are taken from Arb's
+    k-th roots of the end nearer 0 (e₁) and the farther one (e₂); w₋ = σ·x₋^k and
+    w₊ = σ·x₊^k (σ the sign of v) are then checked exactly to lie in [lo, hi] with h
+    non-zero of the sign h has at e₁, resp. e₂: on an isolating interval with a sign
+    change, that places w₋ strictly between e₁ and v and w₊ strictly between v and e₂.
+    So [x₋, x₊] (mirrored for sign < 0) holds exactly one root of g, u, and g, which is
+    h(σ·x^k) there, changes sign at its ends.  Otherwise ``rr`` is refined and the test
+    repeated.  A rational v with |v| a k-th power gives u exactly.
+    """
+    v = minimal_polynomial(rr)
+    g = _power_substituted(v.poly, k)
+    if v.compare(fmpq(0)) == 0:
+        raise ValueError("the k-th root of 0 is not isolated here")
+    sigma = 1 if v.lo > 0 else -1
+
+    def between(w: fmpq, end: fmpq) -> bool:  # strictly between the end and v, proven
+        return v.lo <= w <= v.hi and v.sign_at(w) == v.sign_at(end) != 0
+
+    while True:
+        checkpoint()
+        if v.lo == v.hi:  # v rational (given so, or met exactly by a bisection)
+            x_lo, x_hi = _kth_root_bracket(abs(v.lo), k)
+            break
+        near, far = (v.lo, v.hi) if sigma > 0 else (v.hi, v.lo)
+        with working_precision(64 + max(0, int(-math.log2(float(v.width()))))):
+            x_lo = arb_to_fmpq(arb(abs(near)).root(k).upper())
+            x_hi = arb_to_fmpq(arb(abs(far)).root(k).lower())
+        if 0 < x_lo < x_hi and between(sigma * x_lo**k, near) and \
+                between(sigma * x_hi**k, far):
+            break
+        v.bisect_to(v.width() / 4)
+    return RationalRoot(g, *((x_lo, x_hi) if sign > 0 else (-x_hi, -x_lo)))
+
+
+def _kth_root_bracket(w: fmpq, k: int) -> tuple[fmpq, fmpq]:
+    """w^(1/k) for a rational w > 0: a point when it is rational, else rationals
+    x₋ < x₊ with x₋^k < w < x₊^k (checked exactly)."""
+    a, b = _integer_root(int(w.p), k), _integer_root(int(w.q), k)
+    if a**k == w.p and b**k == w.q:
+        return fmpq(a, b), fmpq(a, b)
+    bits = 64
+    while True:
+        checkpoint()
+        with working_precision(bits):
+            ball = arb(w).root(k)
+            x_lo, x_hi = arb_to_fmpq(ball.lower()), arb_to_fmpq(ball.upper())
+        if 0 < x_lo and x_lo**k < w < x_hi**k:
+            return x_lo, x_hi
+        bits *= 2
+
+
+def _integer_root(n: int, k: int) -> int:
+    """⌊n^(1/k)⌋ for an integer n ≥ 1 (Newton's iteration in integers)."""
+    x = 1 << -(-n.bit_length() // k)  # above the root
+    while True:
+        y = ((k - 1) * x + n // x ** (k - 1)) // k
+        if y >= x:
+            return x
+        x = y

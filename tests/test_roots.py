@@ -360,3 +360,26 @@ def test_root_of_power_isolates_the_kth_root_among_the_roots_of_h_of_u_to_the_k(
                     else:
                         assert u.poly(u.lo) * u.poly(u.hi) < 0
     assert cases > 20
+
+
+def test_exact_isolation_of_roots_spread_over_many_octaves():
+    """Roots at 1 exactly, at dyadic points on both sides of 1, far beyond it (u = tan(t/2)
+    near t = ±π) and near 0, with complex pairs: one interval per known root, holding it
+    and no other, with a sign change at its ends (or the exact point)."""
+    from singcheck.roots.rational import real_roots_exact
+
+    roots = [Fraction(1), Fraction(4), Fraction(1, 3), Fraction(4096), Fraction(1, 4096),
+             Fraction(3, 2), Fraction(1000), Fraction(-7, 5), Fraction(-65536), Fraction(5, 4)]
+    f = fmpq_poly([1])
+    for r in roots:
+        f *= fmpq_poly([fmpq(-r.numerator, r.denominator), 1])
+    f *= fmpq_poly([2, 0, 1]) * fmpq_poly([10**6 + 1, -2000, 1])  # ±i√2, 1000 ± i
+    isolated = real_roots_exact(f)
+    assert len(isolated) == len(roots)
+    for (rr, mult), r in zip(isolated, sorted(roots), strict=True):
+        assert mult == 1
+        q = fmpq(r.numerator, r.denominator)
+        assert rr.lo <= q <= rr.hi
+        assert all(not rr.lo <= fmpq(o.numerator, o.denominator) <= rr.hi
+                   for o in roots if o != r)
+        assert (rr.lo == rr.hi == q) or rr.poly(rr.lo) * rr.poly(rr.hi) < 0

@@ -316,17 +316,15 @@ _X_PLUS_1 = fmpz_poly([1, 1])
 def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     """Isolating intervals of the positive real roots of a squarefree ``f`` with f(0) ≠ 0.
 
-    Vincent–Collins–Akritas bisection: roots are first scaled into (0, 1) by a power
-    of two above the Cauchy bound; on a dyadic interval, the number of sign variations
-    of the coefficients of (x+1)^n g(1/(x+1)) bounds the number of roots and has the
-    same parity (Descartes); 0 proves none, 1 proves exactly one (Vincent's theorem
-    makes the bisection terminate for squarefree input).  A root found exactly at a
-    bisection point is returned as a point interval; an interval whose end is such a
-    root is bisected further, so every other interval has a sign change at its ends.
-
-    Each node costs one Taylor shift by 1 in FLINT (the test polynomial, whose constant
-    term is g(1)) and, when it is split, one more for the right half; halving,
-    2^m g(x/2), is a shift of each coefficient.
+    The roots in (0, 1) are those of f there; the roots x > 1 are the 1/y for the roots
+    y in (0, 1) of the reversal y^n f(1/y) (same degree, non-zero at 0, and of the sign
+    of f(1/y) for y > 0); x = 1 is tested exactly.  Each part is isolated in (0, 1) by
+    :func:`_unit_root_intervals`; an interval [a, b] of the reversal becomes [1/b, 1/a],
+    and [0, b] becomes [1/b, B] with B a power of two above Cauchy's bound (no root at or
+    beyond it, f there of the sign the reversal has at 0).  Splitting at 1 instead of
+    bisecting down from Cauchy's bound spares the levels between the bound and the
+    roots: a root near u = 0 or u = ∞ (t near 0 or ±π) no longer costs a dozen halvings
+    for every other root.
     """
     cs = [int(c) for c in f.coeffs()]
     n = len(cs) - 1
@@ -341,8 +339,31 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
         return []  # no sign variation: no positive root (Descartes)
     spare = len(negative).bit_length() + 1 - cs[-1].bit_length()
     b = max(0, max(-(-(spare + (-c).bit_length()) // (n - i)) for i, c in negative))
-    g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)])  # g(x) = f(2^b x)
-    out: list[tuple[int, int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
+    bound = fmpq(2**b)
+    one = fmpq(1)
+    intervals = [(one, one)] if sum(cs) == 0 else []
+    intervals += _unit_root_intervals(fmpz_poly(cs))
+    for lo, hi in _unit_root_intervals(fmpz_poly(cs[::-1])):
+        intervals.append((1 / hi, 1 / lo if lo > 0 else bound))
+    return intervals
+
+
+def _unit_root_intervals(g: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
+    """Isolating intervals of the roots in (0, 1) of a squarefree ``g`` with g(0) ≠ 0.
+
+    Vincent–Collins–Akritas bisection: on a dyadic interval, the number of sign
+    variations of the coefficients of (x+1)^n g(1/(x+1)) bounds the number of roots and
+    has the same parity (Descartes); 0 proves none, 1 proves exactly one (Vincent's
+    theorem makes the bisection terminate for squarefree input).  A root found exactly
+    at a bisection point is returned as a point interval; an interval whose end is such
+    a root (or 1) is bisected further, so every other interval has a sign change at its
+    ends.
+
+    Each node costs one Taylor shift by 1 in FLINT (the test polynomial, whose constant
+    term is g(1)) and, when it is split, one more for the right half; halving,
+    2^m g(x/2), is a shift of each coefficient.
+    """
+    out: list[tuple[int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
     stack = [(g, 0, 0)]
     while stack:
         g, a, k = stack.pop()
@@ -362,11 +383,10 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
             out.append((2 * a + 1, k + 1, True))
         stack.append((half(_X_PLUS_1), 2 * a + 1, k + 1))
         stack.append((half, 2 * a, k + 1))
-    scale = fmpq(2**b)
     intervals = []
     for a, k, exact in out:
-        lo = scale * fmpq(a, 2**k)
-        intervals.append((lo, lo) if exact else (lo, scale * fmpq(a + 1, 2**k)))
+        lo = fmpq(a, 2**k)
+        intervals.append((lo, lo) if exact else (lo, fmpq(a + 1, 2**k)))
     return intervals
 
 

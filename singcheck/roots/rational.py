@@ -319,33 +319,42 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     The roots in (0, 1) are those of f there; the roots x > 1 are the 1/y for the roots
     y in (0, 1) of the reversal y^n f(1/y) (same degree, non-zero at 0, and of the sign
     of f(1/y) for y > 0); x = 1 is tested exactly.  Each part is isolated in (0, 1) by
-    :func:`_unit_root_intervals`; an interval [a, b] of the reversal becomes [1/b, 1/a],
-    and [0, b] becomes [1/b, B] with B a power of two above Cauchy's bound (no root at or
-    beyond it, f there of the sign the reversal has at 0).  Splitting at 1 instead of
-    bisecting down from Cauchy's bound spares the levels between the bound and the
-    roots: a root near u = 0 or u = ∞ (t near 0 or ±π) no longer costs a dozen halvings
-    for every other root.
+    :func:`_unit_root_intervals`; an interval [a, b] of the reversal becomes [1/b, 1/a]
+    ([0, b] is first narrowed off 0, :func:`_off_zero`).  Splitting at 1 instead of
+    bisecting down from a bound on the roots spares the levels between the bound and
+    the roots: a root near u = 0 or u = ∞ (t near 0 or ±π) no longer costs a dozen
+    halvings for every other root.
     """
     cs = [int(c) for c in f.coeffs()]
-    n = len(cs) - 1
     if cs[-1] < 0:
         cs = [-c for c in cs]
-    # Cauchy's bound for the positive roots: with a_n > 0 and λ negative coefficients,
-    # every positive root x has x^(n-i) <= λ|a_i|/a_n for some a_i < 0 (otherwise a_n x^n
-    # outweighs every negative term).  Bounded with bit lengths (|a| < 2^bitlen,
-    # a_n >= 2^(bitlen-1)), so every positive root is < 2^b strictly.
-    negative = [(i, c) for i, c in enumerate(cs[:-1]) if c < 0]
-    if not negative:
+    if all(c >= 0 for c in cs):
         return []  # no sign variation: no positive root (Descartes)
-    spare = len(negative).bit_length() + 1 - cs[-1].bit_length()
-    b = max(0, max(-(-(spare + (-c).bit_length()) // (n - i)) for i, c in negative))
-    bound = fmpq(2**b)
     one = fmpq(1)
     intervals = [(one, one)] if sum(cs) == 0 else []
     intervals += _unit_root_intervals(fmpz_poly(cs))
-    for lo, hi in _unit_root_intervals(fmpz_poly(cs[::-1])):
-        intervals.append((1 / hi, 1 / lo if lo > 0 else bound))
+    reversal = fmpz_poly(cs[::-1])
+    for lo, hi in _unit_root_intervals(reversal):
+        if lo == 0:
+            lo, hi = _off_zero(fmpq_poly(reversal), hi)
+        intervals.append((1 / hi, 1 / lo))
     return intervals
+
+
+def _off_zero(g: fmpq_poly, hi: fmpq) -> tuple[fmpq, fmpq]:
+    """An isolating interval [lo, hi'] with lo > 0 for the one root y of g in (0, hi),
+    where g(0) > 0 > g(hi) (the reversal's largest-x root): hi is halved while g stays
+    negative there (exact signs); the first point where g > 0 is lo (a point where g = 0
+    is the root itself).  It ends once hi/2 falls below y > 0."""
+    while True:
+        checkpoint()
+        mid = hi / 2
+        value = g(mid)
+        if value == 0:
+            return mid, mid
+        if value > 0:
+            return mid, hi
+        hi = mid
 
 
 def _unit_root_intervals(g: fmpz_poly) -> list[tuple[fmpq, fmpq]]:

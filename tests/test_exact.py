@@ -923,3 +923,51 @@ def test_a_limit_polynomial_is_decided_exactly_at_its_conjugates_root():
     assert root.t.contains(float(2 - mpmath.sqrt(3)))
     assert vanishes_at_root(t * t - 2 * r3 * t - 1, root) is False
     assert vanishes_at_root(t * t + 2 * r3 * t - 1, root) is True
+
+
+def test_rotary_delta_legs_2_and_3_on_their_limit_at_a_transcendental_time():
+    # y = t - cos t is 0 at the Dottie number τ; at (-3/2, 0, -1/2) legs 2 and 3 (each
+    # the other's √3-conjugate) both have a branch on th = -π/2: each limit polynomial
+    # and its conjugate vanish at τ, decided exactly in Q(τ, sin τ, cos τ)(√3)
+    from tests.robot_oracles import rotary_delta
+
+    def pose_at(t):
+        return [-mpmath.mpf(3) / 2, t - mpmath.cos(t), -mpmath.mpf(1) / 2]
+
+    path = _revolute_path("rotary-delta", trajectory("0", "1", x="-3/2", y="t - cos(t)",
+                                                     z="-1/2"))
+    mpmath.mp.dps = 50
+    oracle = rotary_delta()
+    modes = _oracle_modes(path, oracle, pose_at, Fraction(1, 3))
+    tau = mpmath.findroot(lambda t: t - mpmath.cos(t), 0.7)
+    eps = mpmath.mpf("1e-6")
+    report = certify_path(path)
+    assert all(m.status != "unknown" for m in report.modes)
+
+    def offset(theta):  # θ + π/2 taken in (-π, π]
+        return (theta + mpmath.pi / 2 + mpmath.pi) % (2 * mpmath.pi) - mpmath.pi
+
+    leaving = 0
+    for label, indices in modes.items():
+        mode = next(m for m in report.modes if m.label == label)
+        for leg in (1, 2):  # th2, th3: the branch at -π/2 at τ crosses it there
+            value = oracle.joints(indices, pose_at(tau))[leg]
+            on = abs(mpmath.sin((value + mpmath.pi / 2) / 2)) < 1e-40
+            branch = mode.branches[leg]
+            if on:  # θ + π/2 (mod 2π, in (-π, π)) changes sign: θ crosses -π/2 at τ
+                before, after = (offset(oracle.joints(indices, pose_at(tau + d))[leg])
+                                 for d in (-eps, eps))
+                assert before * after < 0
+                assert "exactly (at a transcendental time" in branch.proof
+                inside = all(-mpmath.pi / 2 <= offset(oracle.joints(
+                    indices, pose_at(tau * k / 20))[leg]) - mpmath.pi / 2 <= 3 * mpmath.pi / 4
+                    for k in range(20))
+                if inside and before > 0:  # inside on [0, τ), leaves at τ
+                    leaving += 1
+                    assert branch.status == "infeasible" and \
+                        abs(float(branch.event_time.mid()) - float(tau)) < 1e-9, (label, leg)
+            if branch.event_time is not None and \
+                    abs(float(branch.event_time.mid()) - float(tau)) < 1e-9:
+                assert on
+    assert leaving
+    assert report.verdict == "infeasible"

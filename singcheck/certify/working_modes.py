@@ -35,7 +35,7 @@ from singcheck.algebra.radicals import evaluate_path
 from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
 from singcheck.budget import checkpoint
 from singcheck.certify.path import LegAlongPath, PathModel, joint_float
-from singcheck.roots.enclosures import IdenticallyZeroError, RootIsolation
+from singcheck.roots.enclosures import IN_MIXED, IdenticallyZeroError, RootIsolation
 from singcheck.roots.isolation import isolate_real_roots
 
 FEASIBLE, INFEASIBLE, UNKNOWN = "feasible", "infeasible", "unknown"
@@ -232,9 +232,9 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
                                          f"both branches of {joint} sit on its limit {value}")
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
-        exact += [f"{joint} {'=' if kept else '≠'} {value} at t ≈ {when(t)} exactly "
-                  "(algebraic, in Q(α)(√p): balls cannot tell the robot from a conjugate, "
-                  "√p ↦ -√p, there)" for t, kept in iso.exact]
+        exact += [f"{joint} {'=' if kept else '≠'} {value} at t ≈ {when(r.t)} exactly "
+                  f"({_field(r)}: balls cannot tell the robot from a conjugate, √p ↦ -√p, "
+                  "there)" for r, kept in iso.exact]
     for box in undecided:
         checkpoint()
         if leg.inside(leg.branches(box.t)[label], limits) is not True:
@@ -263,6 +263,13 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
             return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing,
                                      "; ".join(exact))
     return BranchFeasibility(joint, label, FEASIBLE, proof="; ".join(exact))
+
+
+def _field(root) -> str:
+    """Where :func:`~singcheck.certify.exact.vanishes_at_root` decided at this root."""
+    if root.exact.kind == IN_MIXED:
+        return "at a transcendental time, in Q(τ, sin τ, cos τ)(√p)"
+    return "algebraic, in Q(α)(√p)"
 
 
 def _switch_polynomial(leg: LegAlongPath, value) -> object:

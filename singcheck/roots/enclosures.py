@@ -104,9 +104,9 @@ class RootIsolation:
     roots: tuple[RealRoot, ...]
     undecided: tuple[Undecided, ...]
     method: str
-    #: (t, kept) per root of a norm where whether the polynomial itself vanishes was
+    #: (root, kept) per root of a norm where whether the polynomial itself vanishes was
     #: decided exactly (balls could not tell it from a conjugate): kept among ``roots``
-    exact: tuple[tuple[arb, bool], ...] = ()
+    exact: tuple[tuple[RealRoot, bool], ...] = ()
 
     @property
     def certified(self) -> bool:

@@ -278,7 +278,7 @@ def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float,
         if verdict is None and exact_zero is not None:
             verdict = exact_zero(p, r)
             if verdict is not None:
-                exact.append((r.t, verdict))
+                exact.append((r, verdict))
         if verdict:
             roots.append(r)
         elif verdict is None:

@@ -799,7 +799,7 @@ def test_the_workspace_line_tells_a_tangency_from_a_crossing(scale, start, end, 
 # -- limits met where the robot and its conjugate (√3 ↦ -√3) both are ----------------------
 
 
-def _five_bar_feasible(oracle, modes, pose_at, start: Fraction, end: Fraction,
+def _feasible_by_samples(oracle, modes, pose_at, start: Fraction, end: Fraction,
                        samples: int = 60) -> set[str]:
     """The modes whose 50-digit joints are inside the (closed) limits at every sample of
     the range, the ends included (a value within 1e-40 of a limit is on it)."""
@@ -812,7 +812,8 @@ def _five_bar_feasible(oracle, modes, pose_at, start: Fraction, end: Fraction,
             t = mpmath.mpf(q.numerator) / q.denominator
             joints = oracle.joints(indices, pose_at(t))
             inside &= joints is not None and all(  # angles in [lo, lo + 2π): v - 2π too
-                any(leg.lo - eps <= w <= leg.hi + eps for w in (v, v - 2 * pi))
+                any(leg.lo - eps <= w <= leg.hi + eps
+                    for w in ((v, v - 2 * pi) if leg.revolute else (v,)))
                 for leg, v in zip(oracle.legs, joints, strict=True))
         if inside:
             out.add(label)
@@ -846,7 +847,7 @@ def test_five_bar_limit_met_where_the_conjugate_robot_meets_it_too(y, sign, star
         t = mpmath.mpf(q.numerator) / q.denominator
         assert abs(mpmath.sin((oracle.joints(modes["+-"], pose_at(t))[1] - sign * t) / 2)) \
             < 1e-40  # equal modulo 2π
-    assert _five_bar_feasible(oracle, modes, pose_at, start, Fraction(1)) == feasible
+    assert _feasible_by_samples(oracle, modes, pose_at, start, Fraction(1)) == feasible
     report = certify_path(path)
     assert all(m.status != "unknown" for m in report.modes)
     assert {m.label for m in report.modes if m.feasible} == feasible
@@ -884,7 +885,7 @@ def test_five_bar_where_only_the_conjugate_robot_meets_a_limit_is_free():
     joints = oracle.joints(modes[elbows_down], pose_at(tau))
     assert abs(mpmath.cos(joints[0]) - mpmath.mpf(1) / 2) < 1e-40  # th1 = -π/3 ...
     assert abs(mpmath.sin(joints[0]) + mpmath.sqrt(3) / 2) < 1e-40  # ... not π/3
-    feasible = _five_bar_feasible(oracle, modes, pose_at, Fraction(0), Fraction(1))
+    feasible = _feasible_by_samples(oracle, modes, pose_at, Fraction(0), Fraction(1))
     assert elbows_down not in feasible and feasible
     report = certify_path(path)
     assert {m.label for m in report.modes if m.feasible} == feasible
@@ -971,3 +972,48 @@ def test_rotary_delta_legs_2_and_3_on_their_limit_at_a_transcendental_time():
                 assert on
     assert leaving
     assert report.verdict == "infeasible"
+
+
+@pytest.mark.parametrize("y, start, end", [("-t", "-1/4", "0"), ("-t", "-1/4", "1/4")])
+def test_linear_delta_slider_on_its_limit_where_the_conjugate_robot_is_too(y, start, end):
+    # at (1/4, 0, 1/4 - √15/4) rail 2 and its √3-conjugate (rail 3's place) are as far
+    # from the pose, and slider 2's upper branch is exactly on r2 = 1/4: along y = -t it
+    # is inside for t < 0 and leaves there at t = 0
+    from flint import arb
+
+    from tests.robot_oracles import linear_delta
+
+    z = (1 - mpmath.sqrt(15)) / 4
+
+    def pose_at(t):
+        return [mpmath.mpf(1) / 4, -t, z]
+
+    path = _revolute_path("linear-delta", trajectory(start, end, x="1/4", y=y,
+                                                     z="1/4 - sqrt(15)/4"))
+    mpmath.mp.dps = 50
+    oracle = linear_delta()
+    modes = {}  # our label → the oracle's branch indices (its ρ = (-b ± √d)/2a, + first)
+    for label in ("".join(s) for s in product("+-", repeat=3)):
+        modes[label] = tuple(0 if sign == "+" else 1 for sign in label)
+    for ours, theirs in zip(path.legs, oracle.legs, strict=True):  # matched by value
+        t0 = Fraction(start) / 2
+        mine = ours.branches(arb(float(t0)))
+        both = theirs.branches(pose_at(mpmath.mpf(t0.numerator) / t0.denominator))
+        assert [abs(float(mine[k].mid()) - float(v)) < 1e-9
+                for k, v in zip("+-", both, strict=True)] == [True, True]
+    top = oracle.legs[1].branches(pose_at(mpmath.mpf(0)))[0]
+    assert abs(top - mpmath.mpf(1) / 4) < 1e-40  # r2's upper branch on its limit at t = 0
+    for q, inside in ((-1, True), (1, False)):
+        value = oracle.legs[1].branches(pose_at(mpmath.mpf(q) / 8))[0]
+        assert (value >= mpmath.mpf(1) / 4) == inside
+    feasible = _feasible_by_samples(oracle, modes, pose_at, Fraction(start), Fraction(end))
+    report = certify_path(path)
+    assert all(m.status != "unknown" for m in report.modes)
+    assert {m.label for m in report.modes if m.feasible} == feasible
+    assert feasible == ({"++-"} if end == "0" else set())
+    for m in report.modes:
+        branch = m.branches[1]
+        if m.label[1] == "+":
+            assert "r2 = 1/4 at t ≈ 0 exactly (algebraic" in branch.proof
+            if end != "0":
+                assert branch.status == "infeasible" and branch.event_time.contains(0)

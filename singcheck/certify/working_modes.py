@@ -34,6 +34,7 @@ from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.radicals import evaluate_path
 from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
 from singcheck.budget import checkpoint
+from singcheck.certify.exact import vanishes_at_root
 from singcheck.certify.path import LegAlongPath, PathModel, joint_float
 from singcheck.roots.enclosures import IN_MIXED, IdenticallyZeroError, RootIsolation
 from singcheck.roots.isolation import isolate_real_roots
@@ -85,8 +86,6 @@ def gap_points(interval: TimeRange, events: list[arb]) -> list[arb]:
 
 
 def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | None:
-    from singcheck.certify.exact import vanishes_at_root
-
     try:
         return isolate_real_roots(poly, interval, tolerance, vanishes_at_root)
     except IdenticallyZeroError:

@@ -168,29 +168,32 @@ class ModeExpression:
         self.W = [self._split(w) for _, _, w in revolute]
 
     def _split(self, p: fmpq_mpoly) -> dict:
-        """A polynomial in t, s, c and the levels as a multilinear element (reduced with
-        level² = D)."""
-        by_levels: dict[tuple[int, ...], dict] = {}
-        for exps, coeff in p.terms():
-            by_levels.setdefault(tuple(exps[3:]), {})[tuple(exps[:3])] = coeff
-        out: dict = {}
-        for level_exps, trig_terms in by_levels.items():
-            checkpoint()
-            value = {0: reduce_trig(TRIG.from_dict(trig_terms))}
-            for q, e in enumerate(level_exps):
-                factor = {(e % 2) << q: TRIG.from_dict({(0, 0, 0): 1})}
-                for _ in range(e // 2):
-                    factor = multilinear_product(factor, self.D[q], self.D, _trig_mul,
-                                                 _is_zero)
-                if e:
-                    value = multilinear_product(value, factor, self.D, _trig_mul, _is_zero)
-            for m, v in value.items():
-                out[m] = out[m] + v if m in out else v
-        return {m: v for m, v in out.items() if not v.is_zero()}
+        return split_levels(p, self.D)
 
     def signs(self, label: str) -> list[int]:
         """σ per level for a working mode label: + for every √p, then the mode's signs."""
         return [1] * self.fixed + [1 if label[i] == "+" else -1 for i in self.legs]
+
+
+def split_levels(p: fmpq_mpoly, D: list[dict]) -> dict:
+    """A polynomial in t, s, c and the levels (its variables after the third) as a
+    multilinear element, reduced with level_q² = D[q]."""
+    by_levels: dict[tuple[int, ...], dict] = {}
+    for exps, coeff in p.terms():
+        by_levels.setdefault(tuple(exps[3:]), {})[tuple(exps[:3])] = coeff
+    out: dict = {}
+    for level_exps, trig_terms in by_levels.items():
+        checkpoint()
+        value = {0: reduce_trig(TRIG.from_dict(trig_terms))}
+        for q, e in enumerate(level_exps):
+            factor = {(e % 2) << q: TRIG.from_dict({(0, 0, 0): 1})}
+            for _ in range(e // 2):
+                factor = multilinear_product(factor, D[q], D, _trig_mul, _is_zero)
+            if e:
+                value = multilinear_product(value, factor, D, _trig_mul, _is_zero)
+        for m, v in value.items():
+            out[m] = out[m] + v if m in out else v
+    return {m: v for m, v in out.items() if not v.is_zero()}
 
 
 def _by_angle_degree(det_a: fmpq_mpoly, revolute: list) -> dict:
@@ -471,3 +474,34 @@ def mode_zero_polynomial(path: PathModel, label: str, t0: fmpq) -> fmpq_mpoly | 
     along the mode, else a non-zero trig polynomial whose roots hold its zeros."""
     expr = mode_expression(path)
     return _Tower(expr, PathFunctions(t0), expr.signs(label)).reduce()
+
+
+class _RadicalElement:
+    """A trig polynomial over Q(√p₁, …, √pₖ) (a path-ring polynomial) in the form the
+    tower takes: one level per √p (D = p, the positive root), no legs, no W."""
+
+    def __init__(self, p: fmpq_mpoly) -> None:
+        names = p.context().names()
+        primes = [radical_prime(v) for v in names[3:]]
+        if tuple(names[:3]) != ("t", "s", "c") or None in primes:
+            raise NotExact("a polynomial with variables other than t, sin t, cos t and "
+                           "square roots")
+        self.D: list[dict] = [{0: TRIG.from_dict({(0, 0, 0): q})} for q in primes]
+        self.terms = split_levels(p, self.D)
+        self.W: list[dict] = []
+
+
+def vanishes_at_root(p: fmpq_mpoly, root) -> bool | None:
+    """Whether a path-ring polynomial p (square roots among its numbers) is exactly 0 at
+    a root of its norm (a :class:`~singcheck.roots.enclosures.RealRoot` with an exact
+    time), decided in the tower Q(α)(√p₁)…(√pₖ): e.g. a joint's limit polynomial at a time
+    where both it and its conjugate (√3 ↦ -√3) vanish, which no ball can tell apart.
+    None when the root's time has no exact description we compute with."""
+    if root.exact is None:
+        return None
+    try:
+        element = _RadicalElement(p)
+        tower = _Tower(element, exact_point(root.exact, root), [1] * len(element.D))
+        return tower.reduce() is None
+    except NotExact:
+        return None

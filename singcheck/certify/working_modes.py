@@ -34,8 +34,9 @@ from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.radicals import evaluate_path
 from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
 from singcheck.budget import checkpoint
+from singcheck.certify.exact import vanishes_at_root
 from singcheck.certify.path import LegAlongPath, PathModel, joint_float
-from singcheck.roots.enclosures import IdenticallyZeroError, RootIsolation
+from singcheck.roots.enclosures import IN_MIXED, IdenticallyZeroError, RootIsolation
 from singcheck.roots.isolation import isolate_real_roots
 
 FEASIBLE, INFEASIBLE, UNKNOWN = "feasible", "infeasible", "unknown"
@@ -49,6 +50,7 @@ class BranchFeasibility:
     status: str  # feasible | infeasible | unknown
     reason: str = ""
     event_time: arb | None = None  # where it leaves (limit crossing or branch meeting)
+    proof: str = ""  # the exact decisions it rests on, if any (ball arithmetic otherwise)
 
 
 @dataclass
@@ -59,6 +61,7 @@ class WorkingMode:
     reason: str
     joints_at_start: dict[str, float | None]
     singular_times: list = field(default_factory=list)  # filled by certification
+    proof: str = ""  # the exact decisions its feasibility rests on ("": ball arithmetic)
 
     @property
     def feasible(self) -> bool:
@@ -84,7 +87,7 @@ def gap_points(interval: TimeRange, events: list[arb]) -> list[arb]:
 
 def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | None:
     try:
-        return isolate_real_roots(poly, interval, tolerance)
+        return isolate_real_roots(poly, interval, tolerance, vanishes_at_root)
     except IdenticallyZeroError:
         return None
 
@@ -286,6 +289,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
     undecided = []
+    exact: list[str] = []  # limits met where p and a conjugate both vanish: decided exactly
     on_limit: dict = {}  # limit value -> w = 2aL + b, for a limit some branch sits on
     for value in limits:
         if value not in crossings:
@@ -302,6 +306,9 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
                                          f"both branches of {joint} sit on its limit {value}")
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
+        exact += [f"{joint} {'=' if kept else '≠'} {value} at t ≈ {when(r.t)} exactly "
+                  f"({_field(r)}: balls cannot tell the robot from a conjugate, √p ↦ -√p, "
+                  "there)" for r, kept in iso.exact]
     for box in undecided:
         checkpoint()
         if leg.inside(leg.branches(box.t)[label], limits) is not True:
@@ -328,8 +335,16 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
             reason = f"{joint} is outside {_bounds(limits)} from the start" \
                 if crossing is None else \
                 f"{joint} leaves {_bounds(limits)} at t ≈ {when(crossing)}"
-            return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing)
-    return BranchFeasibility(joint, label, FEASIBLE)
+            return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing,
+                                     "; ".join(exact))
+    return BranchFeasibility(joint, label, FEASIBLE, proof="; ".join(exact))
+
+
+def _field(root) -> str:
+    """Where :func:`~singcheck.certify.exact.vanishes_at_root` decided at this root."""
+    if root.exact.kind == IN_MIXED:
+        return "at a transcendental time, in Q(τ, sin τ, cos τ)(√p)"
+    return "algebraic, in Q(α)(√p)"
 
 
 def _bounds(limits) -> str:
@@ -425,7 +440,9 @@ def working_modes(path: PathModel, tolerance: float = 1e-9) -> list[WorkingMode]
         else:
             status = FEASIBLE
         reason = "; ".join(b.reason for b in choice if b.status == status and b.reason)
+        proof = "; ".join(b.proof for b in choice
+                          if b.proof and (status == FEASIBLE or b.status == status))
         at_start = {j: starts[i][b.label] for i, (j, b) in enumerate(zip(joints, choice,
                                                                            strict=True))}
-        modes.append(WorkingMode(label, tuple(choice), status, reason, at_start))
+        modes.append(WorkingMode(label, tuple(choice), status, reason, at_start, proof=proof))
     return modes

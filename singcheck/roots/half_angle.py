@@ -33,6 +33,7 @@ from singcheck.roots.rational import (
     bits_for,
     exact_tolerance,
     real_roots_exact,
+    root_of_power,
 )
 
 _TWO_U = fmpq_poly([0, 2])
@@ -147,31 +148,11 @@ def _deflated_roots(deflated: fmpq_poly, k: int) -> list[_HalfAngleRoot]:
 
 def _u_root(rr: RationalRoot, k: int, sign: int) -> Callable[[], RationalRoot]:
     """The exact u = sign·v^(1/k) for the root v of N isolated by ``rr``: a rational
-    interval isolating u among the real roots of g(u) = f(u^k) (f(0) ≠ 0).
-
-    u ↦ u^k is injective on each sign, so among g's roots of that sign exactly one has
-    u^k = v; every other one's interval image eventually misses rr's interval."""
+    interval isolating u among the real roots of h(u^k), h the minimal polynomial of v
+    (:func:`~singcheck.roots.rational.root_of_power`)."""
 
     def locate():
-        if k == 1:
-            return rr
-        g_coeffs = [fmpq(0)] * (k * rr.poly.degree() + 1)
-        for i, c in enumerate(rr.poly.coeffs()):
-            g_coeffs[k * i] = c
-        g = fmpq_poly(g_coeffs)
-        # a positive root's interval may start at 0, a negative one's end there
-        candidates = [r for r, _ in real_roots_exact(g) if (r.lo + r.hi > 0) == (sign > 0)]
-        while True:
-            checkpoint()
-            hits = [r for r in candidates
-                    if not (max(r.lo**k, r.hi**k) < rr.lo or min(r.lo**k, r.hi**k) > rr.hi)]
-            if len(hits) == 1:
-                return hits[0]
-            if not hits:
-                raise AssertionError("no root of f(u^k) maps onto the isolated root of f")
-            for r in hits:
-                r.bisect_to(r.width() / 4)
-            rr.bisect_to(rr.width() / 4)
+        return rr if k == 1 else root_of_power(rr, k, sign)
 
     return locate
 

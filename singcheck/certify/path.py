@@ -98,6 +98,9 @@ def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
     composition is refused or cut into pieces a time limit can stop
     (:func:`~singcheck.algebra.composition.compose_in_pieces`)."""
     ring, args = _pose_args(p, phi, pose)
+    if p.is_constant():  # (a leg's leading coefficient): nothing to compose
+        return ring.from_dict({(0,) * ring.nvars(): p.leading_coefficient()}) \
+            if not p.is_zero() else ring.from_dict({})
     return compose_in_pieces(p, args, ring, _reduce, work)
 
 
@@ -313,11 +316,13 @@ def _limit_balls(limits) -> tuple[arb, arb]:
     """The balls of a prismatic joint's rational limits (exact when dyadic), once per
     limits object and working precision: feasibility proofs compare against them
     thousands of times (keyed by the object, not by hashing its Fractions each time)."""
-    per_prec = memo_per_object(_LIMIT_BALLS, limits, lambda _: {})
-    hit = per_prec.get(ctx.prec)
-    if hit is None:
-        hit = per_prec[ctx.prec] = tuple(fraction_ball(v) for v in limits)
-    return hit
+    key = (id(limits), ctx.prec)
+    hit = _LIMIT_BALLS.get(key)
+    if hit is None or hit[0] is not limits:  # the entry holds limits: its id is not reused
+        if len(_LIMIT_BALLS) > 256:
+            _LIMIT_BALLS.clear()
+        hit = _LIMIT_BALLS[key] = (limits, tuple(fraction_ball(v) for v in limits))
+    return hit[1]
 
 
 def inside_limits(leg: Leg, value, limits) -> bool | None:

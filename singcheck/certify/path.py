@@ -33,7 +33,12 @@ from singcheck.algebra.composition import (
     crude_work,
 )
 from singcheck.algebra.intervals import evaluate, fraction_ball
-from singcheck.algebra.polynomials import coefficient_in, memo_per_object, restrict
+from singcheck.algebra.polynomials import (
+    coefficient_in,
+    constant_value,
+    memo_per_object,
+    restrict,
+)
 from singcheck.algebra.radicals import (
     angle_function,
     cos_pi,
@@ -99,8 +104,7 @@ def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
     (:func:`~singcheck.algebra.composition.compose_in_pieces`)."""
     ring, args = _pose_args(p, phi, pose)
     if p.is_constant():  # (a leg's leading coefficient): nothing to compose
-        return ring.from_dict({(0,) * ring.nvars(): p.leading_coefficient()}) \
-            if not p.is_zero() else ring.from_dict({})
+        return ring.from_dict({(0,) * ring.nvars(): constant_value(p)})
     return compose_in_pieces(p, args, ring, _reduce, work)
 
 
@@ -113,7 +117,7 @@ def _constants_first(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> fmpq_mpoly:
     constants = {}
     for name, a, d in zip(p.context().names(), args, p.degrees(), strict=True):
         if d > 0 and a.is_constant():
-            constants[name] = a.leading_coefficient() if not a.is_zero() else fmpq(0)
+            constants[name] = constant_value(a)
     return p.subs(constants) if constants else p
 
 

@@ -213,10 +213,9 @@ def direct_kinematics_count(model: RobotModel, joint_point) -> DirectCount:
         exprs = list(basis.exprs)
         if exprs == [1]:
             return DirectCount(0)
-        shape = _shape_position(exprs, syms)
+        shape = _shape_position(exprs, syms, radicals)
         if shape is not None:
-            h, coordinates = shape
-            return _count_on_positive_roots(h, coordinates[:radicals])
+            return _count_on_positive_roots(*shape)
     return DirectCount(None, "no coordinate change put the Gröbner basis in shape position "
                              "(solutions at infinity, multiple or infinitely many)")
 
@@ -272,8 +271,8 @@ def _to_sympy(poly, syms, index):
     return expr
 
 
-def _shape_position(exprs, pose) -> tuple[fmpq_poly, list[fmpq_poly]] | None:
-    """(h, [g_1, …, g_{n-1}]) when ``exprs`` is ``{x_i - g_i(x_n)}`` plus a squarefree
+def _shape_position(exprs, pose, wanted: int = 0) -> tuple[fmpq_poly, list[fmpq_poly]] | None:
+    """(h, [g_1, …, g_wanted]) when ``exprs`` is ``{x_i - g_i(x_n)}`` plus a squarefree
     h(x_n), else None."""
     import sympy
 
@@ -290,7 +289,8 @@ def _shape_position(exprs, pose) -> tuple[fmpq_poly, list[fmpq_poly]] | None:
         rest = g - lead * var
         if rest.free_symbols - {last}:
             return None
-        coordinates.append(_univariate(-rest / lead, last))
+        if len(coordinates) < wanted:
+            coordinates.append(_univariate(-rest / lead, last))
     hp = sympy.Poly(h, *pose)
     if hp.free_symbols - {last} or hp.degree(last) < 1:
         return None

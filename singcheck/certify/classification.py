@@ -129,8 +129,7 @@ class TrajectoryReport:
 
 
 def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
-    pose = path.pose_at(t)
-    variables = path.pose_variables_at(t)
+    pose, variables = path.pose_and_variables_at(t)
     per_leg = [leg.branches(t) for leg in path.legs]
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}

@@ -325,7 +325,7 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     the roots: a root near u = 0 or u = ∞ (t near 0 or ±π) no longer costs a dozen
     halvings for every other root.
     """
-    cs = [int(c) for c in f.coeffs()]
+    cs = f.coeffs()  # FLINT integers: compared and summed as they are, no conversion
     if cs[-1] < 0:
         cs = [-c for c in cs]
     if all(c >= 0 for c in cs):
@@ -438,9 +438,9 @@ def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
     out = []
     for factor, mult in factors:
         f = fmpq_poly(factor)
-        cs = [int(c) for c in factor.coeffs()]
-        shift = next(i for i, c in enumerate(cs) if c != 0)
-        if shift:  # a root at 0 (squarefree: simple)
+        cs = factor.coeffs()
+        if cs[0] == 0:  # a root at 0 (squarefree: simple)
+            shift = next(i for i, c in enumerate(cs) if c != 0)
             out.append((RationalRoot(f, fmpq(0), fmpq(0)), mult))
             factor = fmpz_poly(cs[shift:])
             f = fmpq_poly(factor)  # the other roots: f no longer vanishes at 0
@@ -450,8 +450,7 @@ def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
             out.append((RationalRoot(f, lo, hi), mult))
         if nonnegative_only:
             continue
-        mirrored = fmpz_poly([c if i % 2 == 0 else -c
-                              for i, c in enumerate(int(c) for c in factor.coeffs())])
+        mirrored = fmpz_poly([c if i % 2 == 0 else -c for i, c in enumerate(factor.coeffs())])
         for lo, hi in _positive_root_intervals(mirrored):
             out.append((RationalRoot(f, -hi, -lo), mult))
     out.sort(key=lambda item: item[0].lo)

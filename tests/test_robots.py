@@ -336,3 +336,19 @@ def test_a_pose_angle_too_high_a_multiple_of_t_is_refused_up_front(tmp_path, rob
     code, out, _ = run_cli(monkeypatch, capsys, "run", str(ROBOTS / "3-prr.yaml"), path,
                            "--backend", "flint", "-q", "--format", "json")
     assert code == 2
+
+
+def test_a_mixed_t_and_sin_t_path_of_the_rotary_delta_agrees_with_the_oracle(tmp_path,
+                                                                             robots):
+    """ξ of the rotary Delta is not expanded: μ is eliminated along this path (t and
+    sin t, cos t mixed), then its roots are found by branch-and-bound."""
+    path = oracles.Path("rotary-delta-mixed", oracles.rotary_delta, 0, 1,
+                        lambda t: [t / 3, mp.sin(t) / 4, -2 + mp.cos(t) / 10], False)
+    truth = oracles.solve(path)
+    file = tmp_path / "rotary-delta-mixed.yaml"
+    file.write_text("name: rotary-delta-mixed\nparameter: t\nrange: [0, 1]\npose:\n"
+                    "  x: t/3\n  y: sin(t)/4\n  z: -2 + cos(t)/10\n")
+    robot = robots("rotary-delta")
+    report = api.check(robot, api.load_trajectory(file, robot), regions=False)
+    assert report.verdict == "singularity-free"
+    _agrees(report, path.oracle(), truth)

@@ -188,21 +188,49 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
     """
     names = g.context().names()
     _, factors = g.factor()
-    total = g.context().from_dict({(0,) * g.context().nvars(): 1})
+    one = g.context().from_dict({(0,) * g.context().nvars(): 1})
+    total = one
+    later = [{names.index(x) for v, _ in legs[i + 1:]
+              for x in (v if isinstance(v, tuple) else (v,))} for i in range(len(legs))]
     for factor, _mult in factors:
-        acc, reduced = factor, False
-        for v, f in legs:
+        acc, reduced, aside = factor, False, one
+        for i, (v, f) in enumerate(legs):
             variables = v if isinstance(v, tuple) else (v,)
             if all(acc.degrees()[names.index(x)] <= 0 for x in variables):
                 continue  # a leg that does not touch this factor only raises its power
             checkpoint()
             acc = revolute_norm(acc, v[0], v[1], f, reduce) if isinstance(v, tuple) else \
                 acc.resultant(f, v)
-            acc, reduced = squarefree_part(reduce(acc) if reduce else acc), True
+            acc, reduced = reduce(acc) if reduce else acc, True
+            if later[i]:
+                acc, free = _split_free(acc, later[i])
+                aside *= free
+            else:
+                acc = squarefree_part(acc)
+        if aside != one:
+            acc = squarefree_part(acc * aside)
         if len(factors) == 1 and reduced:
             return acc  # squarefree and monic already: the one factor's norm
         total *= acc
     return squarefree_part(total)
+
+
+def _split_free(p: fmpq_mpoly, variables: set[int]) -> tuple[fmpq_mpoly, fmpq_mpoly]:
+    """``(k, b)``: the squarefree part of ``p`` as the product of its squarefree factors
+    that involve one of ``variables`` (monic) and those that do not.  The norm is
+    multiplicative, and a factor free of a leg's joint only comes out of that leg's
+    resultant or revolute norm as a power of itself: set aside, it keeps its zeros
+    without being squared at every later leg (the rotary Delta's W = a² + b² factors)."""
+    _, parts = p.factor_squarefree()
+    one = p.context().from_dict({(0,) * p.context().nvars(): 1})
+    keep, free = one, one
+    for part, _mult in parts:
+        if any(part.degrees()[i] > 0 for i in variables):
+            keep *= part
+        else:
+            free *= part
+    lc = keep.leading_coefficient()
+    return (keep / lc if lc != 0 else keep), free
 
 
 def _height(p: fmpq_mpoly) -> int:

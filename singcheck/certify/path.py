@@ -26,9 +26,11 @@ from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.composition import (
     MAX_COMPOSE_WORK,
+    PIECE_WORK,
     TooCostly,
     compose_in_pieces,
     composition_work,
+    crude_work,
 )
 from singcheck.algebra.intervals import evaluate, fraction_ball
 from singcheck.algebra.polynomials import coefficient_in, memo_per_object, restrict
@@ -98,6 +100,19 @@ def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
     (:func:`~singcheck.algebra.composition.compose_in_pieces`)."""
     ring, args = _pose_args(p, phi, pose)
     return compose_in_pieces(p, args, ring, _reduce, work)
+
+
+def _constants_first(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> fmpq_mpoly:
+    """``p`` with the variables whose image is a constant (a coordinate such as z = 1)
+    replaced by that rational (exact): the same composition, and FLINT's compose then
+    expands fewer and smaller powers (ξ of the Orthoglide along heart 1: half the time;
+    on a leg's small coefficients the substitution costs more than it saves).  ``p`` no
+    longer depends on them, so their images are left unused."""
+    constants = {}
+    for name, a, d in zip(p.context().names(), args, p.degrees(), strict=True):
+        if d > 0 and a.is_constant():
+            constants[name] = a.leading_coefficient() if not a.is_zero() else fmpq(0)
+    return p.subs(constants) if constants else p
 
 
 _PLANS: dict = {}
@@ -183,7 +198,11 @@ def _compose_mu(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
     :data:`MAX_MU_TERMS` terms or cost more than
     :data:`~singcheck.algebra.composition.MAX_COMPOSE_WORK`; otherwise composed in
     pieces a time limit can stop."""
-    work, deg_t, deg_sc = composition_work(xi, _pose_args(xi, phi, pose)[1])
+    ring, args = _pose_args(xi, phi, pose)
+    work = _small_composition(xi, args)
+    if work is not None:
+        return compose_in_pieces(_constants_first(xi, args), args, ring, _reduce, work)
+    work, deg_t, deg_sc = composition_work(xi, args)
     terms = (deg_t + 1) * (2 * deg_sc + 1)
     if terms > MAX_MU_TERMS:
         raise _too_costly(f"μ(t) = ξ(φ(t)) could have {terms} terms (degree {deg_t} in t "
@@ -192,7 +211,24 @@ def _compose_mu(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
         raise _too_costly(f"composing μ(t) = ξ(φ(t)) would cost {work:.3g} by its a-priori "
                           f"estimate (ξ has {len(xi)} terms; at most {MAX_COMPOSE_WORK:.3g})",
                           trajectory)
-    return compose_pose(xi, phi, pose, work)
+    return compose_in_pieces(_constants_first(xi, args), args, ring, _reduce, work)
+
+
+def _small_composition(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> int | None:
+    """A bound on :func:`composition_work` proven by a crude estimate, when that estimate
+    already keeps ``p(args)`` within one FLINT call and within :data:`MAX_MU_TERMS`
+    (the common case); None otherwise (then the exact estimate is needed).
+
+    Crude: every term is charged the largest exponents of all variables together, so
+    its degrees in t and in (s, c) bound the true ones from above, and its work bounds
+    :func:`composition_work`'s (:func:`~singcheck.algebra.composition.crude_work`).
+    The decisions taken on the bound (compose in one call, do not refuse) are those the
+    exact estimate would take, which is skipped: on heart 1 it cost a third of composing
+    μ."""
+    work, deg_t, deg_sc = crude_work(p, args)
+    if work <= PIECE_WORK and (deg_t + 1) * (2 * deg_sc + 1) <= MAX_MU_TERMS:
+        return work
+    return None
 
 
 @dataclass(frozen=True)
@@ -224,21 +260,25 @@ class LegAlongPath:
             out = out * q + c
         return out
 
-    def branches(self, t: arb, tight: bool = False) -> dict[str, arb | acb | tuple | None]:
+    def branches(self, t: arb, tight: bool = False,
+                 discriminant: arb | None = None) -> dict[str, arb | acb | tuple | None]:
         """Enclosures of each branch's joint value for every t in the ball ``t``.
 
         A quadratic leg's branches are real where D > 0 (proven) and complex
         conjugate where D < 0; where the sign of D is not proven both are None.  A
         revolute branch is the pair (cos θ, sin θ).  ``tight`` spends more on a wide
-        ball (:func:`~singcheck.algebra.trig.evaluate_trig`)."""
+        ball (:func:`~singcheck.algebra.trig.evaluate_trig`); ``discriminant``, D's
+        enclosure over the same ball (and ``tight``) when the caller has it already."""
         if self.leg.kind != REVOLUTE and self.leg.degree == 2:
             # ρ = (-b ± √D)/(2a) needs a, b and D only: c is in D already
-            a, b = (evaluate_path(c, t, tight=tight) for c in self.coefficients[:2])
-            values = [a, b, None]
+            coefficients = self.coefficients
+            values = [evaluate_path(coefficients[0], t, None, tight),
+                      evaluate_path(coefficients[1], t, None, tight), None]
         else:
-            values = [evaluate_path(c, t, tight=tight) for c in self.coefficients]
-        d = evaluate_path(self.discriminant, t, tight=tight) \
-            if self.discriminant is not None else None
+            values = [evaluate_path(c, t, None, tight) for c in self.coefficients]
+        d = discriminant
+        if d is None and self.discriminant is not None:
+            d = evaluate_path(self.discriminant, t, None, tight)
         return branch_values(self.leg, values, d)
 
     def inside(self, value, limits) -> bool | None:
@@ -342,18 +382,32 @@ class PathModel:
 
     def pose_at(self, t: arb) -> list[arb]:
         """The pose coordinates (an angle in radians, its π offset included)."""
-        out = []
-        offsets = self.trajectory.angle_offsets
-        for v, x in zip(self.projection.model.pose, self.phi, strict=True):
-            value = evaluate_path(x, t)
-            if v in offsets:
-                value += arb.pi() * fraction_ball(offsets[v])
-            out.append(value)
-        return out
+        return self.pose_and_variables_at(t)[0]
 
     def pose_variables_at(self, t: arb) -> list[arb]:
         """Balls of the model's pose variables (cos φ, sin φ for an angle)."""
         return [evaluate_path(x, t) for x in self.coordinates]
+
+    def pose_and_variables_at(self, t: arb) -> tuple[list[arb], list[arb]]:
+        """:meth:`pose_at` and :meth:`pose_variables_at` together, each polynomial
+        evaluated once: a coordinate that is not an angle is its own pose variable (the
+        same polynomial object, hence the same ball)."""
+        seen: dict[int, arb] = {}
+
+        def value(x: fmpq_mpoly) -> arb:
+            hit = seen.get(id(x))
+            if hit is None:
+                hit = seen[id(x)] = evaluate_path(x, t)
+            return hit
+
+        pose = []
+        offsets = self.trajectory.angle_offsets
+        for v, x in zip(self.projection.model.pose, self.phi, strict=True):
+            ball = value(x)
+            if v in offsets:
+                ball = ball + arb.pi() * fraction_ball(offsets[v])
+            pose.append(ball)
+        return pose, [value(x) for x in self.coordinates]
 
     def det_A(self, joints: list, pose: list[arb], signs: dict[int, int] | None = None):
         """Enclosure of det A at the given joint values (a revolute joint's as a (cos,
@@ -680,9 +734,20 @@ def _legs_along(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
                 ) -> tuple[LegAlongPath, ...]:
     pose_vars = model.pose_variables
     legs = []
+    composed: list[tuple[fmpq_mpoly, fmpq_mpoly]] = []  # (coefficient, along the path)
+
+    def along(c: fmpq_mpoly) -> fmpq_mpoly:
+        """The coefficient along the path, composed once: legs often share one (the
+        Orthoglide's constant a = 1 and c = x² + y² + z² - l²)."""
+        for known, image in composed:
+            if known == c:
+                return image
+        image = compose_pose(c, coordinates, pose_vars)
+        composed.append((c, image))
+        return image
+
     for leg in model.legs:
-        in_pose_coeffs = _leg_coefficients(leg)
-        coeffs = tuple(compose_pose(c, coordinates, pose_vars) for c in in_pose_coeffs)
+        coeffs = tuple(along(c) for c in _leg_coefficients(leg))
         disc = leg_discriminant(leg, coeffs)
         limits = {}
         if leg.kind == REVOLUTE and leg.joint in model.spec.joint_limits:

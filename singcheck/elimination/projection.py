@@ -35,7 +35,12 @@ from singcheck.algebra.radicals import (
     surd_polynomial,
 )
 from singcheck.elimination.cache import CachedBackend
-from singcheck.elimination.requests import EliminationBackend, EliminationRequest, norm_chain
+from singcheck.elimination.requests import (
+    EliminationBackend,
+    EliminationRequest,
+    chain_is_small,
+    norm_chain,
+)
 from singcheck.errors import BackendError, UnsupportedRobotError
 from singcheck.model.robot import (
     REVOLUTE,
@@ -247,7 +252,22 @@ def _without_degenerate_factors(p: fmpq_mpoly, degenerate) -> fmpq_mpoly:
     return squarefree_part(out)
 
 
-def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str) -> fmpq_mpoly:
+def bounded_norm_over_legs(model: RobotModel, timeout: float) -> fmpq_mpoly:
+    """:func:`norm_over_legs` under the bounds of every elimination: in this process when
+    :func:`~singcheck.elimination.requests.chain_is_small` proves it small, else in a
+    forked child with ``timeout`` seconds and the memory bound
+    (:func:`~singcheck.elimination.cas.isolated.run_bounded`)."""
+    from singcheck.elimination.cas.isolated import run_bounded
+    from singcheck.elimination.cas.limits import memory_limit
+
+    small = chain_is_small(model.det_A, norm_legs(model), memory_limit())
+    return run_bounded(norm_over_legs, model, small, timeout,
+                       "the re-check (the norm of det A over the legs)")
+
+
+def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str,
+                                norm: fmpq_mpoly | None = None,
+                                timeout: float | None = None) -> fmpq_mpoly:
     """Refuse a ξ whose zero set differs from the independently computed norm's; return
     ξ without the degenerate factors (what :func:`project_robot` keeps).
 
@@ -255,10 +275,16 @@ def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str)
     without the factors of the degenerate set W = 0, where a CAS's closure of the
     projection and the norm may differ); a CAS result that parsed but is wrong (or
     belongs to another request) fails here, loudly.  A ξ equal to the norm as it stands
-    passes at once: the norm is squarefree and monic by construction.
+    passes at once: the norm is squarefree and monic by construction.  ``norm``: that
+    norm when the caller has it (the flint backend's result, computed now, is that
+    norm: recomputing it would re-check nothing); else it is computed under ``timeout``
+    (:func:`bounded_norm_over_legs`).
     """
+    from singcheck.elimination.cas.external import DEFAULT_TIMEOUT
+
     degenerate = degenerate_set(model)
-    norm = norm_over_legs(model)
+    if norm is None:
+        norm = bounded_norm_over_legs(model, timeout or DEFAULT_TIMEOUT)
     if xi == norm and not degenerate:
         return norm
     clean = _without_degenerate_factors(xi, degenerate)
@@ -329,9 +355,13 @@ def project_robot(model: RobotModel, backend: EliminationBackend,
 
         checked: list = []  # (ξ as returned, ξ re-checked) of the last result checked
 
+        timeout = getattr(backend, "timeout", None) or getattr(
+            getattr(backend, "backend", None), "timeout", None)
+
         def check(result) -> None:
             raw = _single(result, "singularity surface")
-            checked[:] = [raw, recheck_singularity_surface(model, raw, result.backend)]
+            checked[:] = [raw, recheck_singularity_surface(
+                model, raw, result.backend, raw if result.is_norm else None, timeout)]
 
         request = singularity_surface_request(model)
         if isinstance(backend, CachedBackend):  # cache only what passes the re-check

@@ -423,3 +423,27 @@ def test_exact_isolation_of_roots_spread_over_many_octaves():
         assert all(not rr.lo <= fmpq(o.numerator, o.denominator) <= rr.hi
                    for o in roots if o != r)
         assert (rr.lo == rr.hi == q) or rr.poly(rr.lo) * rr.poly(rr.hi) < 0
+
+
+def test_refinement_on_wilkinsons_polynomial():
+    """Refining the real roots of Wilkinson's perturbed polynomial (x-1)…(x-20) + 2^-23 x^19,
+    ill-conditioned (Newton's unproven guesses there can miss, and the proven steps must
+    take over): each interval, 10^-12 wide, holds exactly one real root computed by
+    mpmath at 50 digits, with a sign change."""
+    from singcheck.roots.rational import real_roots_exact
+
+    f = fmpq_poly([1])
+    for i in range(1, 21):
+        f *= fmpq_poly([-i, 1])
+    f += fmpq_poly([0] * 19 + [fmpq(1, 2**23)])
+    coeffs = [mpmath.mpf(int(c.p)) / int(c.q) for c in f.coeffs()[::-1]]
+    reals = sorted(x.real for x in mpmath.polyroots(coeffs, maxsteps=400, extraprec=400)
+                   if abs(x.imag) < mpmath.mpf(10) ** -30)
+    isolated = real_roots_exact(f)
+    assert len(isolated) == len(reals) == 10
+    for (rr, _), x in zip(isolated, reals, strict=True):
+        rr.bisect_to(fmpq(1, 10**12))
+        assert rr.hi - rr.lo <= fmpq(1, 10**12)
+        lo, hi = (mpmath.mpf(int(q.p)) / int(q.q) for q in (rr.lo, rr.hi))
+        assert lo <= x <= hi
+        assert rr.poly(rr.lo) * rr.poly(rr.hi) < 0

@@ -42,6 +42,7 @@ from singcheck.algebra.radicals import (
     path_ring,
     radical_balls,
     radical_prime,
+    radical_variables,
     reduce_relations,
     sin_pi,
     surd_polynomial,
@@ -158,6 +159,31 @@ def mu_size_bound(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...],
     (a + 1)(2b + 1) terms.  Cheap: nothing is composed."""
     _, deg_t, deg_sc = composition_work(xi, _pose_args(xi, phi, pose)[1])
     return deg_t, deg_sc, (deg_t + 1) * (2 * deg_sc + 1)
+
+
+#: The highest degree in tan(t/2) whose real roots a path's μ may ask for (μ free of t:
+#: exact isolation in the half-angle tangent, :mod:`singcheck.roots.half_angle`).  The
+#: isolation's cost grows about as the fourth power of the degree: the 3-PRR with
+#: phi = k*t (μ of degree 20k in sin t, cos t, 40k in the tangent) isolated μ's roots
+#: in 0.1 s for k = 5, 1.1 s for 10, 6.2 s for 15 and 19 s for 20 (CPU, quiet machine);
+#: k = 30 did not finish its certification in 120 s.
+MAX_HALF_ANGLE_DEGREE = 800
+
+
+def isolation_degree(mu: fmpq_mpoly) -> int:
+    """The degree in u = tan(t/2) of the polynomial whose real roots certify ``mu`` (0
+    when ``mu`` involves t or an angle function: then interval branch-and-bound, with
+    its own budget of boxes, isolates them): twice its degree in (sin t, cos t), doubled
+    again for each square root among its coefficients (their norm is isolated)."""
+    names = mu.context().names()
+    degrees = mu.degrees()
+    radicals = [i for i, _ in radical_variables(mu.context())]
+    if any(d > 0 for i, (v, d) in enumerate(zip(names, degrees, strict=True))
+           if v not in ("s", "c") and i not in radicals):
+        return 0
+    si, ci = names.index("s"), names.index("c")
+    trig = max((e[si] + e[ci] for e in mu.monoms()), default=0)
+    return 2 * trig * 2 ** sum(1 for i in radicals if degrees[i] > 0)
 
 
 def _too_costly(what: str, trajectory: TrajectorySpec) -> SpecError:
@@ -690,6 +716,11 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
             mu = eliminate_along_path(model, coordinates, where)
         except TooCostly as e:
             raise _too_costly(str(e), trajectory) from None
+    degree = isolation_degree(mu)
+    if degree > MAX_HALF_ANGLE_DEGREE:
+        raise _too_costly(f"isolating the real roots of μ(t) would take a polynomial of degree "
+                          f"{degree} in tan(t/2) (at most {MAX_HALF_ANGLE_DEGREE}: the cost "
+                          "grows as its fourth power)", trajectory)
     try:
         legs = _legs_along(model, coordinates)
         degenerate = tuple(compose_pose(w, coordinates, pose_vars)

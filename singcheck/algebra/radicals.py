@@ -287,13 +287,22 @@ def constant_surd(p: fmpq_mpoly) -> Surd | None:
 
 
 def radical_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
-    """[(index, p)] for every ``sqrt(p)`` variable of ``ctx``."""
-    out = []
-    for i, name in enumerate(ctx.names()):
-        p = radical_prime(name)
-        if p is not None:
-            out.append((i, p))
-    return out
+    """[(index, p)] for every ``sqrt(p)`` variable of ``ctx`` (read once per context:
+    asked at every candidate)."""
+    hit = _RADICAL_VARIABLES.get(id(ctx))
+    if hit is None or hit[0] is not ctx:  # the entry holds ctx: its id is not reused
+        out = []
+        for i, name in enumerate(ctx.names()):
+            p = radical_prime(name)
+            if p is not None:
+                out.append((i, p))
+        if len(_RADICAL_VARIABLES) > 256:
+            _RADICAL_VARIABLES.clear()
+        hit = _RADICAL_VARIABLES[id(ctx)] = (ctx, tuple(out))
+    return list(hit[1])
+
+
+_RADICAL_VARIABLES: dict[int, tuple[fmpq_mpoly_ctx, tuple]] = {}
 
 
 def angle_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:

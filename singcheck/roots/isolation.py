@@ -222,14 +222,17 @@ def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
 
 
 def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
-                       tolerance: float = 1e-9) -> RootIsolation:
+                       tolerance: float = 1e-9, exact_zero=None) -> RootIsolation:
     """Every real root of ``poly(t, sin t, cos t)`` on the closed range, certified.
 
     A polynomial with square roots among its coefficients (a :func:`path_ring`
-    element) goes through :func:`_with_radicals`."""
+    element) goes through :func:`_with_radicals`; ``exact_zero(p, root)`` (True, False,
+    or None when it cannot say) decides exactly whether p vanishes at a root of its norm
+    where balls cannot tell p from a conjugate (the caller's exact arithmetic:
+    :func:`singcheck.certify.exact.vanishes_at_root`)."""
     if poly.context() is not TRIG:
         if radical_variables(poly.context()):
-            return _with_radicals(poly, interval, tolerance)
+            return _with_radicals(poly, interval, tolerance, exact_zero)
         p = reduce_relations(poly)
         if p.is_zero():
             raise IdenticallyZeroError("the function is identically zero along the path")
@@ -248,21 +251,24 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
     return _exact_univariate(p, interval, tolerance)
 
 
-def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
+def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float,
+                   exact_zero=None) -> RootIsolation:
     """Roots of a polynomial over Q(√2, √3, …): those of its norm N = ∏ p^σ (over Q,
     isolated as above), kept only where proven to be roots of p itself.
 
     Each ball T of N holds exactly one root τ of N.  If p excludes 0 on T, τ is a root of
     a conjugate only: dropped.  If every conjugate p^σ (σ ≠ id) excludes 0 on T, then
-    p(τ) = 0: kept.  Otherwise T is refined (and the precision raised) a few times;
-    what stays ambiguous is reported undecided, never guessed."""
+    p(τ) = 0: kept.  Otherwise T is refined (and the precision raised) a few times; a
+    root where p and a conjugate both still hold 0 (both may vanish there) is decided
+    by ``exact_zero`` when given (its times are the isolation's ``exact``); what stays
+    ambiguous is reported undecided, never guessed."""
     ctx = p.context()
     rest = [n for n in ctx.names() if radical_prime(n) is None]
     norm = restrict(norm_radicals(p), TRIG if len(rest) == 3 else
                     fmpq_mpoly_ctx.get(tuple(rest), "lex"))
     iso = isolate_real_roots(norm, interval, tolerance)
     sigmas = conjugates(p)
-    roots, undecided = [], list(iso.undecided)
+    roots, undecided, exact = [], list(iso.undecided), []
     for root in iso.roots:
         checkpoint()
         r, verdict = root, None
@@ -276,10 +282,14 @@ def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Root
                     verdict = True
             if verdict is not None:
                 break
+        if verdict is None and exact_zero is not None:
+            verdict = exact_zero(p, r)
+            if verdict is not None:
+                exact.append((r, verdict))
         if verdict:
             roots.append(r)
         elif verdict is None:
             undecided.append(Undecided(r.t, "a root of the norm over the square roots could "
                                        "not be told apart from a root of a conjugate near "
                                        f"t ≈ {float(r.t.mid()):.6g}"))
-    return RootIsolation(tuple(roots), tuple(undecided), iso.method)
+    return RootIsolation(tuple(roots), tuple(undecided), iso.method, tuple(exact))

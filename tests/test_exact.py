@@ -794,3 +794,226 @@ def test_the_workspace_line_tells_a_tangency_from_a_crossing(scale, start, end, 
         assert "crosses" not in line and "touching it 1" in line, line
     (item,) = [c for c in workspace_json(w)["crossings"] if XI in c["surfaces"]]
     assert item["kind"] == kind
+
+
+# -- limits met where the robot and its conjugate (√3 ↦ -√3) both are ----------------------
+
+
+def _feasible_by_samples(oracle, modes, pose_at, start: Fraction, end: Fraction,
+                       samples: int = 60) -> set[str]:
+    """The modes whose 50-digit joints are inside the (closed) limits at every sample of
+    the range, the ends included (a value within 1e-40 of a limit is on it)."""
+    eps, pi = mpmath.mpf("1e-40"), mpmath.pi
+    out = set()
+    for label, indices in modes.items():
+        inside = True
+        for k in range(samples + 1):
+            q = start + (end - start) * Fraction(k, samples)
+            t = mpmath.mpf(q.numerator) / q.denominator
+            joints = oracle.joints(indices, pose_at(t))
+            inside &= joints is not None and all(  # angles in [lo, lo + 2π): v - 2π too
+                any(leg.lo - eps <= w <= leg.hi + eps
+                    for w in ((v, v - 2 * pi) if leg.revolute else (v,)))
+                for leg, v in zip(oracle.legs, joints, strict=True))
+        if inside:
+            out.add(label)
+    return out
+
+
+@pytest.mark.parametrize("y, sign, start, feasible", [
+    # P = (0, √3) + 2(cos t, ±sin t); the elbow-2 branch that is not at (0, √3) is
+    # th2 = ±t exactly (a parallelogram: B2 - A2 = P - (0, √3)), so at t = 0 it is on
+    # th2 = 0, and so is the conjugate robot's (P = (2, -√3) is 2 from (3, 0) too)
+    ("sqrt(3) + 2*sin(t)", 1, Fraction(0), {"++", "+-"}),  # th2 = t: enters at 0
+    ("sqrt(3) - 2*sin(t)", -1, Fraction(-1, 2), {"++"}),  # th2 = -t: leaves at 0
+])
+def test_five_bar_limit_met_where_the_conjugate_robot_meets_it_too(y, sign, start, feasible):
+    from tests.robot_oracles import five_bar
+
+    def pose_at(t):
+        return [2 * mpmath.cos(t), mpmath.sqrt(3) + sign * 2 * mpmath.sin(t)]
+
+    text = trajectory(str(start), "1", x="2*cos(t)", y=y)
+    path = _revolute_path("five-bar", text)
+    mpmath.mp.dps = 50
+    oracle = five_bar()
+    modes = _oracle_modes(path, oracle, pose_at, Fraction(1, 3))
+    on_limits = {label for label, i in modes.items()
+                 if [abs(v - w) < 1e-40 for v, w in zip(
+                     oracle.joints(i, pose_at(mpmath.mpf(1) / 7)),
+                     (mpmath.pi / 3, 2 * mpmath.pi / 3), strict=True)] == [True, True]}
+    assert on_limits == {"++"}
+    for q in (Fraction(1, 3), Fraction(5, 7)):  # the other elbow 2: th2 = ±t
+        t = mpmath.mpf(q.numerator) / q.denominator
+        assert abs(mpmath.sin((oracle.joints(modes["+-"], pose_at(t))[1] - sign * t) / 2)) \
+            < 1e-40  # equal modulo 2π
+    assert _feasible_by_samples(oracle, modes, pose_at, start, Fraction(1)) == feasible
+    report = certify_path(path)
+    assert all(m.status != "unknown" for m in report.modes)
+    assert {m.label for m in report.modes if m.feasible} == feasible
+    by_label = {m.label: m for m in report.modes}
+    assert "th2 = 0 at t ≈ 0 exactly (algebraic" in by_label["++"].proof
+    if "+-" not in feasible:  # it leaves through th2 = 0 at t = 0
+        [leaving] = [b for b in by_label["+-"].branches if b.status == "infeasible"]
+        assert leaving.event_time.contains(0) and "leaves" in leaving.reason
+    # ++ sits on ξ all along (the distal links coincide): singular along the whole path
+    assert report.verdict == "singular" and "whole path" in report.reason
+    from singcheck.spaces.path_regions import path_in_workspace
+
+    w = path_in_workspace(path, name_region=False)
+    assert not w.undecided
+    # the workspace line: th2 = 0 is met at t = 0 (a branch is there; a range end or not)
+    assert [c.surfaces for c in w.crossings if c.t.contains(0)] == [("th2 = 0 (min)",)]
+
+
+def test_five_bar_where_only_the_conjugate_robot_meets_a_limit_is_free():
+    # x = 0, y = t: at τ = 2 - √3 the pose is 2 from (0, -√3), the conjugate robot's
+    # elbow on th1 = π/3 (√3 ↦ -√3): there the mode with both elbows at (0, -√3) is
+    # singular, feasible for the conjugate robot (on its limit) but not for this one
+    from tests.robot_oracles import five_bar
+
+    def pose_at(t):
+        return [mpmath.mpf(0), t]
+
+    path = _revolute_path("five-bar", trajectory("0", "1", x="0", y="t"))
+    mpmath.mp.dps = 50
+    oracle = five_bar()
+    modes = _oracle_modes(path, oracle, pose_at, Fraction(1, 3))
+    tau = 2 - mpmath.sqrt(3)
+    singular = _revolute_zero_modes(oracle, modes, pose_at(tau))
+    [elbows_down] = singular
+    joints = oracle.joints(modes[elbows_down], pose_at(tau))
+    assert abs(mpmath.cos(joints[0]) - mpmath.mpf(1) / 2) < 1e-40  # th1 = -π/3 ...
+    assert abs(mpmath.sin(joints[0]) + mpmath.sqrt(3) / 2) < 1e-40  # ... not π/3
+    feasible = _feasible_by_samples(oracle, modes, pose_at, Fraction(0), Fraction(1))
+    assert elbows_down not in feasible and feasible
+    report = certify_path(path)
+    assert {m.label for m in report.modes if m.feasible} == feasible
+    assert report.verdict == "singularity-free"
+    [near] = [c for c in report.candidates if c.t.contains(float(tau))
+              or abs(float(c.t.mid()) - float(tau)) < 1e-9]
+    assert set(near.singular_modes) == singular
+
+
+def test_a_limit_polynomial_is_decided_exactly_at_its_conjugates_root():
+    """p = t² - 2√3·t - 1 (th1 = π/3 along x = 0, y = t, up to a factor) and its
+    conjugate p̄ = t² + 2√3·t - 1 at τ = 2 - √3, a root of their norm (t² - 1)² - 12t²:
+    computed here in Q(√3) (pairs a + b√3), p̄(τ) = 0 and p(τ) = 12 - 8√3 ≠ 0.  In Q(τ),
+    √3 = 2 - τ: the tower must tell the two apart, both ways."""
+    from flint import fmpq_mpoly_ctx
+
+    from singcheck.algebra.radicals import radical_name
+    from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
+    from singcheck.certify.exact import vanishes_at_root
+    from singcheck.roots.isolation import isolate_real_roots
+
+    def mul(u, v):
+        return (u[0] * v[0] + 3 * u[1] * v[1], u[0] * v[1] + u[1] * v[0])
+
+    tau = (Fraction(2), Fraction(-1))
+    tau2 = mul(tau, tau)
+    for sign, zero in ((-1, False), (1, True)):
+        value = (tau2[0] + 2 * sign * 3 * tau[1] - 1, tau2[1] + 2 * sign * tau[0])
+        assert (value == (0, 0)) == zero
+    ring = fmpq_mpoly_ctx.get(("t", "s", "c", radical_name(3)), "lex")
+    t, _, _, r3 = ring.gens()
+    t_q = TRIG.gens()[0]
+    norm = (t_q * t_q - 1) ** 2 - 12 * t_q * t_q
+    iso = isolate_real_roots(norm, TimeRange(LinearInPi(Fraction(0)), LinearInPi(Fraction(1))))
+    [root] = iso.roots
+    assert root.t.contains(float(2 - mpmath.sqrt(3)))
+    assert vanishes_at_root(t * t - 2 * r3 * t - 1, root) is False
+    assert vanishes_at_root(t * t + 2 * r3 * t - 1, root) is True
+
+
+def test_rotary_delta_legs_2_and_3_on_their_limit_at_a_transcendental_time():
+    # y = t - cos t is 0 at the Dottie number τ; at (-3/2, 0, -1/2) legs 2 and 3 (each
+    # the other's √3-conjugate) both have a branch on th = -π/2: each limit polynomial
+    # and its conjugate vanish at τ, decided exactly in Q(τ, sin τ, cos τ)(√3)
+    from tests.robot_oracles import rotary_delta
+
+    def pose_at(t):
+        return [-mpmath.mpf(3) / 2, t - mpmath.cos(t), -mpmath.mpf(1) / 2]
+
+    path = _revolute_path("rotary-delta", trajectory("0", "1", x="-3/2", y="t - cos(t)",
+                                                     z="-1/2"))
+    mpmath.mp.dps = 50
+    oracle = rotary_delta()
+    modes = _oracle_modes(path, oracle, pose_at, Fraction(1, 3))
+    tau = mpmath.findroot(lambda t: t - mpmath.cos(t), 0.7)
+    eps = mpmath.mpf("1e-6")
+    report = certify_path(path)
+    assert all(m.status != "unknown" for m in report.modes)
+
+    def offset(theta):  # θ + π/2 taken in (-π, π]
+        return (theta + mpmath.pi / 2 + mpmath.pi) % (2 * mpmath.pi) - mpmath.pi
+
+    leaving = 0
+    for label, indices in modes.items():
+        mode = next(m for m in report.modes if m.label == label)
+        for leg in (1, 2):  # th2, th3: the branch at -π/2 at τ crosses it there
+            value = oracle.joints(indices, pose_at(tau))[leg]
+            on = abs(mpmath.sin((value + mpmath.pi / 2) / 2)) < 1e-40
+            branch = mode.branches[leg]
+            if on:  # θ + π/2 (mod 2π, in (-π, π)) changes sign: θ crosses -π/2 at τ
+                before, after = (offset(oracle.joints(indices, pose_at(tau + d))[leg])
+                                 for d in (-eps, eps))
+                assert before * after < 0
+                assert "exactly (at a transcendental time" in branch.proof
+                inside = all(-mpmath.pi / 2 <= offset(oracle.joints(
+                    indices, pose_at(tau * k / 20))[leg]) - mpmath.pi / 2 <= 3 * mpmath.pi / 4
+                    for k in range(20))
+                if inside and before > 0:  # inside on [0, τ), leaves at τ
+                    leaving += 1
+                    assert branch.status == "infeasible" and \
+                        abs(float(branch.event_time.mid()) - float(tau)) < 1e-9, (label, leg)
+            if branch.event_time is not None and \
+                    abs(float(branch.event_time.mid()) - float(tau)) < 1e-9:
+                assert on
+    assert leaving
+    assert report.verdict == "infeasible"
+
+
+@pytest.mark.parametrize("y, start, end", [("-t", "-1/4", "0"), ("-t", "-1/4", "1/4")])
+def test_linear_delta_slider_on_its_limit_where_the_conjugate_robot_is_too(y, start, end):
+    # at (1/4, 0, 1/4 - √15/4) rail 2 and its √3-conjugate (rail 3's place) are as far
+    # from the pose, and slider 2's upper branch is exactly on r2 = 1/4: along y = -t it
+    # is inside for t < 0 and leaves there at t = 0
+    from flint import arb
+
+    from tests.robot_oracles import linear_delta
+
+    z = (1 - mpmath.sqrt(15)) / 4
+
+    def pose_at(t):
+        return [mpmath.mpf(1) / 4, -t, z]
+
+    path = _revolute_path("linear-delta", trajectory(start, end, x="1/4", y=y,
+                                                     z="1/4 - sqrt(15)/4"))
+    mpmath.mp.dps = 50
+    oracle = linear_delta()
+    modes = {}  # our label → the oracle's branch indices (its ρ = (-b ± √d)/2a, + first)
+    for label in ("".join(s) for s in product("+-", repeat=3)):
+        modes[label] = tuple(0 if sign == "+" else 1 for sign in label)
+    for ours, theirs in zip(path.legs, oracle.legs, strict=True):  # matched by value
+        t0 = Fraction(start) / 2
+        mine = ours.branches(arb(float(t0)))
+        both = theirs.branches(pose_at(mpmath.mpf(t0.numerator) / t0.denominator))
+        assert [abs(float(mine[k].mid()) - float(v)) < 1e-9
+                for k, v in zip("+-", both, strict=True)] == [True, True]
+    top = oracle.legs[1].branches(pose_at(mpmath.mpf(0)))[0]
+    assert abs(top - mpmath.mpf(1) / 4) < 1e-40  # r2's upper branch on its limit at t = 0
+    for q, inside in ((-1, True), (1, False)):
+        value = oracle.legs[1].branches(pose_at(mpmath.mpf(q) / 8))[0]
+        assert (value >= mpmath.mpf(1) / 4) == inside
+    feasible = _feasible_by_samples(oracle, modes, pose_at, Fraction(start), Fraction(end))
+    report = certify_path(path)
+    assert all(m.status != "unknown" for m in report.modes)
+    assert {m.label for m in report.modes if m.feasible} == feasible
+    assert feasible == ({"++-"} if end == "0" else set())
+    for m in report.modes:
+        branch = m.branches[1]
+        if m.label[1] == "+":
+            assert "r2 = 1/4 at t ≈ 0 exactly (algebraic" in branch.proof
+            if end != "0":
+                assert branch.status == "infeasible" and branch.event_time.contains(0)

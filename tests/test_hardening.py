@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import os
 import signal
 import stat
@@ -691,6 +692,109 @@ def test_without_a_memory_bound_the_greedy_child_gets_its_memory(monkeypatch):
         run_forked(lambda r: _greedy_eliminate(None, r), None, 1.0, "greedy")
 
 
+# -- in-process when an a-priori bound proves the elimination small ------------------------
+
+
+def _one_norm_bits(p) -> int:
+    """Bits of the 1-norm of p's primitive integer multiple, from its coefficients."""
+    coeffs = [Fraction(int(c.p), int(c.q)) for c in p.coeffs()]
+    den = 1
+    for c in coeffs:
+        den = den * c.denominator // math.gcd(den, c.denominator)
+    ints = [int(c * den) for c in coeffs]
+    g = math.gcd(*ints)
+    return sum(abs(x) // g for x in ints).bit_length()
+
+
+def _dense(ctx, box, bits, seed, extra=None):
+    import itertools
+    import random
+
+    rng = random.Random(seed)
+    terms = {e: rng.randrange(-2**bits, 2**bits)
+             for e in itertools.product(*(range(d + 1) for d in box))}
+    return ctx.from_dict({**terms, **(extra or {})})
+
+
+def _chains():
+    """(g, legs) of the bundled robots' projections (prismatic and revolute legs, √3) and
+    of a dense random chain, whose intermediates fill their degree boxes."""
+    from flint import fmpq_mpoly_ctx
+
+    from singcheck.elimination.projection import singularity_surface_request
+    from singcheck.elimination.requests import leg_structure
+    from singcheck.model.robot import build_model
+    from singcheck.spec.files import load_robot
+
+    out = []
+    for name in ("3-prr", "five-bar", "orthoglide", "linear-delta", "skew-biglide"):
+        model = build_model(load_robot(ROBOTS / f"{name}.yaml"))
+        out.append((name, *leg_structure(singularity_surface_request(model))))
+    ctx = fmpq_mpoly_ctx.get(("x", "y", "u", "v"), "lex")
+    g = _dense(ctx, (6, 6, 3, 2), 60, 1)
+    legs = [("u", _dense(ctx, (2, 2, 0, 0), 20, 2, {(0, 0, 2, 0): 1})),
+            ("v", _dense(ctx, (1, 2, 0, 0), 20, 3, {(0, 0, 0, 2): 3}))]
+    out.append(("dense", g, legs))
+    return out
+
+
+@pytest.mark.parametrize("name, g, legs", _chains(), ids=lambda x: x if isinstance(x, str) else "")
+def test_the_norm_chain_bound_holds_for_every_polynomial_the_chain_forms(
+        monkeypatch, name, g, legs):
+    """Every resultant or revolute norm the chain forms (what it hands to squarefree_part)
+    and every squarefree part has at most the bound's terms and coefficient bits (the
+    1-norm of its primitive integer multiple, recomputed here)."""
+    from singcheck.elimination import requests
+
+    terms, bits = requests.norm_chain_bound(g, legs)
+    seen = []
+    original = requests.squarefree_part
+
+    def recording(p):
+        out = original(p)
+        seen.extend([p, out])
+        return out
+
+    monkeypatch.setattr(requests, "squarefree_part", recording)
+    seen.append(requests.norm_chain(g, legs))
+    assert seen
+    for p in seen:
+        assert len(p) <= terms, name
+        assert _one_norm_bits(p) <= bits, name
+    if name == "dense":  # a dense chain fills its box: the bound is not vacuous
+        assert max(len(p) for p in seen) * 2 > terms
+
+
+def test_a_request_proven_small_runs_without_a_fork_and_any_other_in_one(monkeypatch):
+    """The 3-PRR's ξ (proven at most 714,425 terms of 292 bits: 1.1 GB by the memory
+    bound's count) is computed in this process with the default --timeout and an 8 GiB
+    bound; with --timeout below a minute, or a memory bound too small for its proof, in
+    a forked child; the same ξ either way (24,389 terms), and its re-check passes."""
+    from singcheck.elimination.cas import get_backend
+    from singcheck.elimination.projection import project_robot
+    from singcheck.model.robot import build_model
+    from singcheck.spec.files import load_robot
+
+    model = build_model(load_robot(ROBOTS / "3-prr.yaml"))
+    forks = []
+    real_fork = os.fork
+
+    def counting_fork():
+        forks.append(1)
+        return real_fork()
+
+    monkeypatch.setattr(os, "fork", counting_fork)
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "8G")
+    xi = project_robot(model, get_backend("flint")).singularity_surface
+    assert not forks
+    assert len(xi) == 24389
+    assert project_robot(model, get_backend("flint", timeout=5)).singularity_surface == xi
+    assert len(forks) == 1  # the flint result is the norm: the re-check forks no other
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "512M")
+    assert project_robot(model, get_backend("flint")).singularity_surface == xi
+    assert len(forks) == 2
+
+
 # -- 8. -o targets ------------------------------------------------------------------------
 
 
@@ -835,6 +939,28 @@ def test_mu_size_bound_holds_for_a_composed_path(orthoglide_projection):
     mu = compose_pose(xi, phi, ("x", "y", "z"))
     assert len(mu) <= terms
     assert mu.degrees()[0] <= deg_t and mu.degrees()[1] + mu.degrees()[2] <= deg_sc
+
+
+def test_the_crude_composition_bound_is_above_the_estimate_and_the_result(
+        orthoglide_projection):
+    """The crude bound that lets μ skip the exact estimate is above it (work and both
+    degrees) and above what composing gives, on paths mixing t, sin and cos; then
+    substituting a constant coordinate first gives the same μ."""
+    from singcheck.algebra.composition import composition_work, crude_work
+    from singcheck.certify.path import _compose_mu, _pose_args, compose_pose
+    from singcheck.spec.grammar import compile_trajectory_coordinate, parse
+
+    xi = orthoglide_projection.surface_on_circles
+    for texts in (("(sin(t) + cos(t) + t)^3", "t^2 - sin(2*t)", "1"),
+                  ("8/7*sin(t)^3", "13/14*cos(t) - 5/14*cos(2*t)", "1"),
+                  ("sin(3*t)/2", "t/5", "cos(t)")):
+        phi = tuple(compile_trajectory_coordinate(parse(text), "t", {}) for text in texts)
+        args = _pose_args(xi, phi, ("x", "y", "z"))[1]
+        crude, exact = crude_work(xi, args), composition_work(xi, args)
+        assert all(c >= e for c, e in zip(crude, exact, strict=True)), (texts, crude, exact)
+        mu = _compose_mu(xi, phi, ("x", "y", "z"), None)
+        assert mu.degrees()[0] <= crude[1] and mu.degrees()[1] + mu.degrees()[2] <= crude[2]
+        assert mu == compose_pose(xi, phi, ("x", "y", "z"))  # no shortcut: the same μ
 
 
 @pytest.mark.parametrize("robot, pose, rng", [

@@ -293,3 +293,62 @@ def test_the_path_wise_norm_reduces_sin_t_squared_exactly():
         cm, sm = _circle_point(m)
         point = {"r": Fraction(2, 7), "t": Fraction(-3, 4), "s": sm, "c": cm}
         assert _value(q, point) == _value(p, point)
+
+
+def test_a_pose_angle_that_is_a_multiple_of_t_agrees_with_the_oracle(tmp_path, robots):
+    """The 3-PRR's crossing path run five times as fast (phi = 5t on [0, 1/5]: μ in sin t,
+    cos t of five times the degree): the oracle's singular time, divided by five."""
+    path = oracles.Path("3-prr-5t", oracles.three_prr, 0, mp.mpf(1) / 5,
+                        lambda t: [mp.mpf(3) / 2 + mp.sin(5 * t) / 2,
+                                   2 - mp.cos(5 * t) / 2, 5 * t], True)
+    truth = oracles.solve(path)
+    assert truth.verdict == "singular"
+    file = tmp_path / "3-prr-5t.yaml"
+    file.write_text("name: 3-prr-5t\nparameter: t\nrange: [0, 1/5]\npose:\n"
+                    "  x: 3/2 + sin(5*t)/2\n  y: 2 - cos(5*t)/2\n  phi: 5*t\n")
+    robot = robots("3-prr")
+    _agrees(api.check(robot, api.load_trajectory(file, robot), regions=False),
+            path.oracle(), truth)
+
+
+def test_a_pose_angle_too_high_a_multiple_of_t_is_refused_up_front(tmp_path, robots,
+                                                                    monkeypatch, capsys):
+    """phi = 30t: μ's roots would be isolated in a polynomial of degree above the bound
+    (the run went past a 120 s time limit before the bound): refused at once, in one
+    line naming the bound (a spec error: run exits 2)."""
+    import time
+
+    from singcheck.errors import SpecError
+    from tests.test_hardening import run_cli, trajectory
+
+    path = trajectory(tmp_path, {"x": "3/2 + sin(t)/2", "y": "2 - cos(t)/2", "phi": "30*t"})
+    robot = robots("3-prr")
+    start = time.monotonic()
+    with pytest.raises(SpecError) as refused:
+        api.check(robot, api.load_trajectory(path, robot), regions=False)
+    assert time.monotonic() - start < 5
+    message = str(refused.value)
+    assert "\n" not in message
+    assert "too costly: isolating the real roots of μ(t) would take a polynomial of degree" \
+        in message
+    assert "in tan(t/2) (at most 800: the cost grows as its fourth power)" in message
+    monkeypatch.setenv("SINGCHECK_CACHE_DIR", str(tmp_path / "cache"))
+    code, out, _ = run_cli(monkeypatch, capsys, "run", str(ROBOTS / "3-prr.yaml"), path,
+                           "--backend", "flint", "-q", "--format", "json")
+    assert code == 2
+
+
+def test_a_mixed_t_and_sin_t_path_of_the_rotary_delta_agrees_with_the_oracle(tmp_path,
+                                                                             robots):
+    """ξ of the rotary Delta is not expanded: μ is eliminated along this path (t and
+    sin t, cos t mixed), then its roots are found by branch-and-bound."""
+    path = oracles.Path("rotary-delta-mixed", oracles.rotary_delta, 0, 1,
+                        lambda t: [t / 3, mp.sin(t) / 4, -2 + mp.cos(t) / 10], False)
+    truth = oracles.solve(path)
+    file = tmp_path / "rotary-delta-mixed.yaml"
+    file.write_text("name: rotary-delta-mixed\nparameter: t\nrange: [0, 1]\npose:\n"
+                    "  x: t/3\n  y: sin(t)/4\n  z: -2 + cos(t)/10\n")
+    robot = robots("rotary-delta")
+    report = api.check(robot, api.load_trajectory(file, robot), regions=False)
+    assert report.verdict == "singularity-free"
+    _agrees(report, path.oracle(), truth)

@@ -9,7 +9,16 @@ import mpmath
 import pytest
 from flint import arb, fmpq, fmpq_poly, fmpz_poly
 
-from singcheck.algebra.trig import C, LinearInPi, S, T, TimeRange, cos_multiple, sin_multiple
+from singcheck.algebra.trig import (
+    C,
+    LinearInPi,
+    S,
+    T,
+    TimeRange,
+    cos_multiple,
+    reduce_trig,
+    sin_multiple,
+)
 from singcheck.roots.enclosures import IdenticallyZeroError
 from singcheck.roots.isolation import isolate_real_roots
 
@@ -197,6 +206,37 @@ def testhalf_angle_polynomial_is_the_substitution():
             assert m(u) == w**d * direct.leading_coefficient()
 
 
+def test_deflated_half_angle_is_the_substitution_deflated():
+    """N(u^k) is M(u) = (1+u²)^d p(2u/(1+u²), (1-u²)/(1+u²)) up to a constant factor
+    (exact rationals at sample points), with and without sin t, and k is the largest
+    deflation: no other exponent of N's u^k is a common multiple."""
+    import random
+
+    from singcheck.roots.half_angle import deflated_half_angle
+
+    rng = random.Random(11)
+    for case in range(24):
+        p = _random_trig(rng, 6).subs({"t": 0})
+        if case % 2:  # free of s (even paths such as heart 1): the shortcut's case
+            p = reduce_trig(p.subs({"s": 0}) + C**3 - C)
+        if p.is_zero() or p.is_constant():
+            continue
+        n, k = deflated_half_angle(p)
+        d = max(j + kk for (_, j, kk), _ in p.terms())
+        ratio = None
+        for u in (fmpq(3, 7), fmpq(-5, 2), fmpq(1), fmpq(2), fmpq(-1, 3)):
+            w = 1 + u * u
+            direct = w**d * p.subs({"s": 2 * u / w, "c": (1 - u * u) / w}).leading_coefficient()
+            mine = n(u**k)
+            if direct == 0:
+                assert mine == 0
+                continue
+            ratio = ratio if ratio is not None else mine / direct
+            assert mine == ratio * direct and ratio != 0
+        exponents = [i for i, c in enumerate(n.coeffs()) if c != 0]
+        assert math.gcd(*exponents) == 1 or exponents == [0] or len(exponents) == 1
+
+
 @pytest.mark.parametrize("m, expected", [
     ([-8, 0, 0, 1], [2]),  # u^3 = 8: deflation 3, odd
     ([8, 0, 0, 1], [-2]),  # u^3 = -8
@@ -313,3 +353,97 @@ def test_reduce_trig_is_the_same_function_with_degree_at_most_one_in_sine():
                 return sum(mpmath.mpf(int(c.p)) / int(c.q) * x**int(i) * mpmath.sin(x)**int(j)
                            * mpmath.cos(x)**int(k) for (i, j, k), c in q.terms())
             assert abs(value(p) - value(r)) < mpmath.mpf(10) ** -30 * (1 + abs(value(p)))
+
+
+def test_root_of_power_isolates_the_kth_root_among_the_roots_of_h_of_u_to_the_k():
+    """u = ±|v|^(1/k) from v's own interval (no isolation of h(u^k)): the interval holds
+    the 50-digit root and no other real root of h(u^k) (all of them computed by mpmath),
+    and h(u^k) changes sign at its ends; a rational k-th power comes out exact."""
+    import random
+
+    from singcheck.roots.rational import real_roots_exact, root_of_power
+
+    rng_ = random.Random(17)
+    cases = 0
+    for _ in range(12):
+        degree = rng_.randint(1, 5)
+        h = fmpz_poly([rng_.randint(-30, 30) for _ in range(degree)] + [rng_.randint(1, 5)])
+        h *= fmpz_poly([rng_.choice([-9, -4, -2, 2, 4, 9]), rng_.choice([1, 4])])  # v = ±9/4…
+        for rr, _ in real_roots_exact(fmpq_poly(h)):
+            if rr.lo == rr.hi == 0:
+                continue
+            for k in (2, 3, 4):
+                v_sign = 1 if rr.lo + rr.hi > 0 else -1
+                for sign in ((1, -1) if k % 2 == 0 else (v_sign,)):
+                    if k % 2 == 0 and v_sign < 0:
+                        continue
+                    cases += 1
+                    u = root_of_power(rr, k, sign)
+                    g = [mpmath.mpf(int(c.p)) / int(c.q) for c in u.poly.coeffs()]
+                    reals = [x.real for x in mpmath.polyroots(g[::-1], maxsteps=200,
+                                                              extraprec=100)
+                             if abs(x.imag) < mpmath.mpf(10) ** -30]
+                    a = mpmath.mpf(int(rr.lo.p)) / int(rr.lo.q)
+                    b = mpmath.mpf(int(rr.hi.p)) / int(rr.hi.q)
+                    v, = [x.real for x in mpmath.polyroots(
+                        [mpmath.mpf(int(c.p)) / int(c.q) for c in rr.poly.coeffs()[::-1]],
+                        maxsteps=200, extraprec=100)
+                        if abs(x.imag) < mpmath.mpf(10) ** -30 and a <= x.real <= b]
+                    target = sign * abs(v) ** (mpmath.mpf(1) / k)
+                    lo = mpmath.mpf(int(u.lo.p)) / int(u.lo.q)
+                    hi = mpmath.mpf(int(u.hi.p)) / int(u.hi.q)
+                    inside = [x for x in reals if lo - mpmath.mpf(10) ** -40 <= x
+                              <= hi + mpmath.mpf(10) ** -40]
+                    assert len(inside) == 1 and abs(inside[0] - target) < mpmath.mpf(10) ** -30
+                    if u.lo == u.hi:
+                        assert u.poly(u.lo) == 0
+                    else:
+                        assert u.poly(u.lo) * u.poly(u.hi) < 0
+    assert cases > 20
+
+
+def test_exact_isolation_of_roots_spread_over_many_octaves():
+    """Roots at 1 exactly, at dyadic points on both sides of 1, far beyond it (u = tan(t/2)
+    near t = ±π) and near 0, with complex pairs: one interval per known root, holding it
+    and no other, with a sign change at its ends (or the exact point)."""
+    from singcheck.roots.rational import real_roots_exact
+
+    roots = [Fraction(1), Fraction(4), Fraction(1, 3), Fraction(4096), Fraction(1, 4096),
+             Fraction(3, 2), Fraction(1000), Fraction(-7, 5), Fraction(-65536), Fraction(5, 4)]
+    f = fmpq_poly([1])
+    for r in roots:
+        f *= fmpq_poly([fmpq(-r.numerator, r.denominator), 1])
+    f *= fmpq_poly([2, 0, 1]) * fmpq_poly([10**6 + 1, -2000, 1])  # ±i√2, 1000 ± i
+    isolated = real_roots_exact(f)
+    assert len(isolated) == len(roots)
+    for (rr, mult), r in zip(isolated, sorted(roots), strict=True):
+        assert mult == 1
+        q = fmpq(r.numerator, r.denominator)
+        assert rr.lo <= q <= rr.hi
+        assert all(not rr.lo <= fmpq(o.numerator, o.denominator) <= rr.hi
+                   for o in roots if o != r)
+        assert (rr.lo == rr.hi == q) or rr.poly(rr.lo) * rr.poly(rr.hi) < 0
+
+
+def test_refinement_on_wilkinsons_polynomial():
+    """Refining the real roots of Wilkinson's perturbed polynomial (x-1)…(x-20) + 2^-23 x^19,
+    ill-conditioned (Newton's unproven guesses there can miss, and the proven steps must
+    take over): each interval, 10^-12 wide, holds exactly one real root computed by
+    mpmath at 50 digits, with a sign change."""
+    from singcheck.roots.rational import real_roots_exact
+
+    f = fmpq_poly([1])
+    for i in range(1, 21):
+        f *= fmpq_poly([-i, 1])
+    f += fmpq_poly([0] * 19 + [fmpq(1, 2**23)])
+    coeffs = [mpmath.mpf(int(c.p)) / int(c.q) for c in f.coeffs()[::-1]]
+    reals = sorted(x.real for x in mpmath.polyroots(coeffs, maxsteps=400, extraprec=400)
+                   if abs(x.imag) < mpmath.mpf(10) ** -30)
+    isolated = real_roots_exact(f)
+    assert len(isolated) == len(reals) == 10
+    for (rr, _), x in zip(isolated, reals, strict=True):
+        rr.bisect_to(fmpq(1, 10**12))
+        assert rr.hi - rr.lo <= fmpq(1, 10**12)
+        lo, hi = (mpmath.mpf(int(q.p)) / int(q.q) for q in (rr.lo, rr.hi))
+        assert lo <= x <= hi
+        assert rr.poly(rr.lo) * rr.poly(rr.hi) < 0

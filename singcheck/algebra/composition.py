@@ -124,10 +124,12 @@ def term_costs(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> list[int]:
     return costs
 
 
-def _small(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> bool:
-    """Whether a crude bound (every term costing what the largest exponents together
-    would) already keeps the whole composition within :data:`PIECE_WORK`: a leg's
-    coefficient, a small robot's ξ."""
+def crude_work(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> tuple[int, int, int]:
+    """Upper bounds on the three numbers of :func:`composition_work`, from ``p``'s
+    degree in each variable alone: every term is charged what the largest exponents of
+    all variables together would cost, so its degrees in t and in the others, its bits
+    and hence its cost are at least any real term's.  No Python loop over ``p``'s terms
+    and no composition: for ruling out the exact estimate when it cannot matter."""
     a = b = bits = 0
     widest = 1
     for d, x in zip(p.degrees(), args, strict=True):
@@ -137,7 +139,13 @@ def _small(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> bool:
             a, b, bits = a + d * dt, b + d * dr, bits + d * bt
             widest = max(widest, len(x))
     bits += memo_per_object(_BITS, p, _bits, keep=1024)
-    return len(p) * _cost(a, b, bits, widest) <= PIECE_WORK
+    return len(p) * _cost(a, b, bits, widest), a, b
+
+
+def _small(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> bool:
+    """Whether the crude bound (:func:`crude_work`) already keeps the whole composition
+    within :data:`PIECE_WORK`: a leg's coefficient, a small robot's ξ."""
+    return crude_work(p, args)[0] <= PIECE_WORK
 
 
 def compose_in_pieces(p: fmpq_mpoly, args: list[fmpq_mpoly], ring: fmpq_mpoly_ctx,

@@ -16,8 +16,7 @@ True
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from fractions import Fraction
 
 from flint import acb, arb, ctx, fmpq, fmpq_mpoly
@@ -38,22 +37,41 @@ def evaluate(poly: fmpq_mpoly, values: Sequence[Ball]) -> Ball:
     ball arithmetic, so the result encloses the exact value for every point of the
     input balls.
     """
-    powers: list[dict[int, Ball]] = [{0: arb(1), 1: v} for v in values]
-
-    def power(i: int, e: int) -> Ball:
-        cache = powers[i]
-        if e not in cache:
-            cache[e] = values[i] ** e
-        return cache[e]
-
+    powers: dict[tuple[int, int], Ball] = {}  # (generator, exponent ≥ 2) -> its power
     total: Ball = arb(0)
-    for exps, coeff in poly.terms():
-        term: Ball = arb(coeff)
-        for i, e in enumerate(exps):
-            if e:
-                term = term * power(i, e)
+    for coeff, factors in _terms(poly):
+        term: Ball = coeff
+        for i, e in factors:
+            if e == 1:
+                term = term * values[i]
+            else:
+                p = powers.get((i, e))
+                if p is None:
+                    p = powers[i, e] = values[i] ** e
+                term = term * p
         total = total + term
     return total
+
+
+_TERMS: dict[int, tuple[fmpq_mpoly, dict]] = {}
+
+
+def _terms(poly: fmpq_mpoly) -> list[tuple[arb, tuple[tuple[int, int], ...]]]:
+    """[(ball of the coefficient, ((generator, exponent), …))] of ``poly``'s terms at the
+    current precision, once per polynomial and precision (the entry holds ``poly``, so
+    its id is not reused): :func:`evaluate` runs on the same few polynomials thousands
+    of times."""
+    hit = _TERMS.get(id(poly))
+    if hit is None or hit[0] is not poly:
+        if len(_TERMS) > 1024:
+            _TERMS.clear()
+        hit = _TERMS[id(poly)] = (poly, {})
+    terms = hit[1].get(ctx.prec)
+    if terms is None:
+        terms = hit[1][ctx.prec] = [
+            (arb(coeff), tuple((i, int(e)) for i, e in enumerate(exps) if e))
+            for exps, coeff in poly.terms()]
+    return terms
 
 
 def hull(lo: arb, hi: arb) -> arb:
@@ -91,12 +109,20 @@ def endpoints(x: arb) -> tuple[float, float]:
     return lo, hi
 
 
-@contextmanager
-def working_precision(bits: int) -> Iterator[None]:
-    """Run a block with FLINT's ball precision raised to at least ``bits``; restore after."""
-    old = ctx.prec
-    ctx.prec = max(old, int(bits))
-    try:
-        yield
-    finally:
-        ctx.prec = old
+class working_precision:  # noqa: N801 (used as a function: ``with working_precision(b):``)
+    """Run a block with FLINT's ball precision raised to at least ``bits``; restore after
+    (also on an exception).  A plain class rather than a generator context manager: it
+    is entered dozens of times per certificate, and contextlib's machinery cost more
+    than the block."""
+
+    __slots__ = ("bits", "old")
+
+    def __init__(self, bits: int) -> None:
+        self.bits = int(bits)
+
+    def __enter__(self) -> None:
+        self.old = ctx.prec
+        ctx.prec = max(self.old, self.bits)
+
+    def __exit__(self, *exc) -> None:
+        ctx.prec = self.old

@@ -22,6 +22,7 @@ from __future__ import annotations
 from collections import OrderedDict
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import cached_property
 
 from flint import (
     arb,
@@ -90,13 +91,26 @@ class LinearInPi:
     pi_coefficient: Fraction = Fraction(0)
 
     def ball(self) -> arb:
-        """A rigorous enclosure at the current working precision."""
-        return arb(fmpq(self.rational.numerator, self.rational.denominator)) + arb(
-            fmpq(self.pi_coefficient.numerator, self.pi_coefficient.denominator)
-        ) * arb.pi()
+        """A rigorous enclosure at the current working precision (remembered per number
+        and precision, outside the instance, which stays picklable: range ends are
+        asked for their balls dozens of times per certificate)."""
+        key = (id(self), ctx.prec)
+        hit = _END_BALLS.get(key)
+        if hit is None or hit[0] is not self:  # the entry holds self: its id is not reused
+            if len(_END_BALLS) > 512:
+                _END_BALLS.clear()
+            hit = _END_BALLS[key] = (self, arb(fmpq(self.rational.numerator,
+                                                    self.rational.denominator)) + arb(
+                fmpq(self.pi_coefficient.numerator, self.pi_coefficient.denominator)
+            ) * arb.pi())
+        return hit[1]
+
+    @cached_property
+    def _float(self) -> float:
+        return float(self.rational) + float(self.pi_coefficient) * 3.141592653589793
 
     def __float__(self) -> float:
-        return float(self.rational) + float(self.pi_coefficient) * 3.141592653589793
+        return self._float
 
     def __str__(self) -> str:
         parts = []
@@ -107,6 +121,9 @@ class LinearInPi:
             term = "pi" if k == 1 else "-pi" if k == -1 else f"{k}*pi"
             parts.append(term if not parts or term.startswith("-") else "+" + term)
         return "".join(parts)
+
+
+_END_BALLS: dict[tuple[int, int], tuple[LinearInPi, arb]] = {}
 
 
 @dataclass(frozen=True)
@@ -146,12 +163,17 @@ def evaluate_trig(p: fmpq_mpoly, t: arb, tight: bool = False) -> arb:
     returned: each contains every value.
     """
     split = _split(p)
-    if isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
+    if type(split) is tuple:  # free of t: P₀(c) + s·P₁(c)
+        s, c = _sin_cos_multiple(t, 1)
+        p0, p1 = split
+        total = p0(c) if p1 is None else p0(c) + s * p1(c)
+    elif isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
         return split(t)
-    s, c = _sin_cos_multiple(t, 1)
-    total = arb(0)
-    for p0, p1 in reversed(split):
-        total = total * t + p0(c) + s * p1(c)
+    else:
+        s, c = _sin_cos_multiple(t, 1)
+        total = arb(0)
+        for p0, p1 in reversed(split):
+            total = total * t + p0(c) + s * p1(c)
     if tight and t.rad() > _WIDE:
         fourier = _fourier_value(p, t)
         if fourier is not None:  # each of the three balls holds every value: the narrowest
@@ -278,34 +300,44 @@ def _chebyshev_change(n: int, part: int) -> arb_mat:
     return hit
 
 
-_SPLITS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, list]] = OrderedDict()
+#: id(p) -> (p, {precision: split}); the entry holds p, so its id is not reused
+_SPLITS: OrderedDict[int, tuple[fmpq_mpoly, dict]] = OrderedDict()
 _SPLITS_KEPT = 512
 
 
-def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | arb_poly:
-    """[(P₀ᵢ, P₁ᵢ) for i = 0 … deg_t p] as ball polynomials at the current precision
-    (a polynomial free of sin and cos: one ball polynomial in t)."""
-    key = (id(p), ctx.prec)
-    hit = _SPLITS.get(key)
-    if hit is not None and hit[0] is p:  # the entry holds p, so its id is not reused
-        _SPLITS.move_to_end(key)
-        return hit[1]
+def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | tuple | arb_poly:
+    """[(P₀ᵢ, P₁ᵢ) for i = 0 … deg_t p] as ball polynomials at the current precision;
+    a polynomial free of t: the pair (P₀, P₁) itself (P₁ None when p is free of s, whose
+    term s·P₁(c) is then an exact 0); free of sin and cos: one ball polynomial in t.
+    Memoised per polynomial and precision (the oldest polynomial dropped past
+    :data:`_SPLITS_KEPT`)."""
+    hit = _SPLITS.get(id(p))
+    if hit is not None and hit[0] is p:
+        split = hit[1].get(ctx.prec)
+        if split is not None:
+            return split
+    else:
+        hit = (p, {})
+    split = hit[1][ctx.prec] = _split_at_precision(p)
+    _SPLITS[id(p)] = hit
+    _SPLITS.move_to_end(id(p))
+    if len(_SPLITS) > _SPLITS_KEPT:
+        _SPLITS.popitem(last=False)
+    return split
+
+
+def _split_at_precision(p: fmpq_mpoly):
     q = reduce_trig(p)
     dt, ds, dc = q.degrees()
     if ds == 0 and dc == 0:
         by_t = [fmpq(0)] * (dt + 1)
         for (i, _, _), a in q.terms():
             by_t[i] = a
-        split = arb_poly(fmpq_poly(by_t))
-        _SPLITS[key] = (p, split)
-        if len(_SPLITS) > _SPLITS_KEPT:
-            _SPLITS.popitem(last=False)
-        return split
+        return arb_poly(fmpq_poly(by_t))
     coeffs = [[[fmpq(0)] * (dc + 1) for _ in range(2)] for _ in range(dt + 1)]
     for (i, j, k), a in q.terms():
         coeffs[i][j][k] = a
     split = [tuple(arb_poly([arb(a) for a in row]) for row in by_t) for by_t in coeffs]
-    _SPLITS[key] = (p, split)
-    if len(_SPLITS) > _SPLITS_KEPT:
-        _SPLITS.popitem(last=False)
+    if dt == 0:
+        return (split[0][0], split[0][1] if ds > 0 else None)
     return split

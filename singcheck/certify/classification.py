@@ -129,8 +129,7 @@ class TrajectoryReport:
 
 
 def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
-    pose = path.pose_at(t)
-    variables = path.pose_variables_at(t)
+    pose, variables = path.pose_and_variables_at(t)
     per_leg = [leg.branches(t) for leg in path.legs]
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}
@@ -173,10 +172,11 @@ def _integral(path: PathModel, t: arb) -> bool:
     return all(excludes_zero(evaluate_path(w, t)) for w in path.degenerate)
 
 
-def _sign_at(path: PathModel, mode: WorkingMode, point: arb) -> int | None:
-    _, _, values = _mode_values(path, [mode], point)
-    value = values[mode.label]
-    return sign(value) if isinstance(value, arb) else None
+def _signs_at(path: PathModel, modes: list[WorkingMode], point: arb) -> dict[str, int | None]:
+    """The proven sign of det A along each mode at a point (None: not proven, or
+    complex); the pose and the legs' branches are enclosed once for all the modes."""
+    _, _, values = _mode_values(path, modes, point)
+    return {label: sign(v) if isinstance(v, arb) else None for label, v in values.items()}
 
 
 def _branches_continuous(path: PathModel, t: arb) -> bool:
@@ -214,10 +214,13 @@ def _decide(path, modes, root: RealRoot, by_elimination: bool = True):
         open_modes = []
     if open_modes and not _branches_continuous(path, root.t):
         return pose, joints, decided
-    for mode in open_modes:
-        lo, hi = _sign_at(path, mode, root.t.lower()), _sign_at(path, mode, root.t.upper())
-        if lo is not None and hi is not None and lo != hi:
-            decided[mode.label] = ModeAtCandidate(mode.label, SINGULAR, BY_SIGN_CHANGE)
+    if open_modes:
+        lows, highs = (_signs_at(path, open_modes, end) for end in (root.t.lower(),
+                                                                     root.t.upper()))
+        for mode in open_modes:
+            lo, hi = lows[mode.label], highs[mode.label]
+            if lo is not None and hi is not None and lo != hi:
+                decided[mode.label] = ModeAtCandidate(mode.label, SINGULAR, BY_SIGN_CHANGE)
     return pose, joints, decided
 
 

@@ -45,7 +45,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from flint import acb, arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
+from flint import acb, arb, arb_poly, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 
 from singcheck.algebra.intervals import evaluate, excludes_zero, working_precision
 from singcheck.algebra.polynomials import constant_value, memo_per_object
@@ -56,8 +56,13 @@ from singcheck.certify.path import PathModel
 from singcheck.roots.enclosures import AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t
-from singcheck.roots.rational import RationalRoot, rational_ball
-from singcheck.roots.transcendental import NotExact, TranscendentalPoint, TrigElements
+from singcheck.roots.rational import RationalRoot, minimal_polynomial, rational_ball
+from singcheck.roots.transcendental import (
+    NotExact,
+    TranscendentalPoint,
+    TrigElements,
+    ring_circle,
+)
 
 _MAX_BITS = 1 << 16
 
@@ -106,17 +111,24 @@ class ModeExpression:
     def __init__(self, path: PathModel) -> None:
         model = path.projection.model
         ring_in = path.coordinates[0].context() if path.coordinates else TRIG
+        #: a pose angle g(t) + qπ, g ∈ Q[t]: its (C, S) renamed (c, s) (transcendental)
+        self.circle = ring_circle(ring_in)
+        if self.circle is not None:
+            ring_in = TRIG
         path_names = ring_in.names()
         primes = [radical_prime(v) for v in path_names[3:]]
         if tuple(path_names[:3]) != ("t", "s", "c") or None in primes:
             raise NotExact("the path ring has variables other than t, sin t, cos t and "
-                           "square roots")
+                           "square roots (two pose angles, an angle with sin t or cos t, "
+                           "or one with square roots)")
         quadratic = [i for i, leg in enumerate(path.legs) if leg.leg.degree == 2]
         names = (*path_names, *(f"r{q}" for q in range(len(quadratic))))
         ring = fmpq_mpoly_ctx.get(names, "lex")
         pad = (0,) * len(quadratic)
 
         def lift(p: fmpq_mpoly) -> fmpq_mpoly:
+            if self.circle is not None:
+                p = self.circle.to_trig(p)
             if p.context() is not ring_in:
                 p = ring_in.from_dict({(*e, *(0,) * len(primes)): c for e, c in p.terms()}) \
                     if p.context() is TRIG else None
@@ -168,29 +180,32 @@ class ModeExpression:
         self.W = [self._split(w) for _, _, w in revolute]
 
     def _split(self, p: fmpq_mpoly) -> dict:
-        """A polynomial in t, s, c and the levels as a multilinear element (reduced with
-        level² = D)."""
-        by_levels: dict[tuple[int, ...], dict] = {}
-        for exps, coeff in p.terms():
-            by_levels.setdefault(tuple(exps[3:]), {})[tuple(exps[:3])] = coeff
-        out: dict = {}
-        for level_exps, trig_terms in by_levels.items():
-            checkpoint()
-            value = {0: reduce_trig(TRIG.from_dict(trig_terms))}
-            for q, e in enumerate(level_exps):
-                factor = {(e % 2) << q: TRIG.from_dict({(0, 0, 0): 1})}
-                for _ in range(e // 2):
-                    factor = multilinear_product(factor, self.D[q], self.D, _trig_mul,
-                                                 _is_zero)
-                if e:
-                    value = multilinear_product(value, factor, self.D, _trig_mul, _is_zero)
-            for m, v in value.items():
-                out[m] = out[m] + v if m in out else v
-        return {m: v for m, v in out.items() if not v.is_zero()}
+        return split_levels(p, self.D)
 
     def signs(self, label: str) -> list[int]:
         """σ per level for a working mode label: + for every √p, then the mode's signs."""
         return [1] * self.fixed + [1 if label[i] == "+" else -1 for i in self.legs]
+
+
+def split_levels(p: fmpq_mpoly, D: list[dict]) -> dict:
+    """A polynomial in t, s, c and the levels (its variables after the third) as a
+    multilinear element, reduced with level_q² = D[q]."""
+    by_levels: dict[tuple[int, ...], dict] = {}
+    for exps, coeff in p.terms():
+        by_levels.setdefault(tuple(exps[3:]), {})[tuple(exps[:3])] = coeff
+    out: dict = {}
+    for level_exps, trig_terms in by_levels.items():
+        checkpoint()
+        value = {0: reduce_trig(TRIG.from_dict(trig_terms))}
+        for q, e in enumerate(level_exps):
+            factor = {(e % 2) << q: TRIG.from_dict({(0, 0, 0): 1})}
+            for _ in range(e // 2):
+                factor = multilinear_product(factor, D[q], D, _trig_mul, _is_zero)
+            if e:
+                value = multilinear_product(value, factor, D, _trig_mul, _is_zero)
+        for m, v in value.items():
+            out[m] = out[m] + v if m in out else v
+    return {m: v for m, v in out.items() if not v.is_zero()}
 
 
 def _by_angle_degree(det_a: fmpq_mpoly, revolute: list) -> dict:
@@ -229,12 +244,13 @@ class AlgebraicPoint:
             self.f = fmpq_poly([0, 1])
             self.root = RationalRoot(self.f, fmpq(0), fmpq(0))
             return
-        rr = time.locate()
-        self.f, self.root = _minimal_polynomial(rr)
+        self.root = minimal_polynomial(time.locate())
+        self.f = self.root.poly
         if time.kind == IN_U:
             one_plus = fmpq_poly([1, 0, 1]) % self.f
             g, inverse, _ = one_plus.xgcd(self.f)  # 1 + α² ≠ 0 for a real α: g = 1
             self._inverse = (inverse / g.leading_coefficient()) % self.f
+            self._inverse_powers = [fmpq_poly([1])]  # (1 + α²)^-d for d = 0, 1, …
 
     def of(self, p: fmpq_mpoly) -> fmpq_poly:
         """A trig polynomial's value at the root, as an element of Q(α)."""
@@ -255,10 +271,10 @@ class AlgebraicPoint:
         if p.is_zero():
             return fmpq_poly([])
         m, d = half_angle_polynomial(p)
-        value = m % self.f
-        for _ in range(d):
-            value = (value * self._inverse) % self.f
-        return value
+        powers = self._inverse_powers
+        while len(powers) <= d:
+            powers.append((powers[-1] * self._inverse) % self.f)
+        return ((m % self.f) * powers[d]) % self.f
 
     def mul(self, a: fmpq_poly, b: fmpq_poly) -> fmpq_poly:
         return (a * b) % self.f
@@ -271,10 +287,7 @@ class AlgebraicPoint:
         if self.root.lo != self.root.hi:
             self.root.bisect_to(fmpq(1, 2**bits))
         alpha = rational_ball(self.root.lo, self.root.hi)
-        total = arb(0)
-        for c in reversed(a.coeffs()):
-            total = total * alpha + arb(c)
-        return total
+        return arb_poly(a)(alpha)  # coefficients rounded outward, Horner's rule in Arb
 
 
 _T_ALPHA = fmpq_mpoly_ctx.get(("t", "a"), "lex")
@@ -335,38 +348,21 @@ class PathFunctions(TrigElements):
     """The trig functions along the path (μ ≡ 0): elements are reduced trig polynomials,
     exact zero tests are polynomial ones, and balls are taken at a rational time."""
 
-    def __init__(self, t0: fmpq) -> None:
+    def __init__(self, t0: fmpq, circle=None) -> None:
         self.t0 = t0
+        self.circle = circle  # a pose angle's (C, S), renamed (c, s)
 
     def is_zero(self, a: fmpq_mpoly) -> bool:
         return a.is_zero()
 
     def ball(self, a: fmpq_mpoly, bits: int) -> arb:
+        if self.circle is not None:
+            return self.circle.evaluate(a, arb(self.t0))
         return evaluate_trig(a, arb(self.t0))
 
 
 def _q(x: Fraction) -> fmpq:
     return fmpq(x.numerator, x.denominator)
-
-
-def _minimal_polynomial(rr: RationalRoot) -> tuple[fmpq_poly, RationalRoot]:
-    """The irreducible factor of ``rr.poly`` that vanishes at its isolated root.
-
-    The interval isolates one root of the squarefree polynomial, so exactly one
-    irreducible factor has a root there: the one that vanishes at a point interval, or
-    changes sign between the ends (roots of a squarefree polynomial are simple, and the
-    ends of an isolating interval are not roots).
-    """
-    _, factors = rr.poly.numer().factor()
-    for h, _e in factors:
-        f = fmpq_poly(h)
-        f = f / f.leading_coefficient()
-        if rr.lo == rr.hi:
-            if f(rr.lo) == 0:
-                return f, RationalRoot(f, rr.lo, rr.hi)
-        elif f(rr.lo) * f(rr.hi) < 0:
-            return f, RationalRoot(f, rr.lo, rr.hi)
-    raise AssertionError("no factor of an isolated root's polynomial vanishes there")
 
 
 # ---------------------------------------------------------------------------------
@@ -490,6 +486,41 @@ def det_a_vanishes_at(path: PathModel, point: AlgebraicPoint, label: str) -> boo
 def mode_zero_polynomial(path: PathModel, label: str, t0: fmpq) -> fmpq_mpoly | None:
     """Along the whole path (for a mode whose branches are real and analytic on the
     range, with every discriminant ≠ 0 at the rational sample ``t0``): None when det A ≡ 0
-    along the mode, else a non-zero trig polynomial whose roots hold its zeros."""
+    along the mode, else a non-zero trig polynomial whose roots hold its zeros (in the
+    path ring, with a pose angle's cos, sin, for an angle path)."""
     expr = mode_expression(path)
-    return _Tower(expr, PathFunctions(t0), expr.signs(label)).reduce()
+    zeros = _Tower(expr, PathFunctions(t0, expr.circle), expr.signs(label)).reduce()
+    if zeros is None or expr.circle is None:
+        return zeros
+    return expr.circle.from_trig(zeros)  # C, S back to the pose angle's cos, sin
+
+
+class _RadicalElement:
+    """A trig polynomial over Q(√p₁, …, √pₖ) (a path-ring polynomial) in the form the
+    tower takes: one level per √p (D = p, the positive root), no legs, no W."""
+
+    def __init__(self, p: fmpq_mpoly) -> None:
+        names = p.context().names()
+        primes = [radical_prime(v) for v in names[3:]]
+        if tuple(names[:3]) != ("t", "s", "c") or None in primes:
+            raise NotExact("a polynomial with variables other than t, sin t, cos t and "
+                           "square roots")
+        self.D: list[dict] = [{0: TRIG.from_dict({(0, 0, 0): q})} for q in primes]
+        self.terms = split_levels(p, self.D)
+        self.W: list[dict] = []
+
+
+def vanishes_at_root(p: fmpq_mpoly, root) -> bool | None:
+    """Whether a path-ring polynomial p (square roots among its numbers) is exactly 0 at
+    a root of its norm (a :class:`~singcheck.roots.enclosures.RealRoot` with an exact
+    time), decided in the tower Q(α)(√p₁)…(√pₖ): e.g. a joint's limit polynomial at a time
+    where both it and its conjugate (√3 ↦ -√3) vanish, which no ball can tell apart.
+    None when the root's time has no exact description we compute with."""
+    if root.exact is None:
+        return None
+    try:
+        element = _RadicalElement(p)
+        tower = _Tower(element, exact_point(root.exact, root), [1] * len(element.D))
+        return tower.reduce() is None
+    except NotExact:
+        return None

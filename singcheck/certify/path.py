@@ -26,20 +26,29 @@ from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.composition import (
     MAX_COMPOSE_WORK,
+    PIECE_WORK,
     TooCostly,
     compose_in_pieces,
     composition_work,
+    crude_work,
 )
 from singcheck.algebra.intervals import evaluate, fraction_ball
-from singcheck.algebra.polynomials import coefficient_in, memo_per_object, restrict
+from singcheck.algebra.polynomials import (
+    coefficient_in,
+    constant_value,
+    memo_per_object,
+    restrict,
+)
 from singcheck.algebra.radicals import (
     angle_function,
+    angle_function_of,
     cos_pi,
     evaluate_path,
     into_ring,
     path_ring,
     radical_balls,
     radical_prime,
+    radical_variables,
     reduce_relations,
     sin_pi,
     surd_polynomial,
@@ -96,7 +105,22 @@ def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
     composition is refused or cut into pieces a time limit can stop
     (:func:`~singcheck.algebra.composition.compose_in_pieces`)."""
     ring, args = _pose_args(p, phi, pose)
+    if p.is_constant():  # (a leg's leading coefficient): nothing to compose
+        return ring.from_dict({(0,) * ring.nvars(): constant_value(p)})
     return compose_in_pieces(p, args, ring, _reduce, work)
+
+
+def _constants_first(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> fmpq_mpoly:
+    """``p`` with the variables whose image is a constant (a coordinate such as z = 1)
+    replaced by that rational (exact): the same composition, and FLINT's compose then
+    expands fewer and smaller powers (ξ of the Orthoglide along heart 1: half the time;
+    on a leg's small coefficients the substitution costs more than it saves).  ``p`` no
+    longer depends on them, so their images are left unused."""
+    constants = {}
+    for name, a, d in zip(p.context().names(), args, p.degrees(), strict=True):
+        if d > 0 and a.is_constant():
+            constants[name] = constant_value(a)
+    return p.subs(constants) if constants else p
 
 
 _PLANS: dict = {}
@@ -145,6 +169,31 @@ def mu_size_bound(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...],
     return deg_t, deg_sc, (deg_t + 1) * (2 * deg_sc + 1)
 
 
+#: The highest degree in tan(t/2) whose real roots a path's μ may ask for (μ free of t:
+#: exact isolation in the half-angle tangent, :mod:`singcheck.roots.half_angle`).  The
+#: isolation's cost grows about as the fourth power of the degree: the 3-PRR with
+#: phi = k*t (μ of degree 20k in sin t, cos t, 40k in the tangent) isolated μ's roots
+#: in 0.1 s for k = 5, 1.1 s for 10, 6.2 s for 15 and 19 s for 20 (CPU, quiet machine);
+#: k = 30 did not finish its certification in 120 s.
+MAX_HALF_ANGLE_DEGREE = 800
+
+
+def isolation_degree(mu: fmpq_mpoly) -> int:
+    """The degree in u = tan(t/2) of the polynomial whose real roots certify ``mu`` (0
+    when ``mu`` involves t or an angle function: then interval branch-and-bound, with
+    its own budget of boxes, isolates them): twice its degree in (sin t, cos t), doubled
+    again for each square root among its coefficients (their norm is isolated)."""
+    names = mu.context().names()
+    degrees = mu.degrees()
+    radicals = [i for i, _ in radical_variables(mu.context())]
+    if any(d > 0 for i, (v, d) in enumerate(zip(names, degrees, strict=True))
+           if v not in ("s", "c") and i not in radicals):
+        return 0
+    si, ci = names.index("s"), names.index("c")
+    trig = max((e[si] + e[ci] for e in mu.monoms()), default=0)
+    return 2 * trig * 2 ** sum(1 for i in radicals if degrees[i] > 0)
+
+
 def _too_costly(what: str, trajectory: TrajectorySpec) -> SpecError:
     return SpecError(f"too costly: {what}: lower the degrees or the coefficients of the "
                      "coordinates, or the multiples of t in sin/cos", path=trajectory.path,
@@ -157,7 +206,11 @@ def _compose_mu(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
     :data:`MAX_MU_TERMS` terms or cost more than
     :data:`~singcheck.algebra.composition.MAX_COMPOSE_WORK`; otherwise composed in
     pieces a time limit can stop."""
-    work, deg_t, deg_sc = composition_work(xi, _pose_args(xi, phi, pose)[1])
+    ring, args = _pose_args(xi, phi, pose)
+    work = _small_composition(xi, args)
+    if work is not None:
+        return compose_in_pieces(_constants_first(xi, args), args, ring, _reduce, work)
+    work, deg_t, deg_sc = composition_work(xi, args)
     terms = (deg_t + 1) * (2 * deg_sc + 1)
     if terms > MAX_MU_TERMS:
         raise _too_costly(f"μ(t) = ξ(φ(t)) could have {terms} terms (degree {deg_t} in t "
@@ -166,7 +219,24 @@ def _compose_mu(xi: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
         raise _too_costly(f"composing μ(t) = ξ(φ(t)) would cost {work:.3g} by its a-priori "
                           f"estimate (ξ has {len(xi)} terms; at most {MAX_COMPOSE_WORK:.3g})",
                           trajectory)
-    return compose_pose(xi, phi, pose, work)
+    return compose_in_pieces(_constants_first(xi, args), args, ring, _reduce, work)
+
+
+def _small_composition(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> int | None:
+    """A bound on :func:`composition_work` proven by a crude estimate, when that estimate
+    already keeps ``p(args)`` within one FLINT call and within :data:`MAX_MU_TERMS`
+    (the common case); None otherwise (then the exact estimate is needed).
+
+    Crude: every term is charged the largest exponents of all variables together, so
+    its degrees in t and in (s, c) bound the true ones from above, and its work bounds
+    :func:`composition_work`'s (:func:`~singcheck.algebra.composition.crude_work`).
+    The decisions taken on the bound (compose in one call, do not refuse) are those the
+    exact estimate would take, which is skipped: on heart 1 it cost a third of composing
+    μ."""
+    work, deg_t, deg_sc = crude_work(p, args)
+    if work <= PIECE_WORK and (deg_t + 1) * (2 * deg_sc + 1) <= MAX_MU_TERMS:
+        return work
+    return None
 
 
 @dataclass(frozen=True)
@@ -198,21 +268,25 @@ class LegAlongPath:
             out = out * q + c
         return out
 
-    def branches(self, t: arb, tight: bool = False) -> dict[str, arb | acb | tuple | None]:
+    def branches(self, t: arb, tight: bool = False,
+                 discriminant: arb | None = None) -> dict[str, arb | acb | tuple | None]:
         """Enclosures of each branch's joint value for every t in the ball ``t``.
 
         A quadratic leg's branches are real where D > 0 (proven) and complex
         conjugate where D < 0; where the sign of D is not proven both are None.  A
         revolute branch is the pair (cos θ, sin θ).  ``tight`` spends more on a wide
-        ball (:func:`~singcheck.algebra.trig.evaluate_trig`)."""
+        ball (:func:`~singcheck.algebra.trig.evaluate_trig`); ``discriminant``, D's
+        enclosure over the same ball (and ``tight``) when the caller has it already."""
         if self.leg.kind != REVOLUTE and self.leg.degree == 2:
             # ρ = (-b ± √D)/(2a) needs a, b and D only: c is in D already
-            a, b = (evaluate_path(c, t, tight=tight) for c in self.coefficients[:2])
-            values = [a, b, None]
+            coefficients = self.coefficients
+            values = [evaluate_path(coefficients[0], t, None, tight),
+                      evaluate_path(coefficients[1], t, None, tight), None]
         else:
-            values = [evaluate_path(c, t, tight=tight) for c in self.coefficients]
-        d = evaluate_path(self.discriminant, t, tight=tight) \
-            if self.discriminant is not None else None
+            values = [evaluate_path(c, t, None, tight) for c in self.coefficients]
+        d = discriminant
+        if d is None and self.discriminant is not None:
+            d = evaluate_path(self.discriminant, t, None, tight)
         return branch_values(self.leg, values, d)
 
     def inside(self, value, limits) -> bool | None:
@@ -273,11 +347,13 @@ def _limit_balls(limits) -> tuple[arb, arb]:
     """The balls of a prismatic joint's rational limits (exact when dyadic), once per
     limits object and working precision: feasibility proofs compare against them
     thousands of times (keyed by the object, not by hashing its Fractions each time)."""
-    per_prec = memo_per_object(_LIMIT_BALLS, limits, lambda _: {})
-    hit = per_prec.get(ctx.prec)
-    if hit is None:
-        hit = per_prec[ctx.prec] = tuple(fraction_ball(v) for v in limits)
-    return hit
+    key = (id(limits), ctx.prec)
+    hit = _LIMIT_BALLS.get(key)
+    if hit is None or hit[0] is not limits:  # the entry holds limits: its id is not reused
+        if len(_LIMIT_BALLS) > 256:
+            _LIMIT_BALLS.clear()
+        hit = _LIMIT_BALLS[key] = (limits, tuple(fraction_ball(v) for v in limits))
+    return hit[1]
 
 
 def inside_limits(leg: Leg, value, limits) -> bool | None:
@@ -316,18 +392,32 @@ class PathModel:
 
     def pose_at(self, t: arb) -> list[arb]:
         """The pose coordinates (an angle in radians, its π offset included)."""
-        out = []
-        offsets = self.trajectory.angle_offsets
-        for v, x in zip(self.projection.model.pose, self.phi, strict=True):
-            value = evaluate_path(x, t)
-            if v in offsets:
-                value += arb.pi() * fraction_ball(offsets[v])
-            out.append(value)
-        return out
+        return self.pose_and_variables_at(t)[0]
 
     def pose_variables_at(self, t: arb) -> list[arb]:
         """Balls of the model's pose variables (cos φ, sin φ for an angle)."""
         return [evaluate_path(x, t) for x in self.coordinates]
+
+    def pose_and_variables_at(self, t: arb) -> tuple[list[arb], list[arb]]:
+        """:meth:`pose_at` and :meth:`pose_variables_at` together, each polynomial
+        evaluated once: a coordinate that is not an angle is its own pose variable (the
+        same polynomial object, hence the same ball)."""
+        seen: dict[int, arb] = {}
+
+        def value(x: fmpq_mpoly) -> arb:
+            hit = seen.get(id(x))
+            if hit is None:
+                hit = seen[id(x)] = evaluate_path(x, t)
+            return hit
+
+        pose = []
+        offsets = self.trajectory.angle_offsets
+        for v, x in zip(self.projection.model.pose, self.phi, strict=True):
+            ball = value(x)
+            if v in offsets:
+                ball = ball + arb.pi() * fraction_ball(offsets[v])
+            pose.append(ball)
+        return pose, [value(x) for x in self.coordinates]
 
     def det_A(self, joints: list, pose: list[arb], signs: dict[int, int] | None = None):
         """Enclosure of det A at the given joint values (a revolute joint's as a (cos,
@@ -618,6 +708,11 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
                     f"the angle {v} is neither k*t plus a multiple of pi/12 nor free of square "
                     "roots: not supported", **where)
             functions.append(angle_function(x, offsets.get(v, 0)))
+    for x in phi:  # cos(g(t)), sin(g(t)) written in a coordinate (x: cos(t^2))
+        names = x.context().names()
+        functions += [(n, "sin(" + n[4:]) for n in names if n.startswith("cos(")
+                      and angle_function_of(n) is not None
+                      and (n, "sin(" + n[4:]) not in functions]
     ring = path_ring(primes, functions)
     phi = tuple(into_ring(x, ring) for x in phi)
     coordinates = []
@@ -636,6 +731,11 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
             mu = eliminate_along_path(model, coordinates, where)
         except TooCostly as e:
             raise _too_costly(str(e), trajectory) from None
+    degree = isolation_degree(mu)
+    if degree > MAX_HALF_ANGLE_DEGREE:
+        raise _too_costly(f"isolating the real roots of μ(t) would take a polynomial of degree "
+                          f"{degree} in tan(t/2) (at most {MAX_HALF_ANGLE_DEGREE}: the cost "
+                          "grows as its fourth power)", trajectory)
     try:
         legs = _legs_along(model, coordinates)
         degenerate = tuple(compose_pose(w, coordinates, pose_vars)
@@ -649,9 +749,20 @@ def _legs_along(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
                 ) -> tuple[LegAlongPath, ...]:
     pose_vars = model.pose_variables
     legs = []
+    composed: list[tuple[fmpq_mpoly, fmpq_mpoly]] = []  # (coefficient, along the path)
+
+    def along(c: fmpq_mpoly) -> fmpq_mpoly:
+        """The coefficient along the path, composed once: legs often share one (the
+        Orthoglide's constant a = 1 and c = x² + y² + z² - l²)."""
+        for known, image in composed:
+            if known == c:
+                return image
+        image = compose_pose(c, coordinates, pose_vars)
+        composed.append((c, image))
+        return image
+
     for leg in model.legs:
-        in_pose_coeffs = _leg_coefficients(leg)
-        coeffs = tuple(compose_pose(c, coordinates, pose_vars) for c in in_pose_coeffs)
+        coeffs = tuple(along(c) for c in _leg_coefficients(leg))
         disc = leg_discriminant(leg, coeffs)
         limits = {}
         if leg.kind == REVOLUTE and leg.joint in model.spec.joint_limits:

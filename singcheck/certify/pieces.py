@@ -112,8 +112,10 @@ def _compose_modes(spec, reports) -> list[WorkingMode]:
                     reason = (f"its IK branch is not the same on both sides of the join of "
                               f"segments {i + 1} and {i + 2}")
                     break
+        proof = "; ".join(f"segment {i + 1}: {m.proof}" for i, m in enumerate(per_piece)
+                          if m.proof)
         out.append(WorkingMode(first.label, first.branches, status, reason,
-                               first.joints_at_start))
+                               first.joints_at_start, proof=proof))
     return out
 
 

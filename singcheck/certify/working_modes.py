@@ -28,14 +28,15 @@ import math
 from dataclasses import dataclass, field
 from itertools import product
 
-from flint import arb
+from flint import arb, ctx
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.radicals import evaluate_path
 from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
 from singcheck.budget import checkpoint
+from singcheck.certify.exact import vanishes_at_root
 from singcheck.certify.path import LegAlongPath, PathModel, joint_float
-from singcheck.roots.enclosures import IdenticallyZeroError, RootIsolation
+from singcheck.roots.enclosures import IN_MIXED, IdenticallyZeroError, RootIsolation
 from singcheck.roots.isolation import isolate_real_roots
 
 FEASIBLE, INFEASIBLE, UNKNOWN = "feasible", "infeasible", "unknown"
@@ -49,6 +50,7 @@ class BranchFeasibility:
     status: str  # feasible | infeasible | unknown
     reason: str = ""
     event_time: arb | None = None  # where it leaves (limit crossing or branch meeting)
+    proof: str = ""  # the exact decisions it rests on, if any (ball arithmetic otherwise)
 
 
 @dataclass
@@ -59,6 +61,7 @@ class WorkingMode:
     reason: str
     joints_at_start: dict[str, float | None]
     singular_times: list = field(default_factory=list)  # filled by certification
+    proof: str = ""  # the exact decisions its feasibility rests on ("": ball arithmetic)
 
     @property
     def feasible(self) -> bool:
@@ -84,7 +87,7 @@ def gap_points(interval: TimeRange, events: list[arb]) -> list[arb]:
 
 def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | None:
     try:
-        return isolate_real_roots(poly, interval, tolerance)
+        return isolate_real_roots(poly, interval, tolerance, vanishes_at_root)
     except IdenticallyZeroError:
         return None
 
@@ -142,15 +145,86 @@ def _halves(piece: arb) -> tuple[arb, arb]:
     return lo.union(mid), mid.union(hi)
 
 
-def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True) -> bool:
+class _Cover:
+    """The balls that the quick proofs about one leg try, with the leg's enclosures on
+    each computed once.
+
+    The reality proof (D > 0 on every piece) and each branch's limit proof walk the same
+    balls: the pieces covering (one period of) the range, halved the same way where a
+    proof fails, and the range start.  Each ball's enclosures of a, b and D (and the
+    branches made from them) are computed the first time a proof asks and then shared:
+    the same enclosures of the same balls as evaluating them each time, so every proof
+    is the one it was, at a fraction of the evaluations.  A leg whose polynomials are
+    all constants along the path (the Orthoglide's z leg on a planar path) has the same
+    enclosures on every ball: they are computed once."""
+
+    def __init__(self, leg: LegAlongPath, interval: TimeRange) -> None:
+        self.leg = leg
+        self.range = one_period(interval, _leg_polys(leg))
+        self.retry_tight = _high_degree(leg)
+        self.start = interval.start.ball()
+        self.budget = _budget(self.range)
+        self.constant = all(p is None or p.is_constant() for p in _leg_polys(leg))
+        self._pieces: list[arb] | None = None
+        self._halves: dict[int, tuple[arb, arb, arb]] = {}
+        self._seen: dict[tuple[int, bool, int], list] = {}  # -> [ball, D, branches]
+
+    def pieces(self) -> list[arb]:
+        """:func:`_pieces` of the range (the same balls every time they are asked for)."""
+        if self._pieces is None:
+            self._pieces = _pieces(self.range)
+        return list(self._pieces)
+
+    def halves(self, piece: arb) -> tuple[arb, arb]:
+        """:func:`_halves` of a piece (the same balls every time they are asked for)."""
+        hit = self._halves.get(id(piece))
+        if hit is None or hit[0] is not piece:
+            hit = self._halves[id(piece)] = (piece, *_halves(piece))
+        return hit[1], hit[2]
+
+    def _entry(self, t: arb, tight: bool) -> list:
+        if self.constant:  # one entry for every ball
+            key = (0, False, ctx.prec)
+            hit = self._seen.get(key)
+            if hit is None:
+                hit = self._seen[key] = [t, None, None]
+            return hit
+        key = (id(t), tight, ctx.prec)
+        hit = self._seen.get(key)
+        if hit is None or hit[0] is not t:  # the entry holds t: its id is not reused
+            hit = self._seen[key] = [t, None, None]
+        return hit
+
+    def discriminant(self, t: arb, tight: bool = False) -> arb:
+        """The enclosure of D over the ball ``t``."""
+        entry = self._entry(t, tight)
+        if entry[1] is None:
+            entry[1] = evaluate_path(self.leg.discriminant, t, tight=tight)
+        return entry[1]
+
+    def branches(self, t: arb, tight: bool = False) -> dict:
+        """:meth:`LegAlongPath.branches` over the ball ``t`` (D's enclosure shared)."""
+        entry = self._entry(t, tight)
+        if entry[2] is None:
+            if self.leg.discriminant is not None and entry[1] is None:
+                entry[1] = evaluate_path(self.leg.discriminant, t, tight=tight)
+            entry[2] = self.leg.branches(t, tight, discriminant=entry[1])
+        return entry[2]
+
+
+def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True,
+                cover: _Cover | None = None) -> bool:
     """True when ``predicate(ball, tight)`` is proven on balls covering the whole range:
     a quick proof by ball arithmetic that spares a root isolation (False means "not
     proven").  With ``retry_tight`` a wide piece is tried with ``tight`` enclosures at
     once (they include the plain one, which the polynomials' degree makes fail there);
     a piece where it fails is halved (ball enclosures tighten as pieces shrink) until a
-    budget of evaluations is spent."""
-    todo = _pieces(interval)
-    budget = _budget(interval)
+    budget of evaluations is spent.  With ``cover`` (whose range is ``interval``) the
+    pieces and halves are the cover's, so that proofs about one leg share its
+    enclosures."""
+    todo = cover.pieces() if cover is not None else _pieces(interval)
+    halves = cover.halves if cover is not None else _halves
+    budget = cover.budget if cover is not None else _budget(interval)
     spent = 0
     while todo:
         piece = todo.pop()
@@ -160,16 +234,18 @@ def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True) -> boo
             continue
         if spent + len(todo) + 2 > budget:
             return False
-        todo += _halves(piece)
+        todo += halves(piece)
     return True
 
 
-def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when):
+def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when,
+                 cover: _Cover | None = None):
     """Status of both branches of a quadratic leg with respect to step 1 (``when``
     writes a time ball in the user's parameter)."""
     joint = leg.leg.joint
-    if _everywhere(lambda t, tight: evaluate_path(leg.discriminant, t, tight=tight) > 0,
-                   one_period(interval, _leg_polys(leg)), _high_degree(leg)):
+    cover = cover or _Cover(leg, interval)
+    if _everywhere(lambda t, tight: cover.discriminant(t, tight) > 0, cover.range,
+                   cover.retry_tight, cover):
         return FEASIBLE, "", None
     iso = _isolate(leg.discriminant, interval, tolerance)
     if iso is None:
@@ -196,21 +272,24 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when)
 
 
 def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
-                   tolerance: float, crossings: dict, when) -> BranchFeasibility:
+                   tolerance: float, crossings: dict, when,
+                   cover: _Cover | None = None) -> BranchFeasibility:
     """Whether this branch stays strictly inside the joint limits along the whole path.
 
     ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
-    the leg equals it (one polynomial serves both branches)."""
+    the leg equals it (one polynomial serves both branches); ``cover`` shares the quick
+    proofs' enclosures with the leg's other proofs."""
     joint = leg.leg.joint
-    bounds = f"[{limits[0]}, {limits[1]}]"
-    if leg.inside(leg.branches(interval.start.ball())[label], limits) is False:
+    cover = cover or _Cover(leg, interval)
+    if leg.inside(cover.branches(cover.start)[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
-                                 f"{joint} is outside {bounds} from the start")
-    if _everywhere(lambda t, tight: leg.inside(leg.branches(t, tight)[label], limits) is True,
-                   one_period(interval, _leg_polys(leg)), _high_degree(leg)):
+                                 f"{joint} is outside {_bounds(limits)} from the start")
+    if _everywhere(lambda t, tight: leg.inside(cover.branches(t, tight)[label], limits) is True,
+                   cover.range, cover.retry_tight, cover):
         return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
     undecided = []
+    exact: list[str] = []  # limits met where p and a conjugate both vanish: decided exactly
     on_limit: dict = {}  # limit value -> w = 2aL + b, for a limit some branch sits on
     for value in limits:
         if value not in crossings:
@@ -227,6 +306,9 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
                                          f"both branches of {joint} sit on its limit {value}")
         events += [r.t for r in iso.roots]
         undecided += list(iso.undecided)
+        exact += [f"{joint} {'=' if kept else '≠'} {value} at t ≈ {when(r.t)} exactly "
+                  f"({_field(r)}: balls cannot tell the robot from a conjugate, √p ↦ -√p, "
+                  "there)" for r, kept in iso.exact]
     for box in undecided:
         checkpoint()
         if leg.inside(leg.branches(box.t)[label], limits) is not True:
@@ -250,10 +332,23 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
         if verdict is False:
             crossing = max((e for e in events if e < point), key=lambda b: b.mid(),
                            default=None)
-            reason = f"{joint} is outside {bounds} from the start" if crossing is None else \
-                f"{joint} leaves {bounds} at t ≈ {when(crossing)}"
-            return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing)
-    return BranchFeasibility(joint, label, FEASIBLE)
+            reason = f"{joint} is outside {_bounds(limits)} from the start" \
+                if crossing is None else \
+                f"{joint} leaves {_bounds(limits)} at t ≈ {when(crossing)}"
+            return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing,
+                                     "; ".join(exact))
+    return BranchFeasibility(joint, label, FEASIBLE, proof="; ".join(exact))
+
+
+def _field(root) -> str:
+    """Where :func:`~singcheck.certify.exact.vanishes_at_root` decided at this root."""
+    if root.exact.kind == IN_MIXED:
+        return "at a transcendental time, in Q(τ, sin τ, cos τ)(√p)"
+    return "algebraic, in Q(α)(√p)"
+
+
+def _bounds(limits) -> str:
+    return f"[{limits[0]}, {limits[1]}]"
 
 
 def _switch_polynomial(leg: LegAlongPath, value) -> object:
@@ -289,19 +384,22 @@ def _sits_on_limit(leg: LegAlongPath, label: str, on_limit: dict, point: arb) ->
     return any(sigma * evaluate_path(w, point) > 0 for w in on_limit.values())
 
 
-def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibility]]:
-    """Feasibility of every branch of every leg (outer list in joint order)."""
+def leg_branches(path: PathModel, tolerance: float,
+                 covers: list[_Cover] | None = None) -> list[list[BranchFeasibility]]:
+    """Feasibility of every branch of every leg (outer list in joint order); ``covers``
+    (one per leg, :class:`_Cover`) when the caller shares them."""
     interval = path.trajectory.range
     limits_of = path.projection.model.spec.joint_limits
+    covers = covers or [_Cover(leg, interval) for leg in path.legs]
 
     def when(t: arb) -> str:
         return f"{float(path.trajectory.to_global(arb(t)).mid()):.6g}"
 
     out = []
-    for leg in path.legs:
+    for leg, cover in zip(path.legs, covers, strict=True):
         joint = leg.leg.joint
         if leg.discriminant is not None:
-            status, reason, event = _leg_reality(leg, interval, tolerance, when)
+            status, reason, event = _leg_reality(leg, interval, tolerance, when, cover)
         else:
             status, reason, event = FEASIBLE, "", None
         branches = []
@@ -311,26 +409,24 @@ def leg_branches(path: PathModel, tolerance: float) -> list[list[BranchFeasibili
                 branches.append(BranchFeasibility(joint, label, status, reason, event))
             elif joint in limits_of:
                 branches.append(_branch_limits(leg, label, interval, limits_of[joint],
-                                               tolerance, crossings, when))
+                                               tolerance, crossings, when, cover))
             else:
                 branches.append(BranchFeasibility(joint, label, FEASIBLE))
         out.append(branches)
     return out
 
 
-def _start_values(path: PathModel) -> list[dict[str, float | None]]:
-    start = path.trajectory.range.start.ball()
-    out = []
-    for leg in path.legs:
-        values = leg.branches(start)
-        out.append({label: joint_float(v) for label, v in values.items()})
-    return out
+def _start_values(covers: list[_Cover]) -> list[dict[str, float | None]]:
+    """Each leg's branches at the range start, for display."""
+    return [{label: joint_float(v) for label, v in cover.branches(cover.start).items()}
+            for cover in covers]
 
 
 def working_modes(path: PathModel, tolerance: float = 1e-9) -> list[WorkingMode]:
     """Every working mode (sign choice per leg) with its proven feasibility."""
-    per_leg = leg_branches(path, tolerance)
-    starts = _start_values(path)
+    covers = [_Cover(leg, path.trajectory.range) for leg in path.legs]
+    per_leg = leg_branches(path, tolerance, covers)
+    starts = _start_values(covers)
     joints = [leg.leg.joint for leg in path.legs]
     modes = []
     for choice in product(*per_leg):  # 2^legs
@@ -344,7 +440,9 @@ def working_modes(path: PathModel, tolerance: float = 1e-9) -> list[WorkingMode]
         else:
             status = FEASIBLE
         reason = "; ".join(b.reason for b in choice if b.status == status and b.reason)
+        proof = "; ".join(b.proof for b in choice
+                          if b.proof and (status == FEASIBLE or b.status == status))
         at_start = {j: starts[i][b.label] for i, (j, b) in enumerate(zip(joints, choice,
                                                                            strict=True))}
-        modes.append(WorkingMode(label, tuple(choice), status, reason, at_start))
+        modes.append(WorkingMode(label, tuple(choice), status, reason, at_start, proof=proof))
     return modes

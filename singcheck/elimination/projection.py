@@ -35,7 +35,12 @@ from singcheck.algebra.radicals import (
     surd_polynomial,
 )
 from singcheck.elimination.cache import CachedBackend
-from singcheck.elimination.requests import EliminationBackend, EliminationRequest, norm_chain
+from singcheck.elimination.requests import (
+    EliminationBackend,
+    EliminationRequest,
+    chain_is_small,
+    norm_chain,
+)
 from singcheck.errors import BackendError, UnsupportedRobotError
 from singcheck.model.robot import (
     REVOLUTE,
@@ -95,6 +100,11 @@ def _circles(model: RobotModel, names) -> tuple[fmpq_mpoly, ...]:
                  for c, s in (angle_names(v) for v in names if v in model.angles))
 
 
+def pose_circles(model: RobotModel) -> tuple[fmpq_mpoly, ...]:
+    """cos(φ)² + sin(φ)² - 1 for each angle φ of the pose."""
+    return _circles(model, model.pose)
+
+
 def singularity_surface_request(model: RobotModel) -> EliminationRequest:
     """Eliminate the joints from ``{F, det A}`` (the paper's ξ(X)); an angle joint brings
     its circle cos² + sin² = 1, a square root its pseudo-leg sqrt(p)² = p (eliminated
@@ -107,9 +117,15 @@ def singularity_surface_request(model: RobotModel) -> EliminationRequest:
 
 def joint_space_request(model: RobotModel) -> EliminationRequest:
     """Eliminate the pose from ``{F, det A}`` (the paper's ε(ρ))."""
+    return pose_elimination_request(model, "joint_space_singularities", model.det_A)
+
+
+def pose_elimination_request(model: RobotModel, kind: str, extra: fmpq_mpoly) -> EliminationRequest:
+    """Eliminate the pose from ``{F, extra}``: a pose angle brings its circle
+    cos² + sin² = 1 (its cos and sin are eliminated), a square root its pseudo-leg."""
     return EliminationRequest(
-        "joint_space_singularities", model.context,
-        (*model.constraints, model.det_A, *_circles(model, model.pose),
+        kind, model.context,
+        (*model.constraints, extra, *pose_circles(model),
          *(leg.constraint for leg in model.radical_legs)),
         (*model.pose_variables, *model.spec.radical_variables))
 
@@ -236,7 +252,22 @@ def _without_degenerate_factors(p: fmpq_mpoly, degenerate) -> fmpq_mpoly:
     return squarefree_part(out)
 
 
-def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str) -> fmpq_mpoly:
+def bounded_norm_over_legs(model: RobotModel, timeout: float) -> fmpq_mpoly:
+    """:func:`norm_over_legs` under the bounds of every elimination: in this process when
+    :func:`~singcheck.elimination.requests.chain_is_small` proves it small, else in a
+    forked child with ``timeout`` seconds and the memory bound
+    (:func:`~singcheck.elimination.cas.isolated.run_bounded`)."""
+    from singcheck.elimination.cas.isolated import run_bounded
+    from singcheck.elimination.cas.limits import memory_limit
+
+    small = chain_is_small(model.det_A, norm_legs(model), memory_limit())
+    return run_bounded(norm_over_legs, model, small, timeout,
+                       "the re-check (the norm of det A over the legs)")
+
+
+def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str,
+                                norm: fmpq_mpoly | None = None,
+                                timeout: float | None = None) -> fmpq_mpoly:
     """Refuse a ξ whose zero set differs from the independently computed norm's; return
     ξ without the degenerate factors (what :func:`project_robot` keeps).
 
@@ -244,10 +275,16 @@ def recheck_singularity_surface(model: RobotModel, xi: fmpq_mpoly, backend: str)
     without the factors of the degenerate set W = 0, where a CAS's closure of the
     projection and the norm may differ); a CAS result that parsed but is wrong (or
     belongs to another request) fails here, loudly.  A ξ equal to the norm as it stands
-    passes at once: the norm is squarefree and monic by construction.
+    passes at once: the norm is squarefree and monic by construction.  ``norm``: that
+    norm when the caller has it (the flint backend's result, computed now, is that
+    norm: recomputing it would re-check nothing); else it is computed under ``timeout``
+    (:func:`bounded_norm_over_legs`).
     """
+    from singcheck.elimination.cas.external import DEFAULT_TIMEOUT
+
     degenerate = degenerate_set(model)
-    norm = norm_over_legs(model)
+    if norm is None:
+        norm = bounded_norm_over_legs(model, timeout or DEFAULT_TIMEOUT)
     if xi == norm and not degenerate:
         return norm
     clean = _without_degenerate_factors(xi, degenerate)
@@ -318,9 +355,13 @@ def project_robot(model: RobotModel, backend: EliminationBackend,
 
         checked: list = []  # (ξ as returned, ξ re-checked) of the last result checked
 
+        timeout = getattr(backend, "timeout", None) or getattr(
+            getattr(backend, "backend", None), "timeout", None)
+
         def check(result) -> None:
             raw = _single(result, "singularity surface")
-            checked[:] = [raw, recheck_singularity_surface(model, raw, result.backend)]
+            checked[:] = [raw, recheck_singularity_surface(
+                model, raw, result.backend, raw if result.is_norm else None, timeout)]
 
         request = singularity_surface_request(model)
         if isinstance(backend, CachedBackend):  # cache only what passes the re-check

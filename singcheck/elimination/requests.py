@@ -10,6 +10,7 @@ that zero set, via squarefree parts.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from math import gcd
 from typing import Protocol
 
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
@@ -40,6 +41,10 @@ class EliminationResult:
     polynomials: tuple[fmpq_mpoly, ...]  # in request.kept_context()
     method: str  # how it was computed, for the report (e.g. "resultant chain")
     backend: str
+    #: the polynomial is :func:`norm_chain` of the request itself, computed now (by the
+    #: flint backend, here or in its fork; never set on a result read from the cache):
+    #: the re-check, which computes that norm, would only repeat the computation
+    is_norm: bool = False
 
 
 class EliminationBackend(Protocol):
@@ -183,18 +188,170 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
     """
     names = g.context().names()
     _, factors = g.factor()
-    total = g.context().from_dict({(0,) * g.context().nvars(): 1})
+    one = g.context().from_dict({(0,) * g.context().nvars(): 1})
+    total = one
+    later = [{names.index(x) for v, _ in legs[i + 1:]
+              for x in (v if isinstance(v, tuple) else (v,))} for i in range(len(legs))]
     for factor, _mult in factors:
-        acc, reduced = factor, False
-        for v, f in legs:
+        acc, reduced, aside = factor, False, one
+        for i, (v, f) in enumerate(legs):
             variables = v if isinstance(v, tuple) else (v,)
             if all(acc.degrees()[names.index(x)] <= 0 for x in variables):
                 continue  # a leg that does not touch this factor only raises its power
             checkpoint()
             acc = revolute_norm(acc, v[0], v[1], f, reduce) if isinstance(v, tuple) else \
                 acc.resultant(f, v)
-            acc, reduced = squarefree_part(reduce(acc) if reduce else acc), True
+            acc, reduced = reduce(acc) if reduce else acc, True
+            if later[i]:
+                acc, free = _split_free(acc, later[i])
+                aside *= free
+            else:
+                acc = squarefree_part(acc)
+        if aside != one:
+            acc = squarefree_part(acc * aside)
         if len(factors) == 1 and reduced:
             return acc  # squarefree and monic already: the one factor's norm
         total *= acc
     return squarefree_part(total)
+
+
+def _split_free(p: fmpq_mpoly, variables: set[int]) -> tuple[fmpq_mpoly, fmpq_mpoly]:
+    """``(k, b)``: the squarefree part of ``p`` as the product of its squarefree factors
+    that involve one of ``variables`` (monic) and those that do not.  The norm is
+    multiplicative, and a factor free of a leg's joint only comes out of that leg's
+    resultant or revolute norm as a power of itself: set aside, it keeps its zeros
+    without being squared at every later leg (the rotary Delta's W = a² + b² factors)."""
+    _, parts = p.factor_squarefree()
+    one = p.context().from_dict({(0,) * p.context().nvars(): 1})
+    keep, free = one, one
+    for part, _mult in parts:
+        if any(part.degrees()[i] > 0 for i in variables):
+            keep *= part
+        else:
+            free *= part
+    lc = keep.leading_coefficient()
+    return (keep / lc if lc != 0 else keep), free
+
+
+def _height(p: fmpq_mpoly) -> int:
+    """Bits of the 1-norm of ``p``'s primitive integer multiple (an upper bound)."""
+    coeffs = p.coeffs()
+    if not coeffs:
+        return 0
+    den = 1
+    for c in coeffs:
+        den = den * int(c.q) // gcd(den, int(c.q))
+    return sum(abs(int(c.p)) * (den // int(c.q)) for c in coeffs).bit_length()
+
+
+def norm_chain_bound(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]]) -> tuple[int, int]:
+    """``(terms, bits)``: no polynomial that :func:`norm_chain` (without ``reduce``) forms
+    from ``g`` and ``legs`` has more than ``terms`` terms or a coefficient (of its
+    primitive integer multiple) of more than ``bits`` bits — proven from degrees and
+    coefficient sizes alone, before any work.
+
+    Each polynomial carries a degree in every variable (a revolute leg's cos, sin: one
+    total degree) and the bits h of its 1-norm, which is subadditive and
+    submultiplicative.  ``Res_v(A, f)`` is the Sylvester determinant, deg_v f rows of A's
+    coefficients and deg_v A rows of f's, so ``deg_w ≤ deg_v A·deg_w f + deg_v f·deg_w
+    A`` and ``h ≤ deg_v A·h_f + deg_v f·h_A``; the subresultants FLINT forms on the way
+    are minors of the same matrix, bounded alike.  A revolute norm ``G₀² - Δ·G₁²``
+    (:func:`revolute_norm`, k the degree of A in cos, sin): ``deg_w ≤ 2·deg_w A +
+    2k·(α + max(α, δ))`` (α of a and b, δ of d), and ``‖G₀‖ + ‖G₁‖ ≤ ‖A‖·X^k`` with X
+    the largest of ‖W‖ = ‖a² + b²‖ and ‖P‖ + ‖b‖·√‖Δ‖, ‖Q‖ + ‖a‖·√‖Δ‖, so ``h ≤
+    2(h_A + k·h_X) + h_Δ + 1``.  The chain runs
+    on g's factors and squarefree parts, but resultants and norms are multiplicative,
+    so each polynomial it forms divides the one the same chain forms from g itself:
+    the bound is computed on that chain, and a divisor has no larger degrees and, by
+    Mahler's measure (M(Q) ≤ M(P) ≤ ‖P‖₂), coefficients of at most ``2^(Σ deg)·‖P‖₁``.
+    Terms are bounded by the box of the degrees."""
+    ctx = g.context()
+    names = ctx.names()
+    pairs = [v for v, _ in legs if isinstance(v, tuple)]
+    paired = {x for v in pairs for x in v}
+
+    def bounds(p: fmpq_mpoly) -> dict:
+        degrees = [max(0, int(d)) for d in p.degrees()]
+        out = {v: d for v, d in zip(names, degrees, strict=True) if v not in paired}
+        for c, s in pairs:
+            ci, si = names.index(c), names.index(s)
+            out[c, s] = max((int(e[ci]) + int(e[si]) for e in p.monoms()), default=0)
+        out["h"] = _height(p)
+        return out
+
+    def size(b: dict) -> int:
+        n = 1
+        for v, d in b.items():
+            if isinstance(v, tuple):
+                n *= (d + 1) * (d + 2) // 2
+            elif v != "h":
+                n *= d + 1
+        return n
+
+    def divisor(b: dict) -> dict:
+        total = sum(d * (2 if isinstance(v, tuple) else 1) for v, d in b.items() if v != "h")
+        return {**b, "h": b["h"] + total + size(b).bit_length()}
+
+    chain = []
+    for v, f in legs:
+        if isinstance(v, tuple):
+            ci, si = names.index(v[0]), names.index(v[1])
+            a, b = bounds(coefficient_in(f, ci, 1)), bounds(coefficient_in(f, si, 1))
+            d = bounds(coefficient_in(coefficient_in(f, ci, 0), si, 0))
+            ab = {w: max(a[w], b[w]) for w in a}
+            h_f = _height(f)  # a, b, d scaled together, as parts of f's integer multiple
+            h_w = 2 * h_f + 1
+            h_delta = max(h_w, 2 * h_f) + 1
+            h_x = max(h_w, h_f + max(h_f, (h_delta + 1) // 2) + 1)
+            chain.append((v, ab, d, (h_x, h_delta)))
+        else:
+            chain.append((v, bounds(f), None, None))
+    acc = bounds(g)
+    largest, bits = size(acc), divisor(acc)["h"]
+    for v, f, d, heights in chain:
+        if acc[v] == 0:
+            continue  # a leg that does not touch it
+        if d is not None:
+            k, (h_x, h_delta) = acc[v], heights
+            h = 2 * (acc["h"] + k * h_x) + h_delta + 1
+            acc = {w: 2 * acc[w] + 2 * k * (f[w] + max(f[w], d[w])) for w in acc}
+        else:
+            m, n = acc[v], f[v]
+            h = m * f["h"] + n * acc["h"]
+            acc = {w: m * f[w] + n * acc[w] for w in acc}
+        acc[v], acc["h"] = 0, h
+        largest, bits = max(largest, size(acc)), max(bits, divisor(acc)["h"])
+    return largest, bits
+
+
+#: A request is computed in singcheck's own process, not in a forked child, only when
+#: :func:`norm_chain_bound` proves every polynomial of its chain at most this many terms
+#: of at most :data:`IN_PROCESS_BITS` bits (README, "Budgets").
+IN_PROCESS_TERMS = 1_000_000
+IN_PROCESS_BITS = 1024
+
+
+def chain_memory_bound(terms: int, bits: int, nvars: int) -> int:
+    """Bytes that a chain whose polynomials have at most ``terms`` terms of ``bits`` bits
+    can hold at once, by a generous count: twelve such polynomials alive (the chain's
+    inputs, its accumulator, FLINT's subresultants; a dense chain of 505,161 terms of
+    365 bits peaked at 4.7), each term an exponent word per variable and a coefficient
+    of ``bits`` bits with GMP's header."""
+    return 12 * terms * (8 * nvars + 8 * (bits // 64 + 1) + 32)
+
+
+def chain_is_small(g: fmpq_mpoly, legs: list, memory_limit: int) -> bool:
+    """Whether :func:`norm_chain_bound` proves the chain of ``g`` over ``legs`` small:
+    at most :data:`IN_PROCESS_TERMS` terms of :data:`IN_PROCESS_BITS` bits, and
+    :func:`chain_memory_bound` at most half of ``memory_limit`` (0: none)."""
+    terms, bits = norm_chain_bound(g, legs)
+    memory = chain_memory_bound(terms, bits, g.context().nvars())
+    return (terms <= IN_PROCESS_TERMS and bits <= IN_PROCESS_BITS
+            and (not memory_limit or 2 * memory <= memory_limit))
+
+
+def proven_small(request: EliminationRequest, memory_limit: int) -> bool:
+    """Whether ``request`` is a norm chain (:func:`leg_structure`) that
+    :func:`chain_is_small` proves small."""
+    structure = leg_structure(request)
+    return structure is not None and chain_is_small(*structure, memory_limit)

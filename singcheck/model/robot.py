@@ -47,6 +47,7 @@ squared, ρᵢ² = |…|²: 3-RPR, Gough–Stewart), every mode has the same det
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import TYPE_CHECKING
 
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
@@ -108,11 +109,11 @@ class RobotModel:
     def angles(self) -> frozenset[str]:
         return self.spec.angles
 
-    @property
+    @cached_property  # the model is immutable; asked at every candidate
     def joint_variables(self) -> tuple[str, ...]:
         return self.spec.joint_variables
 
-    @property
+    @cached_property  # the model is immutable; asked at every candidate
     def pose_variables(self) -> tuple[str, ...]:
         return self.spec.pose_variables
 
@@ -121,13 +122,13 @@ class RobotModel:
         """The variables a projection onto the pose eliminates: joints and radicals."""
         return (*self.joint_variables, *self.spec.radical_variables)
 
-    @property
+    @cached_property  # the model is immutable; asked at every candidate
     def joint_free_det_A(self) -> bool:
         """det A involves no joint variable: ξ(X) is det A itself (no elimination)."""
         names = self.context.names()
         return all(self.det_A.degrees()[names.index(v)] <= 0 for v in self.joint_variables)
 
-    @property
+    @cached_property  # the model is immutable; asked at every candidate
     def polynomial(self) -> bool:
         """No angle and no square root: the original, purely polynomial class."""
         return not self.spec.angles and not self.spec.radicals

@@ -105,6 +105,7 @@ def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
                 "status": m.status,
                 "reason": m.reason,
                 "joints_at_start": m.joints_at_start,
+                "proof": m.proof,
                 "singular_times": [float(c.t.mid()) for c in m.singular_times],
             }
             for m in report.modes

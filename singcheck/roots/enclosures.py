@@ -104,6 +104,9 @@ class RootIsolation:
     roots: tuple[RealRoot, ...]
     undecided: tuple[Undecided, ...]
     method: str
+    #: (root, kept) per root of a norm where whether the polynomial itself vanishes was
+    #: decided exactly (balls could not tell it from a conjugate): kept among ``roots``
+    exact: tuple[tuple[RealRoot, bool], ...] = ()
 
     @property
     def certified(self) -> bool:

@@ -33,6 +33,7 @@ from singcheck.roots.rational import (
     bits_for,
     exact_tolerance,
     real_roots_exact,
+    root_of_power,
 )
 
 _TWO_U = fmpq_poly([0, 2])
@@ -44,14 +45,28 @@ def half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
 
     With p = P₀(c) + s·P₁(c), M = H(P₀, d)(u²) + 2u·H(P₁, d-1)(u²) where
     H(Σ aₖcᵏ, n)(w) = Σ aₖ (1-w)ᵏ (1+w)ⁿ⁻ᵏ, a polynomial in w = u² (exact rational
-    arithmetic throughout).  Writing c = (1-w)/(1+w) = -1 + 2y with y = 1/(1+w),
+    arithmetic throughout; :func:`_half_angle_parts`).
+    """
+    even, odd, d = _half_angle_parts(p)
+    m = even(_U2)
+    if odd is not None:
+        m += _TWO_U * odd(_U2)
+    return m, d
+
+
+def _half_angle_parts(p: fmpq_mpoly) -> tuple[fmpq_poly, fmpq_poly | None, int]:
+    """(H(P₀, d), H(P₁, d-1) or None when p is free of s, d) of
+    :func:`half_angle_polynomial`, as polynomials in w = u².
+
+    Writing c = (1-w)/(1+w) = -1 + 2y with y = 1/(1+w),
     (1+w)^m P(c) = y^(-m) P(-1 + 2y) is the reversal of P(-1 + 2y) taken at 1 + w: two
     compositions with linear polynomials in FLINT and a reversal.
     """
-    d = max((j + k for (_i, j, k), _ in p.terms()), default=0)
     by_s: list[dict[int, fmpq]] = [{}, {}]
+    d = 0
     for (_i, j, k), c in p.terms():
         by_s[j][k] = c
+        d = max(d, j + k)
 
     def homogenised(coeffs: dict[int, fmpq], n: int) -> fmpq_poly:
         if not coeffs:
@@ -61,9 +76,23 @@ def half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
         cs = list(shifted.coeffs()) + [fmpq(0)] * (top + 1 - len(shifted.coeffs()))
         return fmpq_poly(cs[::-1])(_ONE_PLUS_W) * _ONE_PLUS_W ** (n - top)
 
-    even = homogenised(by_s[0], d)(_U2)
-    odd = homogenised(by_s[1], d - 1)(_U2) if by_s[1] else fmpq_poly([])
-    return even + _TWO_U * odd, d
+    return homogenised(by_s[0], d), homogenised(by_s[1], d - 1) if by_s[1] else None, d
+
+
+def deflated_half_angle(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
+    """(N, k) with M(u) = N(u^k) for M = :func:`half_angle_polynomial` (p), k as large as
+    FLINT's deflation finds.  For p free of s, M = H(u²) exactly, so N and k are those of
+    H's own deflation with k doubled, without forming M (twice H's degree) and
+    deflating it back: the same N and k."""
+    even, odd, _ = _half_angle_parts(p)
+    if odd is None and even.degree() >= 1:
+        deflated, k = even.numer().deflation()
+        return fmpq_poly(deflated), 2 * max(int(k), 1)
+    m = even(_U2)
+    if odd is not None:
+        m += _TWO_U * odd(_U2)
+    deflated, k = m.numer().deflation()
+    return fmpq_poly(deflated), max(int(k), 1)
 
 
 _MINUS_ONE_PLUS_2Y, _ONE_PLUS_W, _U2 = (fmpq_poly(c) for c in ([-1, 2], [1, 1], [0, 0, 1]))
@@ -80,7 +109,13 @@ class _HalfAngleRoot:
 
 
 def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
-    """The real roots of M, isolated exactly after deflation.
+    """The real roots of M, isolated exactly after deflation (:func:`_deflated_roots`)."""
+    deflated, k = m.numer().deflation()
+    return _deflated_roots(fmpq_poly(deflated), max(int(k), 1))
+
+
+def _deflated_roots(deflated: fmpq_poly, k: int) -> list[_HalfAngleRoot]:
+    """The real roots of M(u) = N(u^k) (N = ``deflated``), isolated exactly.
 
     When M(u) = N(u^k) (flint's deflation; even paths give k = 2), the roots of N are
     isolated instead (degree divided by k): each root v > 0 of N gives u = v^(1/k), and
@@ -88,11 +123,9 @@ def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
     real when k is even; v = 0 gives u = 0 with k times the multiplicity.  u is enclosed
     by Arb's rigorous k-th roots of the interval ends (u ↦ u^k is monotone on each side).
     """
-    deflated, k = m.numer().deflation()
-    k = max(int(k), 1)
     out = []
     # k even: u^k = v has no real root for v < 0, so only v ≥ 0 is isolated
-    for rr, mult in real_roots_exact(fmpq_poly(deflated), nonnegative_only=k % 2 == 0):
+    for rr, mult in real_roots_exact(deflated, nonnegative_only=k % 2 == 0):
         checkpoint()
         for q in (fmpq(0), fmpq(1), fmpq(-1)):  # u = 0, ±1 (t = 0, ±π/2) are exact
             rr.pin(q)
@@ -115,31 +148,11 @@ def _half_angle_roots(m: fmpq_poly) -> list[_HalfAngleRoot]:
 
 def _u_root(rr: RationalRoot, k: int, sign: int) -> Callable[[], RationalRoot]:
     """The exact u = sign·v^(1/k) for the root v of N isolated by ``rr``: a rational
-    interval isolating u among the real roots of g(u) = f(u^k) (f(0) ≠ 0).
-
-    u ↦ u^k is injective on each sign, so among g's roots of that sign exactly one has
-    u^k = v; every other one's interval image eventually misses rr's interval."""
+    interval isolating u among the real roots of h(u^k), h the minimal polynomial of v
+    (:func:`~singcheck.roots.rational.root_of_power`)."""
 
     def locate():
-        if k == 1:
-            return rr
-        g_coeffs = [fmpq(0)] * (k * rr.poly.degree() + 1)
-        for i, c in enumerate(rr.poly.coeffs()):
-            g_coeffs[k * i] = c
-        g = fmpq_poly(g_coeffs)
-        # a positive root's interval may start at 0, a negative one's end there
-        candidates = [r for r, _ in real_roots_exact(g) if (r.lo + r.hi > 0) == (sign > 0)]
-        while True:
-            checkpoint()
-            hits = [r for r in candidates
-                    if not (max(r.lo**k, r.hi**k) < rr.lo or min(r.lo**k, r.hi**k) > rr.hi)]
-            if len(hits) == 1:
-                return hits[0]
-            if not hits:
-                raise AssertionError("no root of f(u^k) maps onto the isolated root of f")
-            for r in hits:
-                r.bisect_to(r.width() / 4)
-            rr.bisect_to(rr.width() / 4)
+        return rr if k == 1 else root_of_power(rr, k, sign)
 
     return locate
 
@@ -161,23 +174,25 @@ def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
         width = exact_tolerance(tol) / 4
         bits = bits_for(tol)
         rr.bisect_to(width)
-        while k > 1 and rr.lo != rr.hi and float(u_bounds(bits).rad()) > tol / 8:
+        u = u_bounds(bits)  # (the ball of the final interval is the one mapped)
+        while k > 1 and rr.lo != rr.hi and float(u.rad()) > tol / 8:
             checkpoint()
             width /= 16
             rr.bisect_to(width)
+            u = u_bounds(bits)
         with working_precision(bits):
-            hit = done[tol] = 2 * u_bounds(bits).atan()
+            hit = done[tol] = 2 * u.atan()
         return hit
 
     return ball
 
 
 def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
-    m, _ = half_angle_polynomial(p)
+    deflated, k = deflated_half_angle(p)
     at_pi = p.subs({"s": 0, "c": -1})
     bases: list[tuple[Callable[[float], arb], LinearInPi | None, int | None,
                       ExactTime | None]] = [
-        (r.ball, r.exact, r.multiplicity, r.time) for r in _half_angle_roots(m)]
+        (r.ball, r.exact, r.multiplicity, r.time) for r in _deflated_roots(deflated, k)]
     if at_pi.is_zero():
 
         def base_pi(tol: float) -> arb:

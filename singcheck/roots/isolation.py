@@ -55,6 +55,7 @@ from singcheck.roots.transcendental import (
     ONE_MINUS_C2,
     NotExact,
     TranscendentalPoint,
+    angle_circle,
     split_s,
 )
 
@@ -169,7 +170,8 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
     (:meth:`~singcheck.roots.transcendental.TranscendentalPoint.is_zero`; at t = kπ by
     :func:`~singcheck.roots.branch_bound.vanishes_at_multiple_of_pi`): p's zeros are
     exactly those where it does, every other stretch is root-free."""
-    p0, p1 = split_s(p)
+    circle = angle_circle(p)  # a pose angle's (C, S), renamed (c, s) for the algebra
+    p0, p1 = split_s(p if circle is None else circle.to_trig(p))
     if p0.is_zero() or p1.is_zero():
         return None
     norm = p0 * p0 - p1 * p1 * ONE_MINUS_C2
@@ -181,7 +183,8 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
         if k.is_constant():
             continue
         checkpoint()
-        iso = branch_and_bound(k, interval, tolerance)
+        iso = branch_and_bound(k if circle is None else circle.from_trig(k), interval,
+                               tolerance)
         undecided += [Undecided(b.t, "possible tangency: the zeros of μ there are zeros of "
                                 "a factor of its norm over sin t, which could not be "
                                 f"isolated in t ∈ [{float(b.t.lower()):.9g}, "
@@ -211,25 +214,32 @@ def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
             return TranscendentalPoint(time).is_zero(p)
         except NotExact:
             return None
-    if time.kind == AT_POINT and time.t_value == 0:
-        return vanishes_at_multiple_of_pi(p, 0)
-    if time.kind == AT_POINT and time.pi_multiple is not None:
-        return vanishes_at_multiple_of_pi(p, time.pi_multiple)
+    if time.kind == AT_POINT and (time.t_value == 0 or time.pi_multiple is not None):
+        zero = vanishes_at_multiple_of_pi(p, 0 if time.t_value == 0 else time.pi_multiple)
+        # with a pose angle's C, S left in p, only "zero whatever C, S are" is a proof
+        return zero if zero or p.context() is TRIG else None
     return None
 
 
 def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
-                       tolerance: float = 1e-9) -> RootIsolation:
+                       tolerance: float = 1e-9, exact_zero=None) -> RootIsolation:
     """Every real root of ``poly(t, sin t, cos t)`` on the closed range, certified.
 
     A polynomial with square roots among its coefficients (a :func:`path_ring`
-    element) goes through :func:`_with_radicals`."""
+    element) goes through :func:`_with_radicals`; ``exact_zero(p, root)`` (True, False,
+    or None when it cannot say) decides exactly whether p vanishes at a root of its norm
+    where balls cannot tell p from a conjugate (the caller's exact arithmetic:
+    :func:`singcheck.certify.exact.vanishes_at_root`)."""
     if poly.context() is not TRIG:
         if radical_variables(poly.context()):
-            return _with_radicals(poly, interval, tolerance)
+            return _with_radicals(poly, interval, tolerance, exact_zero)
         p = reduce_relations(poly)
         if p.is_zero():
             raise IdenticallyZeroError("the function is identically zero along the path")
+        if not any(p.degrees()[3:]):
+            return isolate_real_roots(restrict(p, TRIG), interval, tolerance)
+        if angle_circle(p) is not None:  # t and one pose angle g(t) + qπ, g ∈ Q[t]
+            return _mixed(p, interval, tolerance)
         return branch_and_bound(p, interval, tolerance)  # angle functions: t mixed with them
     p = reduce_trig(poly)
     if p.is_zero():
@@ -241,21 +251,24 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
     return _exact_univariate(p, interval, tolerance)
 
 
-def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
+def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float,
+                   exact_zero=None) -> RootIsolation:
     """Roots of a polynomial over Q(√2, √3, …): those of its norm N = ∏ p^σ (over Q,
     isolated as above), kept only where proven to be roots of p itself.
 
     Each ball T of N holds exactly one root τ of N.  If p excludes 0 on T, τ is a root of
     a conjugate only: dropped.  If every conjugate p^σ (σ ≠ id) excludes 0 on T, then
-    p(τ) = 0: kept.  Otherwise T is refined (and the precision raised) a few times;
-    what stays ambiguous is reported undecided, never guessed."""
+    p(τ) = 0: kept.  Otherwise T is refined (and the precision raised) a few times; a
+    root where p and a conjugate both still hold 0 (both may vanish there) is decided
+    by ``exact_zero`` when given (its times are the isolation's ``exact``); what stays
+    ambiguous is reported undecided, never guessed."""
     ctx = p.context()
     rest = [n for n in ctx.names() if radical_prime(n) is None]
     norm = restrict(norm_radicals(p), TRIG if len(rest) == 3 else
                     fmpq_mpoly_ctx.get(tuple(rest), "lex"))
     iso = isolate_real_roots(norm, interval, tolerance)
     sigmas = conjugates(p)
-    roots, undecided = [], list(iso.undecided)
+    roots, undecided, exact = [], list(iso.undecided), []
     for root in iso.roots:
         checkpoint()
         r, verdict = root, None
@@ -269,10 +282,14 @@ def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Root
                     verdict = True
             if verdict is not None:
                 break
+        if verdict is None and exact_zero is not None:
+            verdict = exact_zero(p, r)
+            if verdict is not None:
+                exact.append((r, verdict))
         if verdict:
             roots.append(r)
         elif verdict is None:
             undecided.append(Undecided(r.t, "a root of the norm over the square roots could "
                                        "not be told apart from a root of a conjugate near "
                                        f"t ≈ {float(r.t.mid()):.6g}"))
-    return RootIsolation(tuple(roots), tuple(undecided), iso.method)
+    return RootIsolation(tuple(roots), tuple(undecided), iso.method, tuple(exact))

@@ -16,6 +16,7 @@ from fractions import Fraction
 from flint import arb, arb_poly, ctx, fmpq, fmpq_poly, fmpz_poly
 
 from singcheck.algebra.intervals import working_precision
+from singcheck.algebra.polynomials import memo_per_object
 from singcheck.budget import checkpoint
 
 
@@ -315,33 +316,63 @@ _X_PLUS_1 = fmpz_poly([1, 1])
 def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     """Isolating intervals of the positive real roots of a squarefree ``f`` with f(0) ≠ 0.
 
-    Vincent–Collins–Akritas bisection: roots are first scaled into (0, 1) by a power
-    of two above the Cauchy bound; on a dyadic interval, the number of sign variations
-    of the coefficients of (x+1)^n g(1/(x+1)) bounds the number of roots and has the
-    same parity (Descartes); 0 proves none, 1 proves exactly one (Vincent's theorem
-    makes the bisection terminate for squarefree input).  A root found exactly at a
-    bisection point is returned as a point interval; an interval whose end is such a
-    root is bisected further, so every other interval has a sign change at its ends.
+    The roots in (0, 1) are those of f there; the roots x > 1 are the 1/y for the roots
+    y in (0, 1) of the reversal y^n f(1/y) (same degree, non-zero at 0, and of the sign
+    of f(1/y) for y > 0); x = 1 is tested exactly.  Each part is isolated in (0, 1) by
+    :func:`_unit_root_intervals`; an interval [a, b] of the reversal becomes [1/b, 1/a]
+    ([0, b] is first narrowed off 0, :func:`_off_zero`).  Splitting at 1 instead of
+    bisecting down from a bound on the roots spares the levels between the bound and
+    the roots: a root near u = 0 or u = ∞ (t near 0 or ±π) no longer costs a dozen
+    halvings for every other root.
+    """
+    cs = f.coeffs()  # FLINT integers: compared and summed as they are, no conversion
+    if cs[-1] < 0:
+        cs = [-c for c in cs]
+    if all(c >= 0 for c in cs):
+        return []  # no sign variation: no positive root (Descartes)
+    one = fmpq(1)
+    intervals = [(one, one)] if sum(cs) == 0 else []
+    intervals += _unit_root_intervals(fmpz_poly(cs))
+    reversal = fmpz_poly(cs[::-1])
+    for lo, hi in _unit_root_intervals(reversal):
+        if lo == 0:
+            lo, hi = _off_zero(fmpq_poly(reversal), hi)
+        intervals.append((1 / hi, 1 / lo))
+    return intervals
+
+
+def _off_zero(g: fmpq_poly, hi: fmpq) -> tuple[fmpq, fmpq]:
+    """An isolating interval [lo, hi'] with lo > 0 for the one root y of g in (0, hi),
+    where g(0) > 0 > g(hi) (the reversal's largest-x root): hi is halved while g stays
+    negative there (exact signs); the first point where g > 0 is lo (a point where g = 0
+    is the root itself).  It ends once hi/2 falls below y > 0."""
+    while True:
+        checkpoint()
+        mid = hi / 2
+        value = g(mid)
+        if value == 0:
+            return mid, mid
+        if value > 0:
+            return mid, hi
+        hi = mid
+
+
+def _unit_root_intervals(g: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
+    """Isolating intervals of the roots in (0, 1) of a squarefree ``g`` with g(0) ≠ 0.
+
+    Vincent–Collins–Akritas bisection: on a dyadic interval, the number of sign
+    variations of the coefficients of (x+1)^n g(1/(x+1)) bounds the number of roots and
+    has the same parity (Descartes); 0 proves none, 1 proves exactly one (Vincent's
+    theorem makes the bisection terminate for squarefree input).  A root found exactly
+    at a bisection point is returned as a point interval; an interval whose end is such
+    a root (or 1) is bisected further, so every other interval has a sign change at its
+    ends.
 
     Each node costs one Taylor shift by 1 in FLINT (the test polynomial, whose constant
     term is g(1)) and, when it is split, one more for the right half; halving,
     2^m g(x/2), is a shift of each coefficient.
     """
-    cs = [int(c) for c in f.coeffs()]
-    n = len(cs) - 1
-    if cs[-1] < 0:
-        cs = [-c for c in cs]
-    # Cauchy's bound for the positive roots: with a_n > 0 and λ negative coefficients,
-    # every positive root x has x^(n-i) <= λ|a_i|/a_n for some a_i < 0 (otherwise a_n x^n
-    # outweighs every negative term).  Bounded with bit lengths (|a| < 2^bitlen,
-    # a_n >= 2^(bitlen-1)), so every positive root is < 2^b strictly.
-    negative = [(i, c) for i, c in enumerate(cs[:-1]) if c < 0]
-    if not negative:
-        return []  # no sign variation: no positive root (Descartes)
-    spare = len(negative).bit_length() + 1 - cs[-1].bit_length()
-    b = max(0, max(-(-(spare + (-c).bit_length()) // (n - i)) for i, c in negative))
-    g = fmpz_poly([c << (b * i) for i, c in enumerate(cs)])  # g(x) = f(2^b x)
-    out: list[tuple[int, int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
+    out: list[tuple[int, int, bool]] = []  # (a, k, exact) on (a/2^k, (a+1)/2^k)
     stack = [(g, 0, 0)]
     while stack:
         g, a, k = stack.pop()
@@ -361,11 +392,10 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
             out.append((2 * a + 1, k + 1, True))
         stack.append((half(_X_PLUS_1), 2 * a + 1, k + 1))
         stack.append((half, 2 * a, k + 1))
-    scale = fmpq(2**b)
     intervals = []
     for a, k, exact in out:
-        lo = scale * fmpq(a, 2**k)
-        intervals.append((lo, lo) if exact else (lo, scale * fmpq(a + 1, 2**k)))
+        lo = fmpq(a, 2**k)
+        intervals.append((lo, lo) if exact else (lo, fmpq(a + 1, 2**k)))
     return intervals
 
 
@@ -408,9 +438,9 @@ def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
     out = []
     for factor, mult in factors:
         f = fmpq_poly(factor)
-        cs = [int(c) for c in factor.coeffs()]
-        shift = next(i for i, c in enumerate(cs) if c != 0)
-        if shift:  # a root at 0 (squarefree: simple)
+        cs = factor.coeffs()
+        if cs[0] == 0:  # a root at 0 (squarefree: simple)
+            shift = next(i for i, c in enumerate(cs) if c != 0)
             out.append((RationalRoot(f, fmpq(0), fmpq(0)), mult))
             factor = fmpz_poly(cs[shift:])
             f = fmpq_poly(factor)  # the other roots: f no longer vanishes at 0
@@ -420,9 +450,123 @@ def real_roots_exact(p: fmpq_poly, nonnegative_only: bool = False
             out.append((RationalRoot(f, lo, hi), mult))
         if nonnegative_only:
             continue
-        mirrored = fmpz_poly([c if i % 2 == 0 else -c
-                              for i, c in enumerate(int(c) for c in factor.coeffs())])
+        mirrored = fmpz_poly([c if i % 2 == 0 else -c for i, c in enumerate(factor.coeffs())])
         for lo, hi in _positive_root_intervals(mirrored):
             out.append((RationalRoot(f, -hi, -lo), mult))
     out.sort(key=lambda item: item[0].lo)
     return out
+
+
+# ---------------------------------------------------------------------------------
+# minimal polynomials of isolated roots, and roots of their k-th powers
+
+_FACTORS: dict = {}
+_POWERS: dict = {}
+
+
+def irreducible_factors(poly: fmpq_poly) -> list[fmpq_poly]:
+    """The monic irreducible factors of ``poly`` over Q, once per polynomial object: the
+    roots of one squarefree factor hold the same object, so the exact decisions at
+    several of its roots factor it once."""
+    def factor(p: fmpq_poly) -> list[fmpq_poly]:
+        return [fmpq_poly(h) / fmpq_poly(h).leading_coefficient()
+                for h, _ in p.numer().factor()[1]]
+    return memo_per_object(_FACTORS, poly, factor)
+
+
+def minimal_polynomial(rr: RationalRoot) -> RationalRoot:
+    """The same root on the irreducible factor of ``rr.poly`` that vanishes there (its
+    minimal polynomial, monic; the same interval).
+
+    The interval isolates one root of the squarefree polynomial, so exactly one
+    irreducible factor has a root there: the one that vanishes at a point interval, or
+    changes sign between the ends (roots of a squarefree polynomial are simple, and the
+    ends of an isolating interval are not roots).
+    """
+    for f in irreducible_factors(rr.poly):
+        if rr.lo == rr.hi:
+            if f(rr.lo) == 0:
+                return RationalRoot(f, rr.lo, rr.hi)
+        elif f(rr.lo) * f(rr.hi) < 0:
+            return RationalRoot(f, rr.lo, rr.hi)
+    raise AssertionError("no factor of an isolated root's polynomial vanishes there")
+
+
+def _power_substituted(h: fmpq_poly, k: int) -> fmpq_poly:
+    """h(u^k), one object per (h, k): its own factorisation is then shared by the roots
+    that need it."""
+    per_h = memo_per_object(_POWERS, h, lambda _: {})
+    if k not in per_h:
+        coeffs = [fmpq(0)] * (k * h.degree() + 1)
+        for i, c in enumerate(h.coeffs()):
+            coeffs[k * i] = c
+        per_h[k] = fmpq_poly(coeffs)
+    return per_h[k]
+
+
+def root_of_power(rr: RationalRoot, k: int, sign: int) -> RationalRoot:
+    """u = sign·|v|^(1/k) for the root v ≠ 0 isolated by ``rr`` (sign = the sign of v when
+    k is odd), as a root of g(u) = h(u^k), h the minimal polynomial of v, with an
+    isolating rational interval: found from v's own interval, without isolating g.
+
+    The roots of g of u's sign are the u' = sign·|v'|^(1/k) for the roots v' of h of v's
+    sign, and u' ↦ v' = u'^k is monotone there.  With [lo, hi] v's isolating interval
+    (refined off 0), rationals x₋ ≥ |e₁|^(1/k) and x₊ ≤ |e₂|^(1/k) are taken from Arb's
+    k-th roots of the end nearer 0 (e₁) and the farther one (e₂); w₋ = σ·x₋^k and
+    w₊ = σ·x₊^k (σ the sign of v) are then checked exactly to lie in [lo, hi] with h
+    non-zero of the sign h has at e₁, resp. e₂: on an isolating interval with a sign
+    change, that places w₋ strictly between e₁ and v and w₊ strictly between v and e₂.
+    So [x₋, x₊] (mirrored for sign < 0) holds exactly one root of g, u, and g, which is
+    h(σ·x^k) there, changes sign at its ends.  Otherwise ``rr`` is refined and the test
+    repeated.  A rational v with |v| a k-th power gives u exactly.
+    """
+    v = minimal_polynomial(rr)
+    g = _power_substituted(v.poly, k)
+    if v.compare(fmpq(0)) == 0:
+        raise ValueError("the k-th root of 0 is not isolated here")
+    sigma = 1 if v.lo > 0 else -1
+
+    def between(w: fmpq, end: fmpq) -> bool:  # strictly between the end and v, proven
+        return v.lo <= w <= v.hi and v.sign_at(w) == v.sign_at(end) != 0
+
+    while True:
+        checkpoint()
+        if v.lo == v.hi:  # v rational (given so, or met exactly by a bisection)
+            x_lo, x_hi = _kth_root_bracket(abs(v.lo), k)
+            break
+        near, far = (v.lo, v.hi) if sigma > 0 else (v.hi, v.lo)
+        with working_precision(64 + max(0, int(-math.log2(float(v.width()))))):
+            x_lo = arb_to_fmpq(arb(abs(near)).root(k).upper())
+            x_hi = arb_to_fmpq(arb(abs(far)).root(k).lower())
+        if 0 < x_lo < x_hi and between(sigma * x_lo**k, near) and \
+                between(sigma * x_hi**k, far):
+            break
+        v.bisect_to(v.width() / 4)
+    return RationalRoot(g, *((x_lo, x_hi) if sign > 0 else (-x_hi, -x_lo)))
+
+
+def _kth_root_bracket(w: fmpq, k: int) -> tuple[fmpq, fmpq]:
+    """w^(1/k) for a rational w > 0: a point when it is rational, else rationals
+    x₋ < x₊ with x₋^k < w < x₊^k (checked exactly)."""
+    a, b = _integer_root(int(w.p), k), _integer_root(int(w.q), k)
+    if a**k == w.p and b**k == w.q:
+        return fmpq(a, b), fmpq(a, b)
+    bits = 64
+    while True:
+        checkpoint()
+        with working_precision(bits):
+            ball = arb(w).root(k)
+            x_lo, x_hi = arb_to_fmpq(ball.lower()), arb_to_fmpq(ball.upper())
+        if 0 < x_lo and x_lo**k < w < x_hi**k:
+            return x_lo, x_hi
+        bits *= 2
+
+
+def _integer_root(n: int, k: int) -> int:
+    """⌊n^(1/k)⌋ for an integer n ≥ 1 (Newton's iteration in integers)."""
+    x = 1 << -(-n.bit_length() // k)  # above the root
+    while True:
+        y = ((k - 1) * x + n // x ** (k - 1)) // k
+        if y >= x:
+            return x
+        x = y

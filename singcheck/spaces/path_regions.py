@@ -37,6 +37,7 @@ from singcheck.algebra.polynomials import constant_value
 from singcheck.algebra.radicals import cos_pi, evaluate_path, sin_pi
 from singcheck.algebra.trig import uses_t, uses_trig
 from singcheck.budget import checkpoint
+from singcheck.certify.exact import vanishes_at_root
 from singcheck.certify.path import PathModel, compose_pose
 from singcheck.certify.working_modes import gap_points
 from singcheck.roots.enclosures import IdenticallyZeroError
@@ -148,7 +149,7 @@ def _crossings(path: PathModel, surfaces: list[tuple[str, object]], tolerance: f
             events += [(t, label) for t in mu_roots]
             continue
         try:
-            iso = isolate_real_roots(poly, interval, tolerance)
+            iso = isolate_real_roots(poly, interval, tolerance, vanishes_at_root)
         except IdenticallyZeroError:
             on.append((label, str(interval)))
             continue
@@ -330,7 +331,7 @@ def outside_chart(path: PathModel, interval) -> str:
         why = (f"the angle {v} reaches π (mod 2π) on the path, where the decomposition in "
                f"tan({v}/2) is cut: no region named")
         try:
-            iso = isolate_real_roots(one_plus_cos, interval, 1e-9)
+            iso = isolate_real_roots(one_plus_cos, interval, 1e-9, vanishes_at_root)
         except IdenticallyZeroError:
             return why
         if iso.roots:

@@ -14,6 +14,7 @@ from singcheck.elimination.requests import (
     EliminationResult,
     leg_structure,
     norm_chain,
+    proven_small,
 )
 
 
@@ -32,6 +33,11 @@ class FlintBackend:
 
             SympyBackend().preload(request)
 
+    def proven_small(self, request: EliminationRequest, memory_limit: int) -> bool:
+        """Whether :class:`~singcheck.elimination.cas.isolated.Isolated` may run
+        ``request`` in this process (:func:`~singcheck.elimination.requests.proven_small`)."""
+        return proven_small(request, memory_limit)
+
     def eliminate(self, request: EliminationRequest) -> EliminationResult:
         structure = leg_structure(request)
         if structure is None:
@@ -42,4 +48,4 @@ class FlintBackend:
         g, legs = structure
         poly = restrict(norm_chain(g, legs), request.kept_context())
         return EliminationResult(request, (poly,), "FLINT resultant chain (norm over the legs)",
-                                 self.name)
+                                 self.name, is_norm=True)

@@ -18,9 +18,12 @@ libraries; nothing is re-imported), which sends its pickled result back through 
   SIGKILLed singcheck leaves no child computing; on Ctrl-C, SIGTERM or SIGHUP it is
   killed and reaped.
 
-A fork costs a few milliseconds (README, "Speed"); :func:`singcheck.elimination.cas.
-get_backend` wraps the in-process backends in it, their classes used directly run in
-this process.
+A fork costs a few milliseconds, and bringing a large result back through the pipe
+tens (the 3-PRR's 24,389-term ξ: about 35 ms, README "Speed"), so a request that
+:func:`~singcheck.elimination.requests.proven_small` bounds up front (a norm chain of at
+most 10⁶ terms of 1024 bits, its memory a quarter of the bound at most) runs in this
+process.  :func:`singcheck.elimination.cas.get_backend` wraps the in-process backends in
+:class:`Isolated`; their classes used directly run in this process.
 """
 
 from __future__ import annotations
@@ -160,6 +163,21 @@ def _outcome(message: bytes, status: int, said: str, limit: int, what: str):
     raise BackendError(f"{what} {how}" + (f": {first[:200]}" if first else ""))
 
 
+def run_bounded(fn, argument, proven_small: bool, timeout: float, what: str):
+    """``fn(argument)`` in this process when ``proven_small`` (an a-priori bound showed
+    that its time and memory are far below ``timeout`` and the memory bound: README,
+    "Budgets") and ``timeout`` is at least :data:`IN_PROCESS_MIN_TIMEOUT`, else
+    :func:`run_forked` — a fork would cost more than such a computation."""
+    if proven_small and timeout >= IN_PROCESS_MIN_TIMEOUT:
+        return fn(argument)
+    return run_forked(fn, argument, timeout, what)
+
+
+#: Below this ``--timeout`` every request goes to the fork (a proven-small chain takes at
+#: most about a second here: README, "Budgets").
+IN_PROCESS_MIN_TIMEOUT = 60.0
+
+
 class Isolated:
     """An in-process backend whose every elimination runs in a forked child
     (:func:`run_forked`) with ``timeout`` seconds and the memory bound."""
@@ -173,6 +191,9 @@ class Isolated:
         return self.backend.version()
 
     def eliminate(self, request: EliminationRequest) -> EliminationResult:
-        self.backend.preload(request)  # imported once here, not in every child
-        return run_forked(self.backend.eliminate, request, self.timeout,
-                          f"the {self.name} backend")
+        proven = getattr(self.backend, "proven_small", None)
+        small = proven is not None and proven(request, memory_limit())
+        if not small:
+            self.backend.preload(request)  # imported once here, not in every child
+        return run_bounded(self.backend.eliminate, request, small, self.timeout,
+                           f"the {self.name} backend")

@@ -208,7 +208,12 @@ def direct_kinematics_count(model: RobotModel, joint_point) -> DirectCount:
               for f in direct_system(model)]
     radicals = len(model.spec.radical_variables)
     last = syms[-1]
-    for change in _COORDINATE_CHANGES:
+    # with a square root, the last pose coordinate alone rarely separates the robot's
+    # poses from its conjugate's (the linear Delta's are mirror images with the same z):
+    # the shift by r, (1,), is tried first
+    changes = _COORDINATE_CHANGES[1:2] + _COORDINATE_CHANGES[:1] + _COORDINATE_CHANGES[2:] \
+        if radicals else _COORDINATE_CHANGES
+    for change in changes:
         checkpoint()
         shift = sum((c * v for c, v in zip(change, syms[:-1], strict=False)), sympy.Integer(0))
         changed = [sympy.expand(e.subs(last, last - shift)) for e in system]

@@ -254,7 +254,7 @@ def _sign_at_root(g: fmpq_poly, root) -> int | None:
     while True:
         checkpoint()
         width = root.width()
-        bits = 64 + max(0, -math.floor(math.log2(float(width))) if float(width) > 0 else 2000)
+        bits = 64 + max(0, int(width.q).bit_length() - int(width.p).bit_length())
         if bits > _MAX_ROOT_BITS:
             return None
         with working_precision(bits):

@@ -292,14 +292,6 @@ def test_five_bar_joint_space_in_the_chart_matches_an_independent_direct_kinemat
     assert inside == {0, 2}
 
 
-@pytest.mark.parametrize("robot, why", [("linear-delta", "square roots among its numbers"),
-                                        ("3-rpr", "angles in its pose")])
-def test_joint_spaces_without_an_exact_direct_kinematics_count_are_refused(robot, why):
-    result = singcheck("jointspace", str(ROBOTS / f"{robot}.yaml"), "--backend", "flint", "-q")
-    assert result.returncode == 2
-    assert why in result.stderr and len(result.stderr.strip().splitlines()) == 1
-
-
 def test_a_chart_region_map_survives_the_cache(tmp_path):
     from singcheck.spaces.region_map import RegionMap, RegionMapCache
 

@@ -100,6 +100,11 @@ def _circles(model: RobotModel, names) -> tuple[fmpq_mpoly, ...]:
                  for c, s in (angle_names(v) for v in names if v in model.angles))
 
 
+def pose_circles(model: RobotModel) -> tuple[fmpq_mpoly, ...]:
+    """cos(φ)² + sin(φ)² - 1 for each angle φ of the pose."""
+    return _circles(model, model.pose)
+
+
 def singularity_surface_request(model: RobotModel) -> EliminationRequest:
     """Eliminate the joints from ``{F, det A}`` (the paper's ξ(X)); an angle joint brings
     its circle cos² + sin² = 1, a square root its pseudo-leg sqrt(p)² = p (eliminated
@@ -112,9 +117,15 @@ def singularity_surface_request(model: RobotModel) -> EliminationRequest:
 
 def joint_space_request(model: RobotModel) -> EliminationRequest:
     """Eliminate the pose from ``{F, det A}`` (the paper's ε(ρ))."""
+    return pose_elimination_request(model, "joint_space_singularities", model.det_A)
+
+
+def pose_elimination_request(model: RobotModel, kind: str, extra: fmpq_mpoly) -> EliminationRequest:
+    """Eliminate the pose from ``{F, extra}``: a pose angle brings its circle
+    cos² + sin² = 1 (its cos and sin are eliminated), a square root its pseudo-leg."""
     return EliminationRequest(
-        "joint_space_singularities", model.context,
-        (*model.constraints, model.det_A, *_circles(model, model.pose),
+        kind, model.context,
+        (*model.constraints, extra, *pose_circles(model),
          *(leg.constraint for leg in model.radical_legs)),
         (*model.pose_variables, *model.spec.radical_variables))
 

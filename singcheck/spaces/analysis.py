@@ -30,14 +30,25 @@ from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.polynomials import restrict, squarefree_part
 from singcheck.budget import checkpoint
-from singcheck.elimination.projection import RobotProjection, joint_space_singularities
+from singcheck.elimination.projection import (
+    RobotProjection,
+    joint_space_singularities,
+    pose_elimination_request,
+)
 from singcheck.elimination.requests import EliminationRequest
 from singcheck.errors import SingcheckError, UnsupportedRobotError
 from singcheck.model.robot import RobotModel
 from singcheck.spaces.cad import Cell, OpenCAD, open_cad
 from singcheck.spaces.chart import Chart
 from singcheck.spaces.regions import Region, Regions, connect_regions, factor_signs
-from singcheck.spaces.solution_counts import direct_kinematics_count, ik_count, ik_root_placement
+from singcheck.spaces.solution_counts import (
+    MAX_DIRECT_BEZOUT,
+    direct_bezout_bound,
+    direct_kinematics_count,
+    direct_unknowns,
+    ik_count,
+    ik_root_placement,
+)
 
 WORKSPACE, JOINTSPACE = "workspace", "jointspace"
 SERIAL, PARALLEL, LIMIT = "serial singularity", "parallel singularity", "joint limit"
@@ -135,20 +146,19 @@ def serial_singularities_request(model: RobotModel, leg) -> EliminationRequest:
     """Eliminate the pose from ``{F, ∂f_leg/∂ρ_leg}``: where that leg is serially singular
     (for an angle joint the derivative along its circle, B's entry)."""
     derivative = model.B[leg.constraint_index][model.joints.index(leg.joint)]
-    return EliminationRequest("joint_space_serial_singularities", model.context,
-                              (*model.constraints, derivative), model.pose)
+    return pose_elimination_request(model, "joint_space_serial_singularities", derivative)
 
 
 def refuse_jointspace(model: RobotModel) -> None:
-    """The joint space's direct-kinematics counts are exact over Q, for a pose without
-    angles: refuse the others in one line."""
-    why = ("square roots among its numbers (a count over Q(√p) is not implemented)"
-           if model.spec.radicals else
-           "angles in its pose (direct kinematics on the circle is not implemented)"
-           if any(v in model.angles for v in model.pose) else "")
-    if why:
+    """Refuse in one line, before any elimination, a joint space whose direct-kinematics
+    counts are out of reach: a system whose Bézout bound passes
+    :data:`~singcheck.spaces.solution_counts.MAX_DIRECT_BEZOUT` (the Gough–Stewart)."""
+    bound = direct_bezout_bound(model)
+    if bound > MAX_DIRECT_BEZOUT:
         raise UnsupportedRobotError(
-            f"the joint space of {model.name} is not decomposed: {why}; `singcheck "
+            f"the joint space of {model.name} is not decomposed: its direct kinematics in "
+            f"{len(direct_unknowns(model))} unknowns has Bézout bound {bound} (over "
+            f"{MAX_DIRECT_BEZOUT}), too large to count its solutions exactly; `singcheck "
             "workspace` and `singcheck run` are supported", path=model.spec.path)
 
 

@@ -19,13 +19,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from flint import acb, fmpq, fmpq_poly
+from flint import acb, arb_poly, fmpq, fmpq_mpoly, fmpq_poly
 
 from singcheck.algebra.intervals import fraction_ball, working_precision
 from singcheck.algebra.polynomials import constant_value
+from singcheck.budget import checkpoint
 from singcheck.certify.path import branches_at_pose, inside_limits
 from singcheck.model.robot import REVOLUTE, RobotModel, leg_coefficients
-from singcheck.roots.rational import to_fmpq
+from singcheck.roots.rational import rational_ball, to_fmpq
 from singcheck.spaces.cad import separated_roots
 
 _COORDINATE_CHANGES = ((), (1,), (1, -2), (3, 1, -1), (2, -3, 5, 1))
@@ -152,61 +153,155 @@ class DirectCount:
     reason: str = ""  # why it is None
 
 
+#: The largest Bézout bound (product of the degrees of the direct-kinematics system in
+#: its unknowns) whose count is attempted: the rotary Delta's is 36, the 3-RPR's 16; the
+#: Gough–Stewart's (40 assembly modes, 12 unknowns) is far beyond a lex Gröbner basis.
+MAX_DIRECT_BEZOUT = 256
+
+
+def direct_unknowns(model: RobotModel) -> tuple[str, ...]:
+    """The unknowns of the direct kinematics: the square roots' variables, then the pose
+    variables (cos, sin of an angle) — a pose variable last, the coordinate solved for."""
+    return (*model.spec.radical_variables, *model.pose_variables)
+
+
+def direct_system(model: RobotModel) -> tuple[fmpq_mpoly, ...]:
+    """F with each pose angle's circle cos² + sin² - 1 and each square root's
+    ``sqrt(p)² - p`` (in the robot's context; the joints still free)."""
+    from singcheck.elimination.projection import pose_circles
+
+    return (*model.constraints, *pose_circles(model),
+            *(leg.constraint for leg in model.radical_legs))
+
+
+def direct_bezout_bound(model: RobotModel) -> int:
+    """Bézout's bound on the number of isolated solutions of :func:`direct_system` in
+    its unknowns at any joint vector."""
+    names = model.context.names()
+    index = [names.index(v) for v in direct_unknowns(model)]
+    return math.prod(max((sum(e[i] for i in index) for e, _ in f.terms()), default=0)
+                     for f in direct_system(model))
+
+
 def direct_kinematics_count(model: RobotModel, joint_point) -> DirectCount:
-    """Real DK solutions (poses) at a rational joint vector, from a shape-position basis."""
+    """Real DK solutions (poses) at a rational joint vector, from a shape-position basis.
+
+    The unknowns are :func:`direct_unknowns`: a pose angle φ as (cos φ, sin φ) on its
+    circle (a real solution is a real point of the circle: one φ in (-π, π]), and each
+    square root √p of the parameters as a variable r with r² = p.  The system is over Q;
+    its solutions are those of the robot (r = +√p) and of its conjugates (r = -√p), and
+    only those with every r > 0 are counted: in the basis r = g_r(t) with g_r rational,
+    and the sign of g_r at each real root t of h is decided on the root's isolating
+    interval by ball arithmetic (|g_r(t)| = √p, so refining ends).
+    """
     import sympy
 
-    pose = sympy.symbols(model.pose)
+    unknowns = direct_unknowns(model)
+    names = model.context.names()
+    index = [names.index(v) for v in unknowns]
+    syms = sympy.symbols(f"v0:{len(unknowns)}")
     values = {j: to_fmpq(q) for j, q in zip(model.joint_variables, joint_point, strict=True)}
-    system = [_to_sympy(f.subs(values), pose, model) for f in model.constraints]
-    last = pose[-1]
+    system = [_to_sympy(f.subs(values) if values else f, syms, index)
+              for f in direct_system(model)]
+    radicals = len(model.spec.radical_variables)
+    last = syms[-1]
     for change in _COORDINATE_CHANGES:
-        shift = sum((c * v for c, v in zip(change, pose[:-1], strict=False)), sympy.Integer(0))
+        checkpoint()
+        shift = sum((c * v for c, v in zip(change, syms[:-1], strict=False)), sympy.Integer(0))
         changed = [sympy.expand(e.subs(last, last - shift)) for e in system]
-        basis = sympy.groebner(changed, *pose, order="lex", domain="QQ")
+        basis = sympy.groebner(changed, *syms, order="lex", domain="QQ")
         exprs = list(basis.exprs)
         if exprs == [1]:
             return DirectCount(0)
-        h = _shape_position(exprs, pose)
-        if h is not None:
-            return DirectCount(roots_within(h, None))
+        shape = _shape_position(exprs, syms, radicals)
+        if shape is not None:
+            return _count_on_positive_roots(*shape)
     return DirectCount(None, "no coordinate change put the Gröbner basis in shape position "
                              "(solutions at infinity, multiple or infinitely many)")
 
 
-def _to_sympy(poly, pose, model: RobotModel):
+def _count_on_positive_roots(h: fmpq_poly, radicals: list[fmpq_poly]) -> DirectCount:
+    """The real roots t of h at which every ``g`` of ``radicals`` is positive."""
+    count = 0
+    for root in separated_roots(h):
+        signs = [_sign_at_root(g, root) for g in radicals]
+        if None in signs:
+            return DirectCount(None, "the sign of a square root at a solution was not "
+                                     f"decided at {_MAX_ROOT_BITS} bits")
+        count += all(s > 0 for s in signs)
+    return DirectCount(count)
+
+
+_MAX_ROOT_BITS = 4096
+
+
+def _sign_at_root(g: fmpq_poly, root) -> int | None:
+    """The sign of ``g`` at the root isolated by ``root`` (g non-zero there), by ball
+    arithmetic on the isolating interval, refined until it decides; None past
+    :data:`_MAX_ROOT_BITS` bits of width."""
+    if root.lo == root.hi:
+        value = g(root.lo)
+        return (value > 0) - (value < 0)
+    while True:
+        checkpoint()
+        width = root.width()
+        bits = 64 + max(0, -math.floor(math.log2(float(width))) if float(width) > 0 else 2000)
+        if bits > _MAX_ROOT_BITS:
+            return None
+        with working_precision(bits):
+            value = arb_poly(g)(rational_ball(root.lo, root.hi))
+        if value > 0:
+            return 1
+        if value < 0:
+            return -1
+        root.bisect_to(width / 256)
+
+
+def _to_sympy(poly, syms, index):
+    """``poly`` (its other variables at degree 0) in the SymPy symbols ``syms``, the
+    variable of ``syms[k]`` at position ``index[k]`` of the context."""
     import sympy
 
-    names = poly.context().names()
-    index = [names.index(v) for v in model.pose]
     expr = sympy.Integer(0)
     for exps, c in poly.terms():
         term = sympy.Rational(int(c.p), int(c.q))
-        for var, i in zip(pose, index, strict=True):
+        for var, i in zip(syms, index, strict=True):
             term *= var ** exps[i]
         expr += term
     return expr
 
 
-def _shape_position(exprs, pose) -> fmpq_poly | None:
-    """h when ``exprs`` is ``{x_i - g_i(x_n)}`` plus a squarefree h(x_n), else None."""
+def _shape_position(exprs, pose, wanted: int = 0) -> tuple[fmpq_poly, list[fmpq_poly]] | None:
+    """(h, [g_1, …, g_wanted]) when ``exprs`` is ``{x_i - g_i(x_n)}`` plus a squarefree
+    h(x_n), else None."""
     import sympy
 
     if len(exprs) != len(pose):
         return None
     last = pose[-1]
     *linear, h = exprs
+    coordinates = []
     for var, g in zip(pose[:-1], linear, strict=True):
         p = sympy.Poly(g, *pose)
-        if p.degree(var) != 1 or p.coeff_monomial(var) == 0:
+        lead = p.coeff_monomial(var)
+        if p.degree(var) != 1 or lead == 0:
             return None
-        if (g - p.coeff_monomial(var) * var).free_symbols - {last}:
+        rest = g - lead * var
+        if rest.free_symbols - {last}:
             return None
+        if len(coordinates) < wanted:
+            coordinates.append(_univariate(-rest / lead, last))
     hp = sympy.Poly(h, *pose)
     if hp.free_symbols - {last} or hp.degree(last) < 1:
         return None
-    coeffs = [fmpq(int(c.p), int(c.q)) for c in sympy.Poly(h, last).all_coeffs()[::-1]]
-    h = fmpq_poly(coeffs)
+    h = _univariate(h, last)
     if h.gcd(h.derivative()).degree() > 0:
         return None
-    return h
+    return h, coordinates
+
+
+def _univariate(expr, var) -> fmpq_poly:
+    import sympy
+
+    coeffs = sympy.Poly(sympy.expand(expr), var).all_coeffs()[::-1]
+    return fmpq_poly([fmpq(int(c.p), int(c.q)) for c in coeffs])

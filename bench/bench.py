@@ -259,7 +259,8 @@ def space_rows() -> list[dict]:
                                 ("orthoglide", WORKSPACE, {"z": Fraction(1)}),
                                 ("orthoglide", JOINTSPACE, {}),
                                 ("orthoglide", JOINTSPACE, {"rho3": Fraction(2)}),
-                                ("skew-biglide", WORKSPACE, {})):
+                                ("skew-biglide", WORKSPACE, {}),
+                                ("linear-delta", JOINTSPACE, {"r3": Fraction(-1)})):
         model = build_model(load_robot(ROOT / "robots" / f"{robot}.yaml"))
         components = (workspace_variety(project_robot(model, backend)) if space == WORKSPACE
                       else jointspace_variety(model, backend))

@@ -941,6 +941,28 @@ def test_mu_size_bound_holds_for_a_composed_path(orthoglide_projection):
     assert mu.degrees()[0] <= deg_t and mu.degrees()[1] + mu.degrees()[2] <= deg_sc
 
 
+def test_the_crude_composition_bound_is_above_the_estimate_and_the_result(
+        orthoglide_projection):
+    """The crude bound that lets μ skip the exact estimate is above it (work and both
+    degrees) and above what composing gives, on paths mixing t, sin and cos; then
+    substituting a constant coordinate first gives the same μ."""
+    from singcheck.algebra.composition import composition_work, crude_work
+    from singcheck.certify.path import _compose_mu, _pose_args, compose_pose
+    from singcheck.spec.grammar import compile_trajectory_coordinate, parse
+
+    xi = orthoglide_projection.surface_on_circles
+    for texts in (("(sin(t) + cos(t) + t)^3", "t^2 - sin(2*t)", "1"),
+                  ("8/7*sin(t)^3", "13/14*cos(t) - 5/14*cos(2*t)", "1"),
+                  ("sin(3*t)/2", "t/5", "cos(t)")):
+        phi = tuple(compile_trajectory_coordinate(parse(text), "t", {}) for text in texts)
+        args = _pose_args(xi, phi, ("x", "y", "z"))[1]
+        crude, exact = crude_work(xi, args), composition_work(xi, args)
+        assert all(c >= e for c, e in zip(crude, exact, strict=True)), (texts, crude, exact)
+        mu = _compose_mu(xi, phi, ("x", "y", "z"), None)
+        assert mu.degrees()[0] <= crude[1] and mu.degrees()[1] + mu.degrees()[2] <= crude[2]
+        assert mu == compose_pose(xi, phi, ("x", "y", "z"))  # no shortcut: the same μ
+
+
 @pytest.mark.parametrize("robot, pose, rng", [
     # cos(50*t): degree 800 in tan(t/2), the most the root-isolation bound admits
     (ORTHO, {"x": "3*sin(t) + cos(50*t)", "y": "0", "z": "1"}, "0, 1"),

@@ -9,7 +9,16 @@ import mpmath
 import pytest
 from flint import arb, fmpq, fmpq_poly, fmpz_poly
 
-from singcheck.algebra.trig import C, LinearInPi, S, T, TimeRange, cos_multiple, sin_multiple
+from singcheck.algebra.trig import (
+    C,
+    LinearInPi,
+    S,
+    T,
+    TimeRange,
+    cos_multiple,
+    reduce_trig,
+    sin_multiple,
+)
 from singcheck.roots.enclosures import IdenticallyZeroError
 from singcheck.roots.isolation import isolate_real_roots
 
@@ -195,6 +204,37 @@ def testhalf_angle_polynomial_is_the_substitution():
             w = 1 + u * u
             direct = p.subs({"s": 2 * u / w, "c": (1 - u * u) / w}).subs({"t": 0})
             assert m(u) == w**d * direct.leading_coefficient()
+
+
+def test_deflated_half_angle_is_the_substitution_deflated():
+    """N(u^k) is M(u) = (1+u²)^d p(2u/(1+u²), (1-u²)/(1+u²)) up to a constant factor
+    (exact rationals at sample points), with and without sin t, and k is the largest
+    deflation: no other exponent of N's u^k is a common multiple."""
+    import random
+
+    from singcheck.roots.half_angle import deflated_half_angle
+
+    rng = random.Random(11)
+    for case in range(24):
+        p = _random_trig(rng, 6).subs({"t": 0})
+        if case % 2:  # free of s (even paths such as heart 1): the shortcut's case
+            p = reduce_trig(p.subs({"s": 0}) + C**3 - C)
+        if p.is_zero() or p.is_constant():
+            continue
+        n, k = deflated_half_angle(p)
+        d = max(j + kk for (_, j, kk), _ in p.terms())
+        ratio = None
+        for u in (fmpq(3, 7), fmpq(-5, 2), fmpq(1), fmpq(2), fmpq(-1, 3)):
+            w = 1 + u * u
+            direct = w**d * p.subs({"s": 2 * u / w, "c": (1 - u * u) / w}).leading_coefficient()
+            mine = n(u**k)
+            if direct == 0:
+                assert mine == 0
+                continue
+            ratio = ratio if ratio is not None else mine / direct
+            assert mine == ratio * direct and ratio != 0
+        exponents = [i for i, c in enumerate(n.coeffs()) if c != 0]
+        assert math.gcd(*exponents) == 1 or exponents == [0] or len(exponents) == 1
 
 
 @pytest.mark.parametrize("m, expected", [

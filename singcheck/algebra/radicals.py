@@ -422,7 +422,7 @@ def angle_function(p: fmpq_mpoly, q: Fraction) -> tuple[str, str]:
     return angle_names(text)
 
 
-def _angle_function_of(name: str) -> tuple[fmpq_mpoly, Fraction] | None:
+def angle_function_of(name: str) -> tuple[fmpq_mpoly, Fraction] | None:
     return _ANGLE_FUNCTIONS.get(name[4:-1]) if name.startswith(("cos(", "sin(")) else None
 
 
@@ -476,7 +476,7 @@ def _extra_balls(ctx: fmpq_mpoly_ctx, t: arb, signs) -> list:
         if q is not None:
             out.append(arb(q).sqrt() * signs.get(q, 1))
             continue
-        p, k = _angle_function_of(name)
+        p, k = angle_function_of(name)
         key = name[4:-1]
         if key not in cache:
             cache[key] = evaluate_trig(p, t) + arb.pi() * arb(fmpq(k.numerator, k.denominator))
@@ -514,8 +514,8 @@ def path_derivative(p: fmpq_mpoly) -> fmpq_mpoly:
     gens = dict(zip(ctx.names(), ctx.gens(), strict=True))
     out = p.derivative("t") + gens["c"] * p.derivative("s") - gens["s"] * p.derivative("c")
     for name in ctx.names()[3:]:
-        if name.startswith("cos(") and _angle_function_of(name) is not None:
-            g, _ = _angle_function_of(name)
+        if name.startswith("cos(") and angle_function_of(name) is not None:
+            g, _ = angle_function_of(name)
             sin_name = "sin(" + name[4:]
             dg = into_ring(derivative(g), ctx)
             out += dg * (gens[name] * p.derivative(sin_name) - gens[sin_name] * p.derivative(name))
@@ -523,7 +523,7 @@ def path_derivative(p: fmpq_mpoly) -> fmpq_mpoly:
 
 
 def has_angle_functions(ctx: fmpq_mpoly_ctx) -> bool:
-    return any(_angle_function_of(n) is not None for n in ctx.names()[3:])
+    return any(angle_function_of(n) is not None for n in ctx.names()[3:])
 
 
 def conjugates(p: fmpq_mpoly) -> list[dict[int, int]]:

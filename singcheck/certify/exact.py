@@ -57,7 +57,12 @@ from singcheck.roots.enclosures import AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t
 from singcheck.roots.rational import RationalRoot, minimal_polynomial, rational_ball
-from singcheck.roots.transcendental import NotExact, TranscendentalPoint, TrigElements
+from singcheck.roots.transcendental import (
+    NotExact,
+    TranscendentalPoint,
+    TrigElements,
+    ring_circle,
+)
 
 _MAX_BITS = 1 << 16
 
@@ -106,17 +111,24 @@ class ModeExpression:
     def __init__(self, path: PathModel) -> None:
         model = path.projection.model
         ring_in = path.coordinates[0].context() if path.coordinates else TRIG
+        #: a pose angle g(t) + qπ, g ∈ Q[t]: its (C, S) renamed (c, s) (transcendental)
+        self.circle = ring_circle(ring_in)
+        if self.circle is not None:
+            ring_in = TRIG
         path_names = ring_in.names()
         primes = [radical_prime(v) for v in path_names[3:]]
         if tuple(path_names[:3]) != ("t", "s", "c") or None in primes:
             raise NotExact("the path ring has variables other than t, sin t, cos t and "
-                           "square roots")
+                           "square roots (two pose angles, an angle with sin t or cos t, "
+                           "or one with square roots)")
         quadratic = [i for i, leg in enumerate(path.legs) if leg.leg.degree == 2]
         names = (*path_names, *(f"r{q}" for q in range(len(quadratic))))
         ring = fmpq_mpoly_ctx.get(names, "lex")
         pad = (0,) * len(quadratic)
 
         def lift(p: fmpq_mpoly) -> fmpq_mpoly:
+            if self.circle is not None:
+                p = self.circle.to_trig(p)
             if p.context() is not ring_in:
                 p = ring_in.from_dict({(*e, *(0,) * len(primes)): c for e, c in p.terms()}) \
                     if p.context() is TRIG else None
@@ -336,13 +348,16 @@ class PathFunctions(TrigElements):
     """The trig functions along the path (μ ≡ 0): elements are reduced trig polynomials,
     exact zero tests are polynomial ones, and balls are taken at a rational time."""
 
-    def __init__(self, t0: fmpq) -> None:
+    def __init__(self, t0: fmpq, circle=None) -> None:
         self.t0 = t0
+        self.circle = circle  # a pose angle's (C, S), renamed (c, s)
 
     def is_zero(self, a: fmpq_mpoly) -> bool:
         return a.is_zero()
 
     def ball(self, a: fmpq_mpoly, bits: int) -> arb:
+        if self.circle is not None:
+            return self.circle.evaluate(a, arb(self.t0))
         return evaluate_trig(a, arb(self.t0))
 
 
@@ -471,9 +486,13 @@ def det_a_vanishes_at(path: PathModel, point: AlgebraicPoint, label: str) -> boo
 def mode_zero_polynomial(path: PathModel, label: str, t0: fmpq) -> fmpq_mpoly | None:
     """Along the whole path (for a mode whose branches are real and analytic on the
     range, with every discriminant ≠ 0 at the rational sample ``t0``): None when det A ≡ 0
-    along the mode, else a non-zero trig polynomial whose roots hold its zeros."""
+    along the mode, else a non-zero trig polynomial whose roots hold its zeros (in the
+    path ring, with a pose angle's cos, sin, for an angle path)."""
     expr = mode_expression(path)
-    return _Tower(expr, PathFunctions(t0), expr.signs(label)).reduce()
+    zeros = _Tower(expr, PathFunctions(t0, expr.circle), expr.signs(label)).reduce()
+    if zeros is None or expr.circle is None:
+        return zeros
+    return expr.circle.from_trig(zeros)  # C, S back to the pose angle's cos, sin
 
 
 class _RadicalElement:

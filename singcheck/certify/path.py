@@ -33,9 +33,15 @@ from singcheck.algebra.composition import (
     crude_work,
 )
 from singcheck.algebra.intervals import evaluate, fraction_ball
-from singcheck.algebra.polynomials import coefficient_in, memo_per_object, restrict
+from singcheck.algebra.polynomials import (
+    coefficient_in,
+    constant_value,
+    memo_per_object,
+    restrict,
+)
 from singcheck.algebra.radicals import (
     angle_function,
+    angle_function_of,
     cos_pi,
     evaluate_path,
     into_ring,
@@ -99,6 +105,8 @@ def compose_pose(p: fmpq_mpoly, phi: tuple[fmpq_mpoly, ...], pose: tuple[str, ..
     composition is refused or cut into pieces a time limit can stop
     (:func:`~singcheck.algebra.composition.compose_in_pieces`)."""
     ring, args = _pose_args(p, phi, pose)
+    if p.is_constant():  # (a leg's leading coefficient): nothing to compose
+        return ring.from_dict({(0,) * ring.nvars(): constant_value(p)})
     return compose_in_pieces(p, args, ring, _reduce, work)
 
 
@@ -111,7 +119,7 @@ def _constants_first(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> fmpq_mpoly:
     constants = {}
     for name, a, d in zip(p.context().names(), args, p.degrees(), strict=True):
         if d > 0 and a.is_constant():
-            constants[name] = a.leading_coefficient() if not a.is_zero() else fmpq(0)
+            constants[name] = constant_value(a)
     return p.subs(constants) if constants else p
 
 
@@ -339,11 +347,13 @@ def _limit_balls(limits) -> tuple[arb, arb]:
     """The balls of a prismatic joint's rational limits (exact when dyadic), once per
     limits object and working precision: feasibility proofs compare against them
     thousands of times (keyed by the object, not by hashing its Fractions each time)."""
-    per_prec = memo_per_object(_LIMIT_BALLS, limits, lambda _: {})
-    hit = per_prec.get(ctx.prec)
-    if hit is None:
-        hit = per_prec[ctx.prec] = tuple(fraction_ball(v) for v in limits)
-    return hit
+    key = (id(limits), ctx.prec)
+    hit = _LIMIT_BALLS.get(key)
+    if hit is None or hit[0] is not limits:  # the entry holds limits: its id is not reused
+        if len(_LIMIT_BALLS) > 256:
+            _LIMIT_BALLS.clear()
+        hit = _LIMIT_BALLS[key] = (limits, tuple(fraction_ball(v) for v in limits))
+    return hit[1]
 
 
 def inside_limits(leg: Leg, value, limits) -> bool | None:
@@ -698,6 +708,11 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
                     f"the angle {v} is neither k*t plus a multiple of pi/12 nor free of square "
                     "roots: not supported", **where)
             functions.append(angle_function(x, offsets.get(v, 0)))
+    for x in phi:  # cos(g(t)), sin(g(t)) written in a coordinate (x: cos(t^2))
+        names = x.context().names()
+        functions += [(n, "sin(" + n[4:]) for n in names if n.startswith("cos(")
+                      and angle_function_of(n) is not None
+                      and (n, "sin(" + n[4:]) not in functions]
     ring = path_ring(primes, functions)
     phi = tuple(into_ring(x, ring) for x in phi)
     coordinates = []

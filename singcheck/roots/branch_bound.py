@@ -50,6 +50,7 @@ from singcheck.roots.enclosures import (
     point_time,
 )
 from singcheck.roots.rational import arb_to_fmpq, bits_for, exact_tolerance, rational_ball
+from singcheck.roots.transcendental import angle_circle
 
 _MAX_BOXES = 200_000
 _SPLIT = fmpq(1, 2) - fmpq(1, 97)  # off-centre, so a root rarely sits on a split point
@@ -222,9 +223,13 @@ class Bracket:
 
 
 def _mixed_time(p: fmpq_mpoly, lo: fmpq, hi: fmpq, s_lo: int) -> ExactTime | None:
-    """The exact description of a bracketed root of p (a trig polynomial in t, s, c;
-    None for a path polynomial with angle functions or square roots)."""
-    if p.context() is not TRIG or (lo <= 0 <= hi and p.subs({"t": 0, "s": 0, "c": 1}) == 0):
+    """The exact description of a bracketed root of p (a trig polynomial in t, s, c, or
+    a path polynomial in t and one pose angle's cos, sin, :func:`angle_circle`; None for
+    other angle functions or square roots)."""
+    if p.context() is not TRIG:
+        if angle_circle(p) is None:
+            return None
+    elif lo <= 0 <= hi and p.subs({"t": 0, "s": 0, "c": 1}) == 0:
         return None  # τ = 0 would be algebraic (the exact zeros at 0 are found apart)
     bracket = Bracket(p, lo, hi, s_lo)
     return ExactTime(IN_MIXED, lambda: bracket)

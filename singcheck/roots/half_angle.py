@@ -174,12 +174,14 @@ def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
         width = exact_tolerance(tol) / 4
         bits = bits_for(tol)
         rr.bisect_to(width)
-        while k > 1 and rr.lo != rr.hi and float(u_bounds(bits).rad()) > tol / 8:
+        u = u_bounds(bits)  # (the ball of the final interval is the one mapped)
+        while k > 1 and rr.lo != rr.hi and float(u.rad()) > tol / 8:
             checkpoint()
             width /= 16
             rr.bisect_to(width)
+            u = u_bounds(bits)
         with working_precision(bits):
-            hit = done[tol] = 2 * u_bounds(bits).atan()
+            hit = done[tol] = 2 * u.atan()
         return hit
 
     return ball

@@ -55,6 +55,7 @@ from singcheck.roots.transcendental import (
     ONE_MINUS_C2,
     NotExact,
     TranscendentalPoint,
+    angle_circle,
     split_s,
 )
 
@@ -169,7 +170,8 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
     (:meth:`~singcheck.roots.transcendental.TranscendentalPoint.is_zero`; at t = kπ by
     :func:`~singcheck.roots.branch_bound.vanishes_at_multiple_of_pi`): p's zeros are
     exactly those where it does, every other stretch is root-free."""
-    p0, p1 = split_s(p)
+    circle = angle_circle(p)  # a pose angle's (C, S), renamed (c, s) for the algebra
+    p0, p1 = split_s(p if circle is None else circle.to_trig(p))
     if p0.is_zero() or p1.is_zero():
         return None
     norm = p0 * p0 - p1 * p1 * ONE_MINUS_C2
@@ -181,7 +183,8 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
         if k.is_constant():
             continue
         checkpoint()
-        iso = branch_and_bound(k, interval, tolerance)
+        iso = branch_and_bound(k if circle is None else circle.from_trig(k), interval,
+                               tolerance)
         undecided += [Undecided(b.t, "possible tangency: the zeros of μ there are zeros of "
                                 "a factor of its norm over sin t, which could not be "
                                 f"isolated in t ∈ [{float(b.t.lower()):.9g}, "
@@ -211,10 +214,10 @@ def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
             return TranscendentalPoint(time).is_zero(p)
         except NotExact:
             return None
-    if time.kind == AT_POINT and time.t_value == 0:
-        return vanishes_at_multiple_of_pi(p, 0)
-    if time.kind == AT_POINT and time.pi_multiple is not None:
-        return vanishes_at_multiple_of_pi(p, time.pi_multiple)
+    if time.kind == AT_POINT and (time.t_value == 0 or time.pi_multiple is not None):
+        zero = vanishes_at_multiple_of_pi(p, 0 if time.t_value == 0 else time.pi_multiple)
+        # with a pose angle's C, S left in p, only "zero whatever C, S are" is a proof
+        return zero if zero or p.context() is TRIG else None
     return None
 
 
@@ -233,6 +236,10 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
         p = reduce_relations(poly)
         if p.is_zero():
             raise IdenticallyZeroError("the function is identically zero along the path")
+        if not any(p.degrees()[3:]):
+            return isolate_real_roots(restrict(p, TRIG), interval, tolerance)
+        if angle_circle(p) is not None:  # t and one pose angle g(t) + qπ, g ∈ Q[t]
+            return _mixed(p, interval, tolerance)
         return branch_and_bound(p, interval, tolerance)  # angle functions: t mixed with them
     p = reduce_trig(poly)
     if p.is_zero():

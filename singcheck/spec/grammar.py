@@ -29,6 +29,7 @@ from flint import fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.radicals import (
     Surd,
+    angle_function,
     cos_pi,
     expand_trig,
     reduce_relations,
@@ -672,6 +673,41 @@ def _multiple_of(node: Node, parameter: str, parameters,
                     f"2*pi*{parameter}), plus a multiple of pi/12", node.column)
 
 
+def polynomial_angle(node: Node, parameter: str, parameters,
+                     pi_scale: Fraction | None = None) -> tuple[str, str] | None:
+    """The path-ring variables ``(cos(g), sin(g))`` of a sin/cos argument g(t) + qπ that
+    is not k·t + qπ, with g a non-constant polynomial in t (``cos(t^2)``): they are the
+    pose angle functions of :func:`~singcheck.algebra.radicals.angle_function`.  None for
+    any other argument (sin/cos inside it, a constant, a piece rescaled by π)."""
+    if pi_scale is not None:
+        return None
+    try:
+        p, q = compile_angle_coordinate(node, parameter, parameters, TRIG)
+    except ExprError:
+        return None
+    degrees = p.degrees()
+    if degrees[1] > 0 or degrees[2] > 0 or degrees[0] < 1:
+        return None
+    return angle_function(p, q)
+
+
+def polynomial_angles(node: Node, parameter: str, parameters,
+                      pi_scale: Fraction | None = None) -> list[tuple[str, str]]:
+    """Every :func:`polynomial_angle` of the sin/cos calls in the tree, in order."""
+    out = []
+    if node.kind == "call" and node.value in FUNCTIONS and node.args:
+        try:
+            _multiple_of(node.args[0], parameter, parameters, pi_scale)
+        except ExprError:
+            names = polynomial_angle(node.args[0], parameter, parameters, pi_scale)
+            if names is not None and names not in out:
+                out.append(names)
+    for a in node.args:
+        out += [n for n in polynomial_angles(a, parameter, parameters, pi_scale)
+                if n not in out]
+    return out
+
+
 def compile_trajectory_coordinate(node: Node, parameter: str, parameters,
                                   ring: fmpq_mpoly_ctx = TRIG,
                                   pi_scale: Fraction | None = None) -> fmpq_mpoly:
@@ -687,7 +723,13 @@ def compile_trajectory_coordinate(node: Node, parameter: str, parameters,
         return compiler.lift(_simplify(value))
 
     def call(n: Node):
-        k, q = _multiple_of(n.args[0], parameter, parameters, pi_scale)
+        try:
+            k, q = _multiple_of(n.args[0], parameter, parameters, pi_scale)
+        except ExprError:
+            names = polynomial_angle(n.args[0], parameter, parameters, pi_scale)
+            if names is None or names[0] not in ring.names():
+                raise
+            return ring.gens()[ring.names().index(names[0 if n.value == "cos" else 1])]
         if abs(k) > MAX_DEGREE:
             raise ExprError(f"the multiple {k} of {parameter} is larger than {MAX_DEGREE}",
                             n.column)

@@ -26,6 +26,8 @@ from singcheck.spec.grammar import (
     compile_trajectory_coordinate,
     compile_value,
     pi_multiples,
+    polynomial_angle,
+    polynomial_angles,
 )
 from singcheck.spec.plainyaml import kind
 
@@ -186,7 +188,18 @@ def trajectory_piece(doc, rng: TimeRange, rnode, nodes: dict, key: str, paramete
     scale = _scale_of([k for tree in trees.values()
                        for k in pi_multiples(tree, parameter, robot.parameters)])
     primes = sorted(radical_primes(robot.parameters, list(trees.values())))
-    ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
+    # cos(g(t)), sin(g(t)) in a coordinate (x: cos(t^2)) where g(t) is a pose angle's
+    # polynomial path (phi: t^2): that angle's functions (certified as such paths are)
+    angles = {polynomial_angle(trees[v], parameter, robot.parameters, scale)
+              for v in trees if v in robot.angles}
+    functions = []
+    for v, tree in trees.items():
+        if v not in robot.angles:
+            functions += [n for n in polynomial_angles(tree, parameter, robot.parameters,
+                                                       scale)
+                          if n in angles and n not in functions]
+    ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes),
+                               *(n for pair in functions for n in pair)), "lex")
     coords, offsets = {}, {}
     for v, node in nodes.items():
         if v in robot.angles:  # (each expression is parsed once: its tree is reused)
@@ -201,7 +214,11 @@ def trajectory_piece(doc, rng: TimeRange, rnode, nodes: dict, key: str, paramete
             if any(p.degrees()[i] > 0 for p in coords.values())]
     names = ("t", "s", "c", *(ring.names()[i] for i in used))
     small = TRIG if not used else fmpq_mpoly_ctx.get(names, "lex")
-    coords = {v: restrict(p, small) for v, p in coords.items()}
+    index = {n: i for i, n in enumerate(ring.names())}
+    extra = [n for pair in functions if any(p.degrees()[index[n]] > 0 for n in pair
+                                            for p in coords.values()) for n in pair]
+    wide = fmpq_mpoly_ctx.get((*names, *extra), "lex") if extra else small
+    coords = {v: restrict(p, small if v in robot.angles else wide) for v, p in coords.items()}
     if scale is not None:
         if rng.start.pi_coefficient or rng.end.pi_coefficient:
             raise doc.error(rnode, "range", f"with sin/cos of k*pi*{parameter} the range "

@@ -1,0 +1,150 @@
+"""Touches on paths whose pose angle is a polynomial g(t), not k·t + qπ (issue 13).
+
+The bundled 3-RPR turns with phi = t² while its position follows the curve
+X*(φ) = ((3 sin φ + cos φ)/4, -sin φ), where leg lines 2 and 3 pass through the base
+point A1 = (0, 0) (so all three leg lines meet there: singular for every φ), plus
+w(t)²·(1, 2) with w = t - cos(t²).  det A then touches 0 where t = cos(t²) (a
+transcendental time), without changing sign.  The expected answers are computed here
+with 50-digit mpmath (the oracle's det A, independent of singcheck).
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import mpmath as mp
+import pytest
+
+from singcheck import api
+from singcheck.algebra.radicals import angle_function, path_ring
+from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
+from singcheck.errors import SpecError
+from singcheck.report.trajectory import workspace_json, workspace_line
+from singcheck.roots.isolation import isolate_real_roots
+from singcheck.roots.transcendental import TranscendentalPoint, angle_circle
+from singcheck.spaces.path_regions import path_in_workspace
+from tests import robot_oracles as oracles
+from tests.conftest import ROBOTS
+
+TOUCH = """\
+name: rpr-touch
+parameter: t
+range: [7/10, 9/10]
+pose:
+  x: (3*sin(t^2) + cos(t^2))/4 + (t - cos(t^2))^2{dx}
+  y: -sin(t^2) + 2*(t - cos(t^2))^2{dy}
+  phi: t^2
+"""
+
+
+def _pose(t, dx=0, dy=0):
+    c, s = mp.cos(t * t), mp.sin(t * t)
+    w2 = (t - c) ** 2
+    return [(3 * s + c) / 4 + w2 + dx, -s + 2 * w2 + dy, t * t]
+
+
+def _det(t, dx=0, dy=0):
+    oracle = oracles.three_rpr()
+    X = _pose(t, dx, dy)
+    return oracle.det_A(None, X)  # det A of the 3-RPR does not involve the joints
+
+
+_ROBOT: list = []
+
+
+def _run(tmp_path, text):
+    if not _ROBOT:
+        _ROBOT.append(api.load_robot(ROBOTS / "3-rpr.yaml", backend="flint", cache=False))
+    path = tmp_path / "t.yaml"
+    path.write_text(text)
+    return api.check(_ROBOT[0], api.load_trajectory(path, _ROBOT[0]), regions=False)
+
+
+def test_a_touch_at_a_transcendental_time_on_a_phi_t_squared_path_is_singular(tmp_path):
+    mp.mp.dps = 50
+    tau = mp.findroot(lambda t: t - mp.cos(t * t), mp.mpf("0.8"))
+    assert abs(_det(tau)) < mp.mpf(10) ** -40  # on the surface at τ
+    before, after = _det(tau - mp.mpf("0.001")), _det(tau + mp.mpf("0.001"))
+    assert before * after > 0  # no sign change: a touch, which no sign change proves
+    samples = [_det(mp.mpf(7) / 10 + k * mp.mpf(2) / 1000) for k in range(101)]
+    assert all(v * before > 0 for v in samples if abs(v) > mp.mpf(10) ** -6)
+    # the mode is feasible there (every leg length within [1/2, 5])
+    X = _pose(tau)
+    assert all(any(leg.lo < b < leg.hi for b in leg.branches(X))
+               for leg in oracles.three_rpr().legs)
+
+    result = _run(tmp_path, TOUCH.format(dx="", dy=""))
+    assert result.verdict == "singular"
+    assert len(result.candidates) == 1
+    t = result.candidates[0].t
+    assert abs(float(t.mid()) - float(tau)) < 1e-8
+    line = workspace_line(workspace_json(path_in_workspace(result.path, name_region=False)))
+    assert "touching it 1" in line
+
+
+def test_a_phi_t_squared_path_that_comes_close_is_proven_free(tmp_path):
+    mp.mp.dps = 50
+    dx, dy = mp.mpf(1) / 1000, mp.mpf(2) / 1000
+    values = [_det(mp.mpf(7) / 10 + k * mp.mpf(2) / 4000, dx, dy) for k in range(401)]
+    assert all(v > 0 for v in values) or all(v < 0 for v in values)
+    # it does come close: a dip to under a tenth of det A's size at the range ends
+    assert min(abs(v) for v in values) < min(abs(values[0]), abs(values[-1])) / 10
+    result = _run(tmp_path, TOUCH.format(dx=" + 1/1000", dy=" + 2/1000"))
+    assert result.verdict == "singularity-free"
+
+
+def test_a_square_on_the_pose_angle_circle_is_decided_exactly():
+    """(sin(t²) - t/2)², written reduced (1 - cos² - t·sin + t²/4: not a square as a
+    polynomial), touches 0 where sin(t²) = t/2; its conjugate sin(t²) + t/2 does not."""
+    mp.mp.dps = 50
+    tau = mp.findroot(lambda t: mp.sin(t * t) - t / 2, mp.mpf("0.5"))
+    g = TRIG.gens()[0] ** 2
+    names = angle_function(g, Fraction(0))
+    ring = path_ring([], [names])
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    t, C, S = gens["t"], gens[names[0]], gens[names[1]]
+    p = 1 - C * C - t * S + t * t / 4  # = (S - t/2)² on the circle
+    interval = TimeRange(LinearInPi(Fraction(2, 5)), LinearInPi(Fraction(1)))
+    iso = isolate_real_roots(p, interval)
+    assert not iso.undecided
+    assert len(iso.roots) == 1
+    root = iso.roots[0]
+    assert abs(float(root.t.mid()) - float(tau)) < 1e-8
+    point = TranscendentalPoint(root.exact)
+    assert point.is_zero(S - t / 2)
+    assert point.is_zero(p)
+    assert not point.is_zero(S + t / 2)
+    assert not point.is_zero(t - C)  # cos(τ²) ≠ τ there (the other test's touch)
+
+
+@pytest.mark.parametrize("angle", ["t^2 + 1", "t"])
+def test_cos_of_the_angle_in_a_coordinate_needs_that_angle(tmp_path, angle):
+    """cos(t^2) in a coordinate is the pose angle's cos only when phi is t^2."""
+    text = TOUCH.format(dx="", dy="").replace("phi: t^2", f"phi: {angle}")
+    path = tmp_path / "t.yaml"
+    path.write_text(text)
+    if not _ROBOT:
+        _ROBOT.append(api.load_robot(ROBOTS / "3-rpr.yaml", backend="flint", cache=False))
+    with pytest.raises(SpecError, match="argument of sin/cos"):
+        api.load_trajectory(path, _ROBOT[0])
+
+
+def test_two_independent_angles_stay_undecided_with_the_reason():
+    """(sin(t²) - sin(t)/2)²: a touch at a point (τ, cos τ, cos τ²) whose transcendence
+    degree is not known (Schanuel's conjecture), so no exact test applies: the window
+    stays undecided, with the reason, and nothing is claimed there."""
+    mp.mp.dps = 50
+    tau = mp.findroot(lambda t: mp.sin(t * t) - mp.sin(t) / 2, mp.mpf("0.47"))
+    g = TRIG.gens()[0] ** 2
+    names = angle_function(g, Fraction(0))
+    ring = path_ring([], [names])
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    s, c, S = gens["s"], gens["c"], gens[names[1]]
+    p = (S - s / 2) ** 2
+    interval = TimeRange(LinearInPi(Fraction(484, 1000)), LinearInPi(Fraction(486, 1000)))
+    iso = isolate_real_roots(p, interval, tolerance=1e-5)  # coarse: fewer boxes
+    assert not iso.roots
+    assert any(w.t.lower() - 1e-9 <= float(tau) <= w.t.upper() + 1e-9 for w in iso.undecided)
+    assert all("tangency" in w.reason for w in iso.undecided)
+    assert angle_circle(p) is None
+    assert angle_circle(S * S + c) is None  # any use of sin t, cos t with the angle

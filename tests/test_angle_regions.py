@@ -314,3 +314,32 @@ def test_a_decomposition_too_costly_to_project_is_refused_up_front():
                        "-q")
     assert result.returncode == 2
     assert "too costly" in result.stderr and len(result.stderr.strip().splitlines()) == 1
+    # the line names the file and what to ask for instead
+    assert "rotary-delta.yaml" in result.stderr and "--slice z=VALUE" in result.stderr
+
+
+def test_3rpr_plane_regions_are_proven_and_match_the_checked_segments(monkeypatch):
+    # the plane y = 1 in (x, tan(phi/2)): critical values of degree 10 and 12, once
+    # joined by checked segments only (regions not proven to be components)
+    from singcheck.spaces import plane_adjacency
+    from singcheck.spaces.analysis import decomposition, space_chart
+    from singcheck.spaces.cad import fiber
+    from singcheck.spaces.regions import connect_regions
+
+    projection = _projection("3-rpr")
+    axes = space_chart(projection.model, WORKSPACE).axes
+    _, _, cad = decomposition(axes, workspace_variety(projection), {"y": Fraction(1)})
+    base = fiber(cad.levels, cad.variables, ())
+    assert max(plane_adjacency.minimal_polynomial(r).degree() for r in base) >= 10
+    exact = connect_regions(cad)
+    assert exact.components_proven and len(exact.regions) == 36
+
+    def partition(regions):
+        return sorted(sorted(c.index for c in r.cells) for r in regions.regions)
+
+    # the joins by checked segments alone (an independent proof of each join) give the
+    # same partition: no two of the exact regions are joined by a free segment
+    monkeypatch.setattr(plane_adjacency, "exact_joins", lambda *args: None)
+    segments = connect_regions(cad)
+    assert not segments.components_proven
+    assert partition(segments) == partition(exact)

@@ -175,9 +175,10 @@ def test_rotary_delta_joint_space_counts_match_three_spheres():
 
 @pytest.mark.slow
 def test_3rpr_joint_space_counts_match_a_scan_of_the_orientation():
-    fixed = {"r2": Fraction(3), "r3": Fraction(3)}
+    fixed = {"r2": Fraction(9, 2), "r3": Fraction(7, 2)}
     model, analysis = _jointspace("3-rpr", _backend("singular"), fixed)
     _check(model, analysis, fixed, _rpr_count)
+    assert {c.count for c in analysis.cells if c.within_limits} == {0, 2, 4}
 
 
 def test_direct_kinematics_counts_only_the_robots_own_square_root():
@@ -192,7 +193,7 @@ def test_direct_kinematics_counts_only_the_robots_own_square_root():
 
 def test_direct_kinematics_counts_poses_with_an_angle():
     model = build_model(load_robot(ROBOTS / "3-rpr.yaml"))
-    for r in ((3, 3, 3), (2, 3, 3), (4, 4, 3)):
+    for r in ((3, 3, 3), (5, 3, 2), (Fraction(1, 2), Fraction(9, 2), Fraction(7, 2))):
         assert direct_kinematics_count(model, r).count == _rpr_count(r, 512), r
 
 

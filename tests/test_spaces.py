@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from fractions import Fraction
 
 import mpmath
@@ -76,6 +77,41 @@ def test_regions_are_the_connected_components(curve, regions, proven):
     result = connect_regions(open_cad([curve]))
     assert len(result.regions) == regions
     assert result.components_proven is proven
+
+
+# g = (x - 1)(x - 2)…(x - 10) + 1/10 is irreducible with ten simple real roots r₁ < … <
+# r₁₀ near 1, …, 10 (|∏(x - i)| is at least 1 at every local extremum, so adding 1/10
+# moves no root past one): every critical value below is a root of g, of degree 10
+G10 = math.prod((X - i for i in range(1, 11)), start=XY.from_dict({(0, 0): 1})) + fmpq(1, 10)
+
+
+@pytest.mark.parametrize(("curve", "regions"), [
+    # y² = g: g > 0 on (r₂, r₃), (r₄, r₅), (r₆, r₇), (r₈, r₉): 4 ovals; left of r₁ and
+    # right of r₁₀ two branches, each bounding one region; and the outside: 7
+    (Y**2 - G10, 7),
+    # y² = -g: 5 ovals (on (r₁, r₂), …, (r₉, r₁₀)) and the outside: 6
+    (Y**2 + G10, 6),
+    # the same ovals and branches of y² = g cut by the axis y = 0 (meeting it at each
+    # double root): each of the 7 split in an upper and a lower half: 14
+    ((Y**2 - G10) * Y, 14),
+    # the graph y = g crossing the axis at r₁, …, r₁₀: above both, below both, the 9
+    # lenses between them and the two ends: 13
+    ((Y - G10) * Y, 13),
+    # y = g, y = -g and y = 0 all through each (r_i, 0): in each half-plane the region
+    # above |g| and one between the axis and |g| per interval (11): 24
+    ((Y - G10) * (Y + G10) * Y, 24),
+])
+def test_regions_are_the_components_at_critical_values_of_degree_10(curve, regions):
+    from singcheck.spaces.cad import fiber
+    from singcheck.spaces.plane_adjacency import minimal_polynomial
+
+    cad = open_cad([curve])
+    base = fiber(cad.levels, cad.variables, ())
+    assert {minimal_polynomial(r).degree() for r in base} == {10}
+    result = connect_regions(cad)
+    assert len(result.regions) == regions
+    assert result.components_proven  # same signs everywhere inside the ovals: only the
+    # exact adjacency proves them apart
 
 
 XYZ = fmpq_mpoly_ctx.get(("x", "y", "z"), "lex")

@@ -120,7 +120,8 @@ def joint_space_request(model: RobotModel) -> EliminationRequest:
     return pose_elimination_request(model, "joint_space_singularities", model.det_A)
 
 
-def pose_elimination_request(model: RobotModel, kind: str, extra: fmpq_mpoly) -> EliminationRequest:
+def pose_elimination_request(model: RobotModel, kind: str,
+                             extra: fmpq_mpoly) -> EliminationRequest:
     """Eliminate the pose from ``{F, extra}``: a pose angle brings its circle
     cos² + sin² = 1 (its cos and sin are eliminated), a square root its pseudo-leg."""
     return EliminationRequest(

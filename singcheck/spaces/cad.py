@@ -130,13 +130,15 @@ def simplest_between(lo: Fraction | None, hi: Fraction | None) -> Fraction:
         return Fraction(0)
     if hi <= 0:
         return -simplest_between(-hi, -lo)
-    n = math.floor(lo) + 1
-    if n < hi:
-        return Fraction(n)
-    # lo and hi share their integer part: recurse on the fractional parts' reciprocals
-    whole = math.floor(lo)
-    inner = simplest_between(1 / (hi - whole), 1 / (lo - whole) if lo > whole else None)
-    return whole + 1 / inner
+    wholes = []  # while lo and hi share their integer part, go on with the reciprocals
+    while not (hi is None or math.floor(lo) + 1 < hi):  # of their fractional parts (a
+        whole = math.floor(lo)  # loop: balls of 2048 bits give thousands of steps)
+        wholes.append(whole)
+        lo, hi = 1 / (hi - whole), (1 / (lo - whole) if lo > whole else None)
+    value = Fraction(math.floor(lo) + 1)
+    for whole in reversed(wholes):
+        value = whole + 1 / value
+    return value
 
 
 def separated_roots(p: fmpq_poly) -> list[RationalRoot]:

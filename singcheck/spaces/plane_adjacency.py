@@ -5,13 +5,17 @@ prove that two cells are *not*.  Here the line x = α itself is studied, exactly
 joining cells across every critical value gives exactly the connected components.
 
 * **The fibre.**  α is a real root of an irreducible m ∈ Q[x] (its isolating interval
-  picks the factor).  The product P of the variety's factors is taken in Q(α)[y]
-  (coefficients reduced mod m; an element is 0 exactly when its remainder is).  If P(α, y)
-  is 0 the line x = α lies in the variety: nothing is adjacent across it.  Otherwise the
-  squarefree part h = P / gcd(P, ∂P/∂y) (Euclid in Q(α)[y]) has the distinct roots of
-  P(α, ·) as simple roots; Arb isolates them from ball coefficients (α enclosed as
-  tightly as needed), and a root ball whose conjugate meets no other root ball holds a
-  real root (h has real coefficients).
+  picks the factor).  Each factor f_i of the variety is taken in Q(α)[y] (coefficients
+  reduced mod m; an element is 0 exactly when its remainder is).  If some f_i(α, y) is 0
+  the line x = α lies in the variety: nothing is adjacent across it.  Otherwise the
+  squarefree part h_i of each f_i(α, ·) is found: f_i itself when a modular image
+  proves gcd(f_i, ∂f_i/∂y) = 1 over Q(α), else by Euclid in Q(α)[y]; likewise the number
+  c_ij of distinct roots two factors share (0 by a modular image, else the degree of
+  gcd(h_i, h_j)).  Arb isolates the roots of each h_i from ball coefficients (α enclosed
+  as tightly as needed); a root ball whose conjugate meets no other root ball holds a
+  real root (h_i has real coefficients).  Roots of h_i and h_j are one point exactly
+  when their balls meet and c_ij pairs of balls meet, one to one: each common root
+  makes such a pair, so there is no other.
 * **Bands.**  Rationals s₀ < y₁ < s₁ < … < y_k < s_k separate the fibre's real points; a
   bracket a < α < b is narrowed until every line y = s_j is free on [a, b] (exact).
   Then no section crosses a line on [a, b]: the sections over (a, α) in a bounded band
@@ -28,8 +32,9 @@ joining cells across every critical value gives exactly the connected components
 from __future__ import annotations
 
 from fractions import Fraction
+from itertools import combinations
 
-from flint import acb, acb_poly, arb, arb_poly, fmpq, fmpq_poly
+from flint import acb, acb_poly, arb, arb_poly, fmpq, fmpq_poly, fmpz, nmod_poly
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.budget import checkpoint
@@ -39,12 +44,14 @@ from singcheck.spaces.segments import segment_is_free
 
 WALL = "wall"  # the line x = α lies in the variety
 
-#: Critical values α of higher degree are not studied exactly: Euclid in Q(α)[y] grows
-#: too fast (a 3-RPR plane in the chart tan(φ/2) has α of degree 10 and did not finish
-#: in minutes; the Orthoglide's planes and the 5-bar's workspace reach 8 and 6).  Their
-#: cells are joined by free segments instead, and the regions are then not proven to be
-#: the components.
-MAX_EXACT_DEGREE = 8
+#: Euclid in Q(α)[y] is run only where a factor has a multiple root over α or two
+#: factors meet there (elsewhere a modular proof suffices), and only while deg α times
+#: the square of the degree in y stays within this bound: its coefficients grow fast (a
+#: 3-PRR plane's factor of degree 40 in y over quadratic α's, 3200, took 3 to 6 s per α).
+#: Past it, cells are joined by free segments, and the regions are then not proven to be
+#: the components.  The degree of α is not bounded as such: the planes of y² = g(x) with
+#: g of degree 10, 32, 64 and 128 are exact in 0.06, 0.2, 2.6 and 46 s of CPU.
+MAX_EUCLID_COST = 1024
 
 
 class NotDecided(ArithmeticError):
@@ -114,77 +121,210 @@ class _Field:
 # the fibre over α
 
 
-def _product_in_y(factors, field: _Field) -> list:
-    """The product of the factors (in x, y) as an element of Q(α)[y]."""
-    out = [fmpq_poly([1])]
-    for f in factors:
-        coeffs: dict[int, dict[int, fmpq]] = {}
-        for (i, j), c in f.terms():
-            coeffs.setdefault(j, {})[i] = c
-        g = [field.reduce(fmpq_poly([coeffs.get(j, {}).get(i, 0)
-                                     for i in range(max(coeffs.get(j, {0: 0})) + 1)]))
-             for j in range(max(coeffs) + 1)]
-        prod = [fmpq_poly([])] * (len(out) + len(g) - 1)
-        for i, a in enumerate(out):
-            for j, b in enumerate(g):
-                prod[i + j] = prod[i + j] + a * b
-        out = field.trim([field.reduce(c) for c in prod])
+def _in_y(f, field: _Field) -> list:
+    """A factor (in x, y) as an element of Q(α)[y]."""
+    coeffs: dict[int, dict[int, fmpq]] = {}
+    for (i, j), c in f.terms():
+        coeffs.setdefault(j, {})[i] = c
+    return field.trim([field.reduce(fmpq_poly([coeffs.get(j, {}).get(i, 0)
+                                               for i in range(max(coeffs.get(j, {0: 0})) + 1)]))
+                       for j in range(max(coeffs) + 1)])
+
+
+def _images(m: fmpq_poly, wanted: int = 2) -> list[tuple[int, int]]:
+    """Up to ``wanted`` pairs (p, r): a prime p ∤ lc(m)·denominators with a root r of m
+    mod p.  x ↦ r is then a ring homomorphism from the p-integral part of Q[x]/(m) ≅ Q(α)
+    onto F_p (it kills m)."""
+    out = []
+    num, den = m.numer(), m.denom()
+    for p in _primes():
+        if num.leading_coefficient() % p == 0 or den % p == 0:
+            continue
+        roots = nmod_poly([int(c) % p for c in num.coeffs()], p).roots()
+        if roots:
+            out.append((p, int(roots[0][0])))
+            if len(out) == wanted:
+                break
     return out
 
 
-def squarefree_fibre(factors, m: fmpq_poly) -> list | str:
-    """The squarefree part of ∏ factors in Q[x]/(m)[y] (or :data:`WALL` when it is 0).
+_PRIMES: list[int] = []
 
-    The same for every root of m: Q[x]/(m) is isomorphic to Q(α) for each of them."""
+
+def _primes(count: int = 24) -> list[int]:
+    """The first ``count`` primes above 2^62, each proven prime (FLINT's is_prime: a
+    composite modulus would make F_p no field and its gcds no proof)."""
+    n = _PRIMES[-1] if _PRIMES else 2 ** 62
+    while len(_PRIMES) < count:
+        n += 1
+        if fmpz(n).is_prime():
+            _PRIMES.append(n)
+    return _PRIMES[:count]
+
+
+def _image(f, degree: int, p: int, r: int):
+    """f(r, y) mod p as an nmod_poly, or None when a denominator of f vanishes mod p or
+    the image loses the degree ``degree`` that f keeps over α."""
+    coeffs = [0] * (degree + 1)
+    for (i, j), c in f.terms():
+        if j > degree:
+            continue  # (that coefficient vanishes at α, hence at r)
+        if c.q % p == 0:
+            return None
+        coeffs[j] = (coeffs[j] + int(c.p) * pow(int(c.q), -1, p) * pow(r, i, p)) % p
+    if coeffs[degree] == 0:
+        return None
+    return nmod_poly(coeffs, p)
+
+
+def _no_common_root_mod_p(images, f, df, g=None, dg=None) -> bool:
+    """Proof that (f, g) over α have no common root (g defaults to ∂f/∂y): some image
+    (p, r) keeps both degrees and gives coprime images.  The principal subresultant
+    coefficients are polynomials in the coefficients, so psc_0 maps to psc_0 of the
+    images: non-zero there, it is non-zero over Q(α) (the gcd over Q(α) has degree 0)."""
+    for p, r in images:
+        a = _image(f, df, p, r)
+        b = _image(g, dg, p, r) if g is not None else None
+        if a is None or (g is not None and b is None):
+            continue
+        b = a.derivative() if g is None else b
+        if b.degree() == (df if g is not None else df - 1) and a.gcd(b).degree() == 0:
+            return True
+    return False
+
+
+def _refuse_costly_euclid(m: fmpq_poly, degree: int) -> None:
+    if m.degree() * degree ** 2 > MAX_EUCLID_COST:
+        raise NotDecided(f"Euclid over a critical value of degree {m.degree()} on a "
+                         f"fibre of degree {degree}: too costly")
+
+
+def squarefree_fibre(factors, m: fmpq_poly):
+    """The fibre of ∏ factors over the roots of m, exactly in Q[x]/(m)[y] (isomorphic to
+    Q(α)[y] for each root α of the irreducible m): :data:`WALL` when some factor vanishes
+    on the whole line, else ``(parts, common)``: the squarefree part h_i = f_i / gcd(f_i,
+    ∂f_i/∂y) of each factor that keeps y, and for each pair of parts the degree of
+    gcd(h_i, h_j), the number of their distinct common roots.
+
+    Each factor is handled on its own, and Euclid in Q(α)[y] is run only where a quick
+    modular proof fails (a factor with a multiple root over α, two that meet there):
+    Euclid on the product of all factors (degree 16 in y on a 3-RPR plane, α of degree
+    10) spent seconds per step in coefficient growth."""
     field = _Field(m)
-    p = _product_in_y(factors, field)
-    if not p:
-        return WALL
-    if len(p) == 1:
-        return p
-    dp = field.trim([field.reduce(c * i) for i, c in enumerate(p)][1:])
-    g = field.gcd(p, dp)
-    return field.divmod(p, g)[0] if len(g) > 1 else p
+    images = _images(m)
+    parts, owners, degrees = [], [], []
+    for f in factors:
+        checkpoint()
+        g = _in_y(f, field)
+        if not g:
+            return WALL
+        if len(g) == 1:
+            continue  # a non-zero constant on the line: no point of this factor
+        if _no_common_root_mod_p(images, f, len(g) - 1):
+            parts.append(g)  # squarefree over α
+        else:
+            _refuse_costly_euclid(m, len(g) - 1)
+            dg = field.trim([field.reduce(c * i) for i, c in enumerate(g)][1:])
+            d = field.gcd(g, dg)
+            parts.append(field.divmod(g, d)[0] if len(d) > 1 else g)
+        owners.append(f)
+        degrees.append(len(g) - 1)
+    common = {}
+    for a, b in combinations(range(len(parts)), 2):
+        if _no_common_root_mod_p(images, owners[a], degrees[a], owners[b], degrees[b]):
+            continue
+        checkpoint()
+        _refuse_costly_euclid(m, min(len(parts[a]), len(parts[b])) - 1)
+        g = field.gcd(parts[a], parts[b])
+        if len(g) > 1:
+            common[a, b] = len(g) - 1
+    return parts, common
 
 
 def fibre_points(factors, alpha: RationalRoot, memo: dict | None = None) -> list[arb] | str:
     """The distinct real points of the variety on the line x = α (sorted, disjoint
     balls), or :data:`WALL` when the whole line lies in it.  ``memo`` keeps the
-    squarefree fibre per minimal polynomial (conjugate critical values share it)."""
+    exact fibre per minimal polynomial (conjugate critical values share it)."""
     m = minimal_polynomial(alpha)
+    if m.degree() == 1:  # a rational α: met exactly (short brackets around it, cheap
+        alpha.pin(-m[0] / m[1])  # fibres over their ends)
     memo = {} if memo is None else memo
     if str(m) not in memo:
         memo[str(m)] = squarefree_fibre(factors, m)
-    h = memo[str(m)]
-    if h == WALL:
+    fibre = memo[str(m)]
+    if fibre == WALL:
         return WALL
-    if len(h) == 1:
+    parts, common = fibre
+    if not parts:
         return []
     for bits in (128, 512, 2048):
-        points = _real_roots(h, alpha, bits)
+        checkpoint()
+        points = _real_points(parts, common, alpha, bits)
         if points is not None:
             return points
     raise NotDecided("the real points of the fibre could not be isolated")
 
 
-def _real_roots(h: list, alpha: RationalRoot, bits: int) -> list[arb] | None:
+def _roots_of(h: list, a: arb, bits: int) -> list[tuple[acb, bool]] | None:
+    """The roots of the squarefree h (coefficients in Q(α), evaluated at the ball a of
+    α), each as (isolating complex ball, proven real); None when not separated."""
+    coeffs = [arb_poly([arb(c) for c in q.coeffs()])(a) if not q.is_zero() else arb(0)
+              for q in h]
+    try:
+        # refined well below the balls' own isolation radius, so that roots of two
+        # parts closer than that (two fibre points 5e-17 apart on a Delta's plane) meet
+        # only when they are one point
+        roots = acb_poly([acb(c) for c in coeffs]).roots(tol=arb(2) ** (-bits // 2),
+                                                         maxprec=4 * bits)
+    except ValueError:
+        return None
+    out = []
+    for i, z in enumerate(roots):
+        real = False
+        if z.imag.contains(0):  # h has real coefficients: a ball whose mirror image meets
+            mirror = z.conjugate()  # no other root ball holds a real root
+            if any(j != i and mirror.overlaps(w) for j, w in enumerate(roots)):
+                return None
+            real = True
+        out.append((z, real))
+    return out
+
+
+def _real_points(parts: list, common: dict, alpha: RationalRoot, bits: int
+                 ) -> list[arb] | None:
+    """The distinct real points of the parts' roots, or None at too low a precision.
+
+    A root of h_i and one of h_j are the same point exactly when their balls overlap and
+    the number of overlapping pairs is the number of common roots (gcd degree): each
+    common root makes one overlapping pair, so equal counts leave no other."""
     alpha.bisect_to(fmpq(1, 2 ** (bits + 16)))
     with working_precision(bits + 64):
         a = alpha.ball()
-        coeffs = [arb_poly([arb(c) for c in q.coeffs()])(a) if not q.is_zero() else arb(0)
-                  for q in h]
-        try:
-            roots = acb_poly([acb(c) for c in coeffs]).roots(maxprec=4 * bits)
-        except ValueError:
+        roots = [_roots_of(h, a, bits) for h in parts]
+        if any(r is None for r in roots):
             return None
-        real = []
-        for i, z in enumerate(roots):
-            if not z.imag.contains(0):
-                continue
-            mirror = z.conjugate()
-            if any(j != i and mirror.overlaps(w) for j, w in enumerate(roots)):
+        parent = {(i, k): (i, k) for i, rs in enumerate(roots) for k in range(len(rs))}
+
+        def find(u):
+            while parent[u] != u:
+                u = parent[u]
+            return u
+
+        for i, j in combinations(range(len(parts)), 2):
+            pairs = [(u, v) for u, (z, _) in enumerate(roots[i])
+                     for v, (w, _) in enumerate(roots[j]) if z.overlaps(w)]
+            if len(pairs) != common.get((i, j), 0) or \
+                    len({u for u, _ in pairs}) != len(pairs) or \
+                    len({v for _, v in pairs}) != len(pairs):
                 return None
-            real.append(z.real)
+            for u, v in pairs:
+                parent[find((i, u))] = find((j, v))
+        classes: dict = {}
+        for i, rs in enumerate(roots):
+            for k, (z, real) in enumerate(rs):
+                classes.setdefault(find((i, k)), []).append((z, real))
+        real = [min((z.real for z, _ in members), key=lambda x: x.rad())
+                for members in classes.values() if any(r for _, r in members)]
     real.sort(key=lambda r: r.mid())
     if any(x.overlaps(y) for x, y in zip(real, real[1:], strict=False)):
         return None
@@ -219,8 +359,6 @@ def exact_joins(cad, base, i: int, brackets, memo: dict | None = None
     """
 
     try:
-        if minimal_polynomial(base[i]).degree() > MAX_EXACT_DEGREE:
-            return None
         points = fibre_points(cad.factors, base[i], memo)
     except NotDecided:
         return None

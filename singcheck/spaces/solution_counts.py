@@ -12,6 +12,10 @@
   rational coefficients); the real roots of h are counted exactly.  When the basis is
   not in that shape, a rational linear change of coordinates is tried (it keeps the
   real solutions in bijection); if no shape is found the count is left undecided.
+  A pose angle φ is the pair (cos φ, sin φ) with cos² + sin² = 1 (one real solution per
+  φ in (-π, π]); a square root √p of the parameters is a variable r with r² = p, over Q
+  (the norm, not Q(√p)), and only solutions with r > 0 (the robot, not its conjugate)
+  are counted.
 """
 
 from __future__ import annotations
@@ -25,6 +29,7 @@ from singcheck.algebra.intervals import fraction_ball, working_precision
 from singcheck.algebra.polynomials import constant_value
 from singcheck.budget import checkpoint
 from singcheck.certify.path import branches_at_pose, inside_limits
+from singcheck.elimination.projection import pose_circles
 from singcheck.model.robot import REVOLUTE, RobotModel, leg_coefficients
 from singcheck.roots.rational import rational_ball, to_fmpq
 from singcheck.spaces.cad import separated_roots
@@ -154,8 +159,8 @@ class DirectCount:
 
 
 #: The largest Bézout bound (product of the degrees of the direct-kinematics system in
-#: its unknowns) whose count is attempted: the rotary Delta's is 36, the 3-RPR's 16; the
-#: Gough–Stewart's (40 assembly modes, 12 unknowns) is far beyond a lex Gröbner basis.
+#: its unknowns) whose count is attempted: the Deltas' and the 3-RPR's are 16; the
+#: Gough–Stewart's (40 assembly modes, 9 unknowns: 32768) is far beyond a SymPy lex basis.
 MAX_DIRECT_BEZOUT = 256
 
 
@@ -168,8 +173,6 @@ def direct_unknowns(model: RobotModel) -> tuple[str, ...]:
 def direct_system(model: RobotModel) -> tuple[fmpq_mpoly, ...]:
     """F with each pose angle's circle cos² + sin² - 1 and each square root's
     ``sqrt(p)² - p`` (in the robot's context; the joints still free)."""
-    from singcheck.elimination.projection import pose_circles
-
     return (*model.constraints, *pose_circles(model),
             *(leg.constraint for leg in model.radical_legs))
 
@@ -205,7 +208,12 @@ def direct_kinematics_count(model: RobotModel, joint_point) -> DirectCount:
               for f in direct_system(model)]
     radicals = len(model.spec.radical_variables)
     last = syms[-1]
-    for change in _COORDINATE_CHANGES:
+    # with a square root, the last pose coordinate alone rarely separates the robot's
+    # poses from its conjugate's (the linear Delta's are mirror images with the same z):
+    # the shift by r, (1,), is tried first
+    changes = _COORDINATE_CHANGES[1:2] + _COORDINATE_CHANGES[:1] + _COORDINATE_CHANGES[2:] \
+        if radicals else _COORDINATE_CHANGES
+    for change in changes:
         checkpoint()
         shift = sum((c * v for c, v in zip(change, syms[:-1], strict=False)), sympy.Integer(0))
         changed = [sympy.expand(e.subs(last, last - shift)) for e in system]
@@ -224,6 +232,7 @@ def _count_on_positive_roots(h: fmpq_poly, radicals: list[fmpq_poly]) -> DirectC
     """The real roots t of h at which every ``g`` of ``radicals`` is positive."""
     count = 0
     for root in separated_roots(h):
+        checkpoint()
         signs = [_sign_at_root(g, root) for g in radicals]
         if None in signs:
             return DirectCount(None, "the sign of a square root at a solution was not "
@@ -245,7 +254,7 @@ def _sign_at_root(g: fmpq_poly, root) -> int | None:
     while True:
         checkpoint()
         width = root.width()
-        bits = 64 + max(0, -math.floor(math.log2(float(width))) if float(width) > 0 else 2000)
+        bits = 64 + max(0, int(width.q).bit_length() - int(width.p).bit_length())
         if bits > _MAX_ROOT_BITS:
             return None
         with working_precision(bits):

@@ -973,16 +973,11 @@ def test_the_crude_composition_bound_is_above_the_estimate_and_the_result(
 ])
 def test_costly_paths_stop_at_the_time_limit(tmp_path, cache_env, robot, pose, rng):
     from singcheck import api
-    from singcheck.errors import SpecError
 
     machine = api.load_robot(robot, backend="flint")
     spec = api.load_trajectory(trajectory(tmp_path, pose, rng), machine)
     start = time.monotonic()
-    try:
-        report = api.check(machine, spec, time_limit=3)
-    except SpecError as e:  # refused up front by an a-priori bound (exit 2): stopped too
-        assert "too costly" in str(e) and time.monotonic() - start < 3 + 10
-        return
+    report = api.check(machine, spec, time_limit=3)  # admitted: within every a-priori bound
     elapsed = time.monotonic() - start
     assert elapsed < 3 + 10, elapsed
     if report.verdict == "unknown":
@@ -1005,8 +1000,7 @@ def test_costly_paths_end_unknown_at_the_command_lines_time_limit(
     assert code in (0, 1, 2, 3), err
     assert "Traceback" not in err
     (doc,) = json.loads(out)["trajectories"]
-    if code == 2:  # refused up front by an a-priori bound (the Orthoglide's cos(256*t))
-        assert doc["verdict"] == "error" and "too costly" in doc["reason"]
+    assert code != 2, doc  # admitted: within every a-priori bound
     if code == 3:  # stopped; or decided in time (the biglide meets y = 0 at t = 0 exactly)
         assert doc["verdict"] == "unknown" and "time limit" in doc["reason"]
     assert time.monotonic() - start < 3 + 15

@@ -314,6 +314,8 @@ def test_a_decomposition_too_costly_to_project_is_refused_up_front():
                        "-q")
     assert result.returncode == 2
     assert "too costly" in result.stderr and len(result.stderr.strip().splitlines()) == 1
+    # the line names the file and what to ask for instead
+    assert "rotary-delta.yaml" in result.stderr and "--slice z=VALUE" in result.stderr
 
 
 def test_3rpr_plane_regions_are_proven_and_match_the_checked_segments(monkeypatch):

@@ -131,15 +131,13 @@ def _in_y(f, field: _Field) -> list:
                        for j in range(max(coeffs) + 1)])
 
 
-def _images(m: fmpq_poly, wanted: int = 2, tries: int = 24) -> list[tuple[int, int]]:
+def _images(m: fmpq_poly, wanted: int = 2) -> list[tuple[int, int]]:
     """Up to ``wanted`` pairs (p, r): a prime p ∤ lc(m)·denominators with a root r of m
     mod p.  x ↦ r is then a ring homomorphism from the p-integral part of Q[x]/(m) ≅ Q(α)
     onto F_p (it kills m)."""
     out = []
     num, den = m.numer(), m.denom()
-    p = 2 ** 62
-    for _ in range(tries):
-        p = _next_prime(p)
+    for p in _primes():
         if num.leading_coefficient() % p == 0 or den % p == 0:
             continue
         roots = nmod_poly([int(c) % p for c in num.coeffs()], p).roots()
@@ -150,11 +148,18 @@ def _images(m: fmpq_poly, wanted: int = 2, tries: int = 24) -> list[tuple[int, i
     return out
 
 
-def _next_prime(n: int) -> int:
-    n += 1
-    while not fmpz(n).is_probable_prime():  # (a prime that is not one only loses a
-        n += 1  # quick proof below: the bound it gives is checked against m's root)
-    return n
+_PRIMES: list[int] = []
+
+
+def _primes(count: int = 24) -> list[int]:
+    """The first ``count`` primes above 2^62, each proven prime (FLINT's is_prime: a
+    composite modulus would make F_p no field and its gcds no proof)."""
+    n = _PRIMES[-1] if _PRIMES else 2 ** 62
+    while len(_PRIMES) < count:
+        n += 1
+        if fmpz(n).is_prime():
+            _PRIMES.append(n)
+    return _PRIMES[:count]
 
 
 def _image(f, degree: int, p: int, r: int):

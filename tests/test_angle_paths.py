@@ -148,3 +148,27 @@ def test_two_independent_angles_stay_undecided_with_the_reason():
     assert all("tangency" in w.reason for w in iso.undecided)
     assert angle_circle(p) is None
     assert angle_circle(S * S + c) is None  # any use of sin t, cos t with the angle
+
+
+def test_a_touch_at_a_zero_of_the_angle_polynomial_is_an_exact_point(tmp_path):
+    """phi = t² at the constant position (2, 2), on the 3-RPR's surface at φ = 0
+    (x + y = 4 there): det A(φ(t)) touches 0 at t = 0, where g = t² vanishes and
+    everything is rational (cos 0 = 1, sin 0 = 0)."""
+    mp.mp.dps = 50
+    oracle = oracles.three_rpr()
+
+    def det(t):
+        return oracle.det_A(None, [mp.mpf(2), mp.mpf(2), t * t])
+
+    assert det(mp.mpf(0)) == 0
+    assert det(mp.mpf("-0.01")) * det(mp.mpf("0.01")) > 0  # the same sign: a touch
+    values = [det(mp.mpf(k) / 100) for k in range(-50, 51) if k]
+    assert all(v * values[0] > 0 for v in values)  # no other zero on [-1/2, 1/2]
+    assert all(any(leg.lo < b < leg.hi for b in leg.branches([2, 2, mp.mpf(0)]))
+               for leg in oracle.legs)
+    text = TOUCH.format(dx="", dy="").replace("[7/10, 9/10]", "[-1/2, 1/2]")
+    text = text.replace(text[text.index("  x:"):text.index("  phi:")], "  x: 2\n  y: 2\n")
+    result = _run(tmp_path, text)
+    assert result.verdict == "singular"
+    assert len(result.candidates) == 1
+    assert result.candidates[0].t.is_exact() and result.candidates[0].t == 0

@@ -964,7 +964,8 @@ def test_the_crude_composition_bound_is_above_the_estimate_and_the_result(
 
 
 @pytest.mark.parametrize("robot, pose, rng", [
-    (ORTHO, {"x": "3*sin(t) + cos(256*t)", "y": "0", "z": "1"}, "0, 1"),
+    # cos(50*t): degree 800 in tan(t/2), the most the root-isolation bound admits
+    (ORTHO, {"x": "3*sin(t) + cos(50*t)", "y": "0", "z": "1"}, "0, 1"),
     (BIGLIDE, {"x": "sin(100*t)", "y": "t"}, "0, 1"),
     (ORTHO, {"x": "sin(t)", "y": "cos(t)", "z": "t/20"}, "-1000000, 1000000"),
     # found by the fuzz campaign: 10^5 periods of the half-angle roots ran 286 s
@@ -976,7 +977,7 @@ def test_costly_paths_stop_at_the_time_limit(tmp_path, cache_env, robot, pose, r
     machine = api.load_robot(robot, backend="flint")
     spec = api.load_trajectory(trajectory(tmp_path, pose, rng), machine)
     start = time.monotonic()
-    report = api.check(machine, spec, time_limit=3)
+    report = api.check(machine, spec, time_limit=3)  # admitted: within every a-priori bound
     elapsed = time.monotonic() - start
     assert elapsed < 3 + 10, elapsed
     if report.verdict == "unknown":
@@ -986,7 +987,7 @@ def test_costly_paths_stop_at_the_time_limit(tmp_path, cache_env, robot, pose, r
 
 
 @pytest.mark.parametrize("robot, pose", [
-    (ORTHO, {"x": "3*sin(t) + cos(256*t)", "y": "0", "z": "1"}),
+    (ORTHO, {"x": "3*sin(t) + cos(50*t)", "y": "0", "z": "1"}),
     (BIGLIDE, {"x": "sin(100*t)", "y": "t"}),
     (BIGLIDE, {"x": "sin(100*t)", "y": "t + 1/1000"}),
 ])
@@ -996,9 +997,10 @@ def test_costly_paths_end_unknown_at_the_command_lines_time_limit(
     start = time.monotonic()
     code, out, err = run_cli(monkeypatch, capsys, "run", robot, spec, "-q", "--backend",
                              "flint", "--time-limit", "3", "--format", "json")
-    assert code in (0, 1, 3), err
+    assert code in (0, 1, 2, 3), err
     assert "Traceback" not in err
     (doc,) = json.loads(out)["trajectories"]
+    assert code != 2, doc  # admitted: within every a-priori bound
     if code == 3:  # stopped; or decided in time (the biglide meets y = 0 at t = 0 exactly)
         assert doc["verdict"] == "unknown" and "time limit" in doc["reason"]
     assert time.monotonic() - start < 3 + 15

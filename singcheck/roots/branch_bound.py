@@ -31,9 +31,9 @@ import math
 from dataclasses import dataclass
 from fractions import Fraction
 
-from flint import arb, fmpq, fmpq_mpoly
+from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
 
-from singcheck.algebra.intervals import excludes_zero, sign, working_precision
+from singcheck.algebra.intervals import excludes_zero, fraction_ball, sign, working_precision
 from singcheck.algebra.radicals import evaluate_path as evaluate_trig
 from singcheck.algebra.radicals import path_derivative as derivative
 from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
@@ -136,6 +136,50 @@ def _exact_zeros(p: fmpq_mpoly, interval: TimeRange) -> list[tuple[int, int, fmp
     return out
 
 
+def _angle_zeros(p: fmpq_mpoly, interval: TimeRange
+                 ) -> list[tuple[Fraction, int, int, int, fmpq, fmpq]]:
+    """(t₀, s, c, m, a, b) for a path polynomial in t and one pose angle's C, S
+    (G = g(t) + qπ, 2q an integer): at a rational zero t₀ of g, C = cos qπ and
+    S = sin qπ are exact (0, ±1), so whether p and its derivatives vanish there is
+    decided exactly, and the Taylor argument of the module docstring proves t₀ the only
+    root in [a, b], of multiplicity m (a touch when m is even: phi = t² at t = 0)."""
+    circle = angle_circle(p)
+    if circle is None or (2 * circle.q).denominator != 1:
+        return []
+    k = int(2 * circle.q) % 4
+    s0, c0 = (0, 1, 0, -1)[k], (1, 0, -1, 0)[k]
+    cos_name, sin_name = circle.names
+    g = fmpq_poly([0] * (circle.g.degrees()[0] + 1))
+    for (i, _, _), coeff in circle.g.terms():
+        g += fmpq_poly([0] * i + [coeff])
+    out = []
+    for f, _ in g.factor()[1]:
+        checkpoint()
+        if f.degree() != 1:
+            continue
+        t0 = -f[0] / f[1]
+        if not inside_range(arb(t0), LinearInPi(Fraction(int(t0.p), int(t0.q))), interval,
+                            128):
+            continue
+
+        def zero(q: fmpq_mpoly, t0=t0) -> bool:
+            return q.subs({"t": t0, cos_name: c0, sin_name: s0}).is_zero()
+
+        dk, order = p, 0
+        while order < _MAX_ORDER and zero(dk):
+            checkpoint()
+            dk, order = derivative(dk), order + 1
+        if order == 0 or zero(dk):
+            continue
+        for e in range(1, 64):
+            checkpoint()
+            a, b = t0 - fmpq(1, 2 ** e), t0 + fmpq(1, 2 ** e)
+            if excludes_zero(_eval(dk, a, b)):
+                out.append((Fraction(int(t0.p), int(t0.q)), s0, c0, order, a, b))
+                break
+    return out
+
+
 def _without(lo: fmpq, hi: fmpq, boxes: list[tuple[fmpq, fmpq]]) -> list[tuple[fmpq, fmpq]]:
     """[lo, hi] minus the open insides of the boxes (sorted, disjoint)."""
     pieces, at = [], lo
@@ -164,7 +208,9 @@ def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Ro
     lo0, hi0 = arb_to_fmpq(a.lower()), arb_to_fmpq(b.upper())
     min_width = exact_tolerance(max(tolerance, 1e-12) / 1000)
     exact_zeros = _exact_zeros(p, interval)
-    stack = _without(lo0, hi0, [(za, zb) for _, _, za, zb in exact_zeros])[::-1]
+    angle_zeros = _angle_zeros(p, interval)
+    stack = _without(lo0, hi0, [(za, zb) for _, _, za, zb in exact_zeros] +
+                     [(za, zb) for *_, za, zb in angle_zeros])[::-1]
     found: list[tuple[fmpq, fmpq]] = []
     exact_points: list[fmpq] = []
     ambiguous: list[tuple[fmpq, fmpq, str]] = []
@@ -200,7 +246,10 @@ def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Ro
         cut = lo + (hi - lo) * _SPLIT
         stack += [(cut, hi), (lo, cut)]
     return _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambiguous,
-                                    [_exact_root(k, order) for k, order, _, _ in exact_zeros])
+                                    [_exact_root(k, order) for k, order, _, _ in exact_zeros]
+                                    + [RealRoot(fraction_ball(t0), order, None,
+                                                exact=point_time(t0, s0, c0))
+                                       for t0, s0, c0, order, _, _ in angle_zeros])
 
 
 @dataclass

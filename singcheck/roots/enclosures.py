@@ -49,7 +49,10 @@ class ExactTime:
       s = 2α/(1+α²) and c = (1-α²)/(1+α²);
     * ``AT_POINT``: s and c are exact rationals (t = kπ), and so is t when it is 0
       (``t_value``); ``None`` means t is a non-zero multiple of π (not rational), the
-      multiple ``pi_multiple`` when known;
+      multiple ``pi_multiple`` when known; on a path with a pose angle g(t) + qπ
+      (2q an integer), also t = t₀ a rational zero of g, with s, c the angle's exact
+      sin, cos there (the path's polynomials then carry them as s, c: see
+      :class:`~singcheck.roots.transcendental.AngleCircle`);
     * ``IN_MIXED``: t = τ ≠ 0, the one zero of a trig polynomial h(t, sin t, cos t)
       mixing t with sin t, cos t in a rational bracket where h is strictly monotone with
       proven opposite signs at the ends (not an algebraic time: decided in the field

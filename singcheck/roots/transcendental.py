@@ -19,8 +19,10 @@ holds word for word with (t, C, S) for (t, c, s), because C² + S² = 1 is the s
 relation: the polynomials are renamed into ``TRIG`` (:meth:`AngleCircle.to_trig`) for
 the algebra (norms over S, factors, divisibility) and evaluated with Arb's cos and sin
 of the ball of G for the balls (:meth:`AngleCircle.evaluate`).  At a zero of g
-everything is algebraic (C = cos qπ, S = sin qπ): there the test is refused
-(:class:`NotExact`) unless τ is proven not to be a zero of g.
+everything is algebraic (C = cos qπ, S = sin qπ): a rational zero of g, with 2q an
+integer, is an exact point of the branch-and-bound (decided in Q, multiplicity by
+Taylor, :func:`~singcheck.roots.branch_bound._angle_zeros`); elsewhere this test is
+refused (:class:`NotExact`) unless τ is proven not to be a zero of g.
 
 Two independent arguments (``x: cos(t)`` with ``phi: t^2``: the point (τ, cos τ,
 cos τ²)) are outside this: that the point is not on a curve of Q[t, c, C] other than the
@@ -30,6 +32,8 @@ problem, so such touches stay undecided.
 """
 
 from __future__ import annotations
+
+from fractions import Fraction
 
 from flint import arb, fmpq_mpoly
 
@@ -68,9 +72,11 @@ class AngleCircle:
     (the algebra is the same: C² + S² = 1), ``from_trig`` back, and ``evaluate`` encloses
     a renamed polynomial's value with C, S at Arb's cos, sin of the ball of G."""
 
-    def __init__(self, ring, cos_name: str, sin_name: str, g: fmpq_mpoly) -> None:
+    def __init__(self, ring, cos_name: str, sin_name: str, g: fmpq_mpoly,
+                 q: Fraction = Fraction(0)) -> None:
         self.ring = ring
-        self.g = g
+        self.g, self.q = g, q
+        self.names = cos_name, sin_name
         names = ring.names()
         self._c, self._s = names.index(cos_name), names.index(sin_name)
         self._n = len(names)
@@ -108,10 +114,10 @@ def ring_circle(ring) -> AngleCircle | None:
             and angle_function_of(v) is not None]
     if len(keys) != 1 or len(names) != 5 or f"sin({keys[0]})" not in names:
         return None
-    g, _ = angle_function_of(f"cos({keys[0]})")
+    g, q = angle_function_of(f"cos({keys[0]})")
     if g.degrees()[1] > 0 or g.degrees()[2] > 0 or g.degrees()[0] < 1:
         return None
-    return AngleCircle(ring, f"cos({keys[0]})", f"sin({keys[0]})", g)
+    return AngleCircle(ring, f"cos({keys[0]})", f"sin({keys[0]})", g, Fraction(q))
 
 
 def angle_circle(p: fmpq_mpoly) -> AngleCircle | None:

@@ -159,8 +159,8 @@ class DirectCount:
 
 
 #: The largest Bézout bound (product of the degrees of the direct-kinematics system in
-#: its unknowns) whose count is attempted: the rotary Delta's is 36, the 3-RPR's 16; the
-#: Gough–Stewart's (40 assembly modes, 12 unknowns) is far beyond a lex Gröbner basis.
+#: its unknowns) whose count is attempted: the Deltas' and the 3-RPR's are 16; the
+#: Gough–Stewart's (40 assembly modes, 9 unknowns: 32768) is far beyond a SymPy lex basis.
 MAX_DIRECT_BEZOUT = 256
 
 

@@ -190,14 +190,15 @@ def trajectory_piece(doc, rng: TimeRange, rnode, nodes: dict, key: str, paramete
     primes = sorted(radical_primes(robot.parameters, list(trees.values())))
     # cos(g(t)), sin(g(t)) in a coordinate (x: cos(t^2)) where g(t) is a pose angle's
     # polynomial path (phi: t^2): that angle's functions (certified as such paths are)
-    angles = {polynomial_angle(trees[v], parameter, robot.parameters, scale)
-              for v in trees if v in robot.angles}
     functions = []
     for v, tree in trees.items():
         if v not in robot.angles:
             functions += [n for n in polynomial_angles(tree, parameter, robot.parameters,
-                                                       scale)
-                          if n in angles and n not in functions]
+                                                       scale) if n not in functions]
+    if functions:  # (rare: the angles' own trees are compiled once more only then)
+        angles = {polynomial_angle(trees[v], parameter, robot.parameters, scale)
+                  for v in trees if v in robot.angles}
+        functions = [n for n in functions if n in angles]
     ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes),
                                *(n for pair in functions for n in pair)), "lex")
     coords, offsets = {}, {}

@@ -21,7 +21,7 @@ libraries; nothing is re-imported), which sends its pickled result back through 
 A fork costs a few milliseconds, and bringing a large result back through the pipe
 tens (the 3-PRR's 24,389-term ξ: about 35 ms, README "Speed"), so a request that
 :func:`~singcheck.elimination.requests.proven_small` bounds up front (a norm chain of at
-most 10⁶ terms of 1024 bits, its memory a quarter of the bound at most) runs in this
+most 10⁶ terms of 1024 bits, its memory count at most half the bound) runs in this
 process.  :func:`singcheck.elimination.cas.get_backend` wraps the in-process backends in
 :class:`Isolated`; their classes used directly run in this process.
 """
@@ -173,14 +173,15 @@ def run_bounded(fn, argument, proven_small: bool, timeout: float, what: str):
     return run_forked(fn, argument, timeout, what)
 
 
-#: Below this ``--timeout`` every request goes to the fork (a proven-small chain takes at
-#: most about a second here: README, "Budgets").
+#: Below this ``--timeout`` every request goes to the fork (a proven-small chain took at
+#: most about 7 s here even when dense, filling its bound: README, "Budgets").
 IN_PROCESS_MIN_TIMEOUT = 60.0
 
 
 class Isolated:
-    """An in-process backend whose every elimination runs in a forked child
-    (:func:`run_forked`) with ``timeout`` seconds and the memory bound."""
+    """An in-process backend whose eliminations run in a forked child
+    (:func:`run_forked`) with ``timeout`` seconds and the memory bound, unless the
+    backend proves one small up front (:func:`run_bounded`)."""
 
     def __init__(self, backend, timeout: float) -> None:
         self.backend = backend

@@ -40,7 +40,6 @@ from singcheck.algebra.intervals import working_precision
 from singcheck.budget import checkpoint
 from singcheck.roots.rational import RationalRoot, ball_ends, to_fraction
 from singcheck.spaces.cad import fiber, sector_of, simplest_between
-from singcheck.spaces.regions import _UnionFind
 from singcheck.spaces.segments import segment_is_free
 
 WALL = "wall"  # the line x = α lies in the variety
@@ -304,7 +303,13 @@ def _real_points(parts: list, common: dict, alpha: RationalRoot, bits: int
         roots = [_roots_of(h, a, bits) for h in parts]
         if any(r is None for r in roots):
             return None
-        points = _UnionFind()
+        parent = {(i, k): (i, k) for i, rs in enumerate(roots) for k in range(len(rs))}
+
+        def find(u):
+            while parent[u] != u:
+                u = parent[u]
+            return u
+
         for i, j in combinations(range(len(parts)), 2):
             pairs = [(u, v) for u, (z, _) in enumerate(roots[i])
                      for v, (w, _) in enumerate(roots[j]) if z.overlaps(w)]
@@ -313,11 +318,11 @@ def _real_points(parts: list, common: dict, alpha: RationalRoot, bits: int
                     len({v for _, v in pairs}) != len(pairs):
                 return None
             for u, v in pairs:
-                points.union((i, u), (j, v))
+                parent[find((i, u))] = find((j, v))
         classes: dict = {}
         for i, rs in enumerate(roots):
             for k, (z, real) in enumerate(rs):
-                classes.setdefault(points.find((i, k)), []).append((z, real))
+                classes.setdefault(find((i, k)), []).append((z, real))
         real = [min((z.real for z, _ in members), key=lambda x: x.rad())
                 for members in classes.values() if any(r for _, r in members)]
     real.sort(key=lambda r: r.mid())

@@ -76,9 +76,10 @@ def test_backends_command_lists_all_four():
 
 # Issue 12: a robot with revolute actuators (the 5-bar, bundled) and one with an
 # orientation whose ξ needs an elimination (a small bar robot: the bundled 3-RPR and
-# Gough–Stewart need none, and the 3-PRR's ξ of degree 32 takes Singular more than ten
-# minutes).  Each backend agrees with FLINT's answer, or refuses in one line that names a
-# backend that can; the refusals known today are listed, any other one fails.
+# Gough–Stewart need none, and the 3-PRR's ξ of degree 32 takes Singular's resultant
+# chain about 4 s: test_cas.py).  Each backend agrees with FLINT's answer, or refuses in
+# one line that names a backend that can; the refusals known today are listed, any other
+# one fails.
 ANGLES = {
     "five-bar": (ROBOTS / "five-bar.yaml", TRAJECTORIES / "five-bar-cross.yaml"),
     "2-prr-bar": (DATA_ROBOTS / "2-prr-bar.yaml", DATA_ROBOTS / "2-prr-bar-turn.yaml"),

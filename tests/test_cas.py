@@ -260,3 +260,33 @@ def test_programs_run_from_two_threads_do_not_kill_each_other():
     second.join()
     assert [(results[k].returncode, results[k].stdout.strip()) for k in ("first", "second")] \
         == [(0, "first"), (0, "second")]
+
+
+def test_live_singular_computes_a_pose_angle_robots_surface_by_its_resultant_chain():
+    """The 3-PRR (pose x, y, φ; prismatic legs): Singular gets the resultant chain, not a
+    Gröbner elimination (which did not finish in 10 minutes), and its ξ is the chain
+    Res_r3(Res_r2(Res_r1(det A, F1), F2), F3) computed here with FLINT, squarefree, up to
+    a constant."""
+    from singcheck.elimination.projection import singularity_surface_request
+    from singcheck.model.robot import build_model
+    from singcheck.spec.files import load_robot
+
+    backend = _backend("singular")
+    request = singularity_surface_request(build_model(load_robot(
+        HERE.parent / "robots" / "3-prr.yaml")))
+    assert "sc_resultant_chain" in singular_script(request, "LIBRARY")
+    assert "sc_eliminate" in singular_script(XI, "LIBRARY")  # no pose angle: Gröbner
+    result = backend.eliminate(request)
+    assert result.method == "Singular resultant chain"
+    (xi,) = result.polynomials
+    *legs, det_a = request.generators
+    chain = det_a
+    for leg, joint in zip(legs, ("r1", "r2", "r3"), strict=True):
+        chain = chain.resultant(leg, joint)
+    from singcheck.algebra.polynomials import restrict
+
+    expected = restrict(squarefree_part(chain), request.kept_context())  # r's are gone
+    assert expected.total_degree() == 32
+    assert request.kept_context().names() == ("x", "y", "cos(phi)", "sin(phi)")
+    got = squarefree_part(xi)
+    assert got * expected.leading_coefficient() == expected * got.leading_coefficient()

@@ -13,7 +13,12 @@ import os
 from dataclasses import dataclass
 from functools import cache
 
-from singcheck.elimination.cas.scripts import macaulay2_script, parse_result, singular_script
+from singcheck.elimination.cas.scripts import (
+    macaulay2_script,
+    parse_result,
+    prismatic_chain,
+    singular_script,
+)
 from singcheck.elimination.requests import EliminationRequest, EliminationResult
 from singcheck.errors import BackendError
 
@@ -214,4 +219,6 @@ class ExternalBackend:
         polys = parse_result(self.cas.program, run.stdout, run.stderr, request)
         if run.returncode != 0:
             raise BackendError(f"{self.cas.program} exited with status {run.returncode}")
-        return EliminationResult(request, polys, f"{self.cas.program} eliminate", self.name)
+        how = "resultant chain" if self.name == "singular" and prismatic_chain(request) \
+            else "eliminate"
+        return EliminationResult(request, polys, f"{self.cas.program} {how}", self.name)

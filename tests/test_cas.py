@@ -290,3 +290,25 @@ def test_live_singular_computes_a_pose_angle_robots_surface_by_its_resultant_cha
     assert request.kept_context().names() == ("x", "y", "cos(phi)", "sin(phi)")
     got = squarefree_part(xi)
     assert got * expected.leading_coefficient() == expected * got.leading_coefficient()
+
+
+@pytest.mark.parametrize("name", ["sympy", "macaulay2"])
+def test_slow_backends_refuse_the_3prr_surface_up_front_naming_those_that_can(name):
+    """SymPy and Macaulay2 each ran past 10 minutes on the 3-PRR's ξ (Gröbner elimination
+    and resultants alike): they refuse it at once, in one line naming flint and singular,
+    instead of running into --timeout."""
+    from singcheck.elimination.cas import get_backend
+    from singcheck.elimination.projection import singularity_surface_request
+    from singcheck.model.robot import build_model
+    from singcheck.spec.files import load_robot
+
+    backend = _backend(name) if name == "macaulay2" else get_backend(name)
+    request = singularity_surface_request(build_model(load_robot(
+        HERE.parent / "robots" / "3-prr.yaml")))
+    start = time.monotonic()
+    with pytest.raises(BackendError) as error:
+        backend.eliminate(request)
+    assert time.monotonic() - start < 5
+    message = str(error.value)
+    assert "\n" not in message and "714,425 terms" in message
+    assert message.endswith("use --backend flint or singular")

@@ -355,3 +355,44 @@ def proven_small(request: EliminationRequest, memory_limit: int) -> bool:
     :func:`chain_is_small` proves small."""
     structure = leg_structure(request)
     return structure is not None and chain_is_small(*structure, memory_limit)
+
+
+def prismatic_chain(request: EliminationRequest):
+    """``(g, [(v, f_v), …])`` of :func:`leg_structure` when every leg is a single variable
+    and the kept variables hold a pose angle's (cos, sin), else None.  Gröbner
+    elimination struggles there: Singular computes the resultant chain instead (its
+    ``eliminate`` of the 3-PRR's ξ did not finish in 10 minutes; the chain takes
+    seconds), and :func:`slow_backend_refusal` turns large ones away from the slow
+    backends."""
+    kept = request.keep
+    if not any(v.startswith("cos(") and "sin(" + v[4:] in kept for v in kept):
+        return None
+    structure = leg_structure(request)
+    if structure is None or any(isinstance(v, tuple) for v, _ in structure[1]):
+        return None
+    return structure
+
+
+#: Above this a-priori bound on the terms of its resultant chain (:func:`norm_chain_bound`),
+#: a :func:`prismatic_chain` request is refused by SymPy and Macaulay2: on the bundled
+#: 3-PRR (bound 714,425 terms; its ξ has 24,389) each ran past 10 minutes, with their
+#: Gröbner elimination and with their resultants, where FLINT takes 14 ms and Singular's
+#: chain 4 s.  The small robots of the cross-backend test stay under it (the 2-PRR bar:
+#: 1,989).
+SLOW_CHAIN_TERMS = 100_000
+
+
+def slow_backend_refusal(request: EliminationRequest, backend: str) -> str | None:
+    """The one-line reason why ``backend`` (sympy, macaulay2) turns ``request`` away up
+    front, or None when it takes it."""
+    structure = prismatic_chain(request)
+    if structure is None:
+        return None
+    terms, _ = norm_chain_bound(*structure)
+    if terms <= SLOW_CHAIN_TERMS:
+        return None
+    what = request.label.replace("_", " ")
+    return (f"{backend} cannot compute this {what} in reasonable time: the resultant chain "
+            f"over the legs may reach {terms:,} terms (a-priori bound; above "
+            f"{SLOW_CHAIN_TERMS:,} with a pose angle it took over 10 minutes on the bundled "
+            "3-PRR); use --backend flint or singular")

@@ -13,13 +13,13 @@ import os
 from dataclasses import dataclass
 from functools import cache
 
-from singcheck.elimination.cas.scripts import (
-    macaulay2_script,
-    parse_result,
+from singcheck.elimination.cas.scripts import macaulay2_script, parse_result, singular_script
+from singcheck.elimination.requests import (
+    EliminationRequest,
+    EliminationResult,
     prismatic_chain,
-    singular_script,
+    slow_backend_refusal,
 )
-from singcheck.elimination.requests import EliminationRequest, EliminationResult
 from singcheck.errors import BackendError
 
 # (the subprocess machinery, tempfile and importlib.resources are imported where a CAS
@@ -202,6 +202,10 @@ class ExternalBackend:
         from singcheck.elimination.cas.limits import describe_limit
         from singcheck.elimination.cas.process import run_program
 
+        if self.name == "macaulay2":
+            refusal = slow_backend_refusal(request, "macaulay2")
+            if refusal:
+                raise BackendError(refusal)
         script = self.script(request)
         with tempfile.TemporaryDirectory(prefix="singcheck-") as tmp:
             suffix = "sing" if self.name == "singular" else "m2"

@@ -22,7 +22,7 @@ from singcheck.elimination.cas.polytext import (
     format_polynomial,
     parse_polynomial,
 )
-from singcheck.elimination.requests import EliminationRequest, leg_structure
+from singcheck.elimination.requests import EliminationRequest, prismatic_chain
 from singcheck.errors import BackendError
 
 BEGIN, END = "@@singcheck-begin", "@@singcheck-end"
@@ -44,20 +44,6 @@ def _parts(request: EliminationRequest) -> tuple[list[str], str, list[str]]:
     names = [f"v{i}" for i in range(1, request.context.nvars() + 1)]
     generators = ",\n  ".join(format_polynomial(g) for g in request.generators)
     return names, generators, [_var(request, v) for v in request.eliminate]
-
-
-def prismatic_chain(request: EliminationRequest):
-    """``(g, [(v, f_v), …])`` of :func:`~singcheck.elimination.requests.leg_structure`
-    when every leg is a single variable and the kept variables hold a pose angle's
-    (cos, sin): Singular then computes the resultant chain (its Gröbner elimination of the
-    3-PRR's ξ did not finish in 10 minutes; the chain takes seconds), else None."""
-    kept = request.keep
-    if not any(v.startswith("cos(") and "sin(" + v[4:] in kept for v in kept):
-        return None
-    structure = leg_structure(request)
-    if structure is None or any(isinstance(v, tuple) for v, _ in structure[1]):
-        return None
-    return structure
 
 
 def singular_script(request: EliminationRequest, library: str) -> str:

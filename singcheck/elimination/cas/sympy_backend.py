@@ -18,7 +18,12 @@ from __future__ import annotations
 from flint import fmpq, fmpq_mpoly
 
 from singcheck.algebra.polynomials import restrict
-from singcheck.elimination.requests import EliminationRequest, EliminationResult, leg_structure
+from singcheck.elimination.requests import (
+    EliminationRequest,
+    EliminationResult,
+    leg_structure,
+    slow_backend_refusal,
+)
 from singcheck.errors import BackendError
 
 
@@ -63,6 +68,9 @@ class SympyBackend:
                 f"sympy cannot eliminate the angle {pairs[0][4:-1]} (a revolute joint's cos, "
                 "sin pair: its Gröbner basis does not finish); use --backend flint, singular "
                 "or macaulay2")
+        refusal = slow_backend_refusal(request, "sympy")
+        if refusal:
+            raise BackendError(refusal)
         if structure is not None:
             g, legs = structure
             acc = _to_sympy(g, gens)

@@ -887,16 +887,26 @@ def test_undecided_boxes_and_a_known_root_are_kept_when_no_mode_is_feasible(
         tmp_path, monkeypatch, capsys, cache_env):
     """On the biglide (ξ vanishes where y = 0) the path y = t·sin t touches y = 0 at t = 0
     without crossing, and x = 10 puts it outside every joint's limits: μ has a double
-    root at t = 0, exactly known.  It must be reported, not dropped with the boxes around
-    it because no working mode is feasible."""
+    root at t = 0, exactly known.  Every mode is proven infeasible, so μ is not looked
+    at: the report claims no candidate list (root isolation "none"), rather than a
+    list with the root at 0 dropped.  Isolated, the root is kept with its boxes."""
     spec = trajectory(tmp_path, {"x": "10", "y": "t*sin(t)"}, "-1, 1")
     code, out, err = run_cli(monkeypatch, capsys, "run", BIGLIDE, spec, "-q", "--backend",
                              "flint", "--format", "json")
     assert code == 1, err
     (doc,) = json.loads(out)["trajectories"]
     assert doc["verdict"] == "infeasible"
-    assert [c["t_interval"] for c in doc["candidates"]] == [[0.0, 0.0]]
-    assert all(lo <= 0 <= hi for lo, hi in (u["t_interval"] for u in doc["undecided"]))
+    assert "outside" in doc["reason"]
+    assert doc["root_isolation"].startswith("none")
+    assert doc["candidates"] == [] and doc["undecided"] == []
+    from flint import fmpq_mpoly_ctx
+
+    from singcheck.algebra.trig import LinearInPi, TimeRange
+    from singcheck.roots.isolation import isolate_real_roots
+
+    t, s, c = fmpq_mpoly_ctx.get(("t", "s", "c"), "lex").gens()
+    iso = isolate_real_roots(t * s, TimeRange(LinearInPi(-1), LinearInPi(1)), 1e-9)
+    assert [(float(r.t.lower()), float(r.t.upper())) for r in iso.roots] == [(0.0, 0.0)]
     # an undecided box is kept when no mode is feasible (all([]) is true: it was dropped)
     from types import SimpleNamespace
 
@@ -1064,6 +1074,16 @@ def test_a_triple_root_at_t_0_of_the_half_angle_polynomial(tmp_path, monkeypatch
     assert code in (0, 1, 3) and "Traceback" not in err, err
     (doc,) = json.loads(out)["trajectories"]
     intervals = [c["t_interval"] for c in doc["candidates"]]
+    if doc["verdict"] == "infeasible":  # μ is not looked at then: isolate it here
+        from fractions import Fraction
+
+        from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
+        from singcheck.roots.isolation import isolate_real_roots
+
+        y = 9 * TRIG.gens()[1] ** 3 / 14  # the path's y; ξ of the biglide is y·(…)
+        iso = isolate_real_roots(y, TimeRange(LinearInPi(Fraction(-45, 54)),
+                                              LinearInPi(Fraction(0), Fraction(2))), 1e-9)
+        intervals = [(float(r.t.lower()), float(r.t.upper())) for r in iso.roots]
     assert len(intervals) == 3
     for (lo, hi), root in zip(intervals, (0.0, math.pi, 2 * math.pi), strict=True):
         assert lo <= root <= hi and hi - lo < 1e-8

@@ -336,9 +336,20 @@ def _clear_undecided(path, modes, box) -> bool:
     return all(v is not None and excludes_zero(v) for v in values.values())
 
 
+#: ``root_method`` of a path on which no working mode is feasible (μ not looked at)
+NOT_NEEDED = "none (no working mode is feasible)"
+
+
 def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
-    """The verdict for one trajectory, with everything that supports it."""
+    """The verdict for one trajectory, with everything that supports it.
+
+    When every working mode is proven infeasible the verdict is ``infeasible`` whatever
+    μ's roots are (no mode can follow the path, so none of its singularities is met):
+    μ's roots are then not isolated, and the report lists no candidate."""
     modes = working_modes(path, tolerance)
+    if all(m.status == INFEASIBLE for m in modes):
+        verdict, reason = verdict_of(modes, [], [])
+        return TrajectoryReport(path, verdict, reason, [], modes, NOT_NEEDED)
     try:
         isolation = isolate_real_roots(path.mu, path.trajectory.range, tolerance)
     except IdenticallyZeroError:
@@ -440,7 +451,9 @@ def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
         return VERDICT_SINGULAR, (f"working mode {label} is singular at t ≈ "
                                   f"{float(c.t.mid()):.6g}")
     if not feasible and not unsure:
-        reasons = sorted({m.reason for m in modes if m.status == INFEASIBLE})
+        reasons = list(dict.fromkeys(b.reason for m in modes if m.status == INFEASIBLE
+                                     for b in m.branches
+                                     if b.status == INFEASIBLE and b.reason))
         return VERDICT_INFEASIBLE, "no working mode stays in the workspace and joint limits: " \
             + "; ".join(reasons)
     if unsure:

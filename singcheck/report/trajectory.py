@@ -10,7 +10,7 @@ import json
 from typing import Any
 
 from singcheck.algebra.intervals import endpoints
-from singcheck.certify.classification import TrajectoryReport
+from singcheck.certify.classification import NOT_NEEDED, TrajectoryReport
 from singcheck.elimination.projection import RobotProjection
 from singcheck.version import __version__
 
@@ -215,9 +215,11 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
     for t in trajectories:
         segments = t.get("segments") or []
         pieces = f", {len(segments)} segments" if len(segments) > 1 else ""
+        sought = t["root_isolation"] != NOT_NEEDED
         title = f"{robot['name']} · {t['name']}" + (
-            f"  ({t['parameter']} ∈ [{t['range'][0]}, {t['range'][1]}]{pieces}, roots by "
-            f"{t['root_isolation']})" if t["range"] else f"  ({t['path']})")
+            f"  ({t['parameter']} ∈ [{t['range'][0]}, {t['range'][1]}]{pieces}"
+            + (f", roots by {t['root_isolation']})" if sought else ")")
+            if t["range"] else f"  ({t['path']})")
         feasible = [m["label"] for m in t["working_modes"] if m["feasible"]]
         if t["candidates"]:
             table = Table(title=title, title_justify="left")
@@ -235,6 +237,9 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
                               ", ".join(c["singular_modes"]) or "none",
                               f"[{style}]{c['status']}[/{style}]")
             console.print(table)
+        elif not sought:
+            console.print(f"[bold]{title}[/bold]\n  candidates not sought: no working mode "
+                          "is feasible, so no singularity can be met (μ not isolated)")
         else:
             console.print(f"[bold]{title}[/bold]\n  no candidate: μ(t) = ξ(φ(t)) has no real "
                           "root on the range")

@@ -269,6 +269,44 @@ def test_mixed_path_through_a_tangency_at_zero_takes_seconds():
     assert all(m.status == "singular" for m in candidate.modes)
 
 
+_HALF = mpmath.mpf(1) / 2
+
+
+@pytest.mark.parametrize("interval, scale, oracle, root", [
+    (("0", "1"), "1 + (t^2 - 1/2)^2*(2 + cos(t))/64",
+     lambda t: 1 + (t * t - _HALF) ** 2 * (2 + mpmath.cos(t)) / 64, "sqrt"),
+    (("0", "1"), "1 + (t - 1/2)^2*(2 + cos(t))/64",
+     lambda t: 1 + (t - _HALF) ** 2 * (2 + mpmath.cos(t)) / 64, _HALF),
+    (("1/2", "1"), "1 + (t - 1/2)^2*(2 + cos(t))/64",  # at the range's start
+     lambda t: 1 + (t - _HALF) ** 2 * (2 + mpmath.cos(t)) / 64, _HALF),
+    (("0", "1/2"), "1 - (t - 1/2)*(2 + cos(t))/64",  # a crossing at the range's end
+     lambda t: 1 - (t - _HALF) * (2 + mpmath.cos(t)) / 64, _HALF),
+])
+def test_mixed_path_meeting_the_sphere_at_an_algebraic_time_is_decided(interval, scale,
+                                                                       oracle, root):
+    """The scale is 1 exactly at an algebraic time τ ≠ 0 (a factor of μ in t alone),
+    where sin τ, cos τ are transcendental: four modes are singular at once there (so no
+    elimination proof), decided exactly over Q(τ)[sin, cos] (issue 13: a tangency, or
+    several modes, at an algebraic time of a mixed path, also at a range end)."""
+    mpmath.mp.dps = 50
+    root = mpmath.sqrt(_HALF) if root == "sqrt" else root
+    assert abs(oracle(root) - 1) < mpmath.mpf(10) ** -45  # the pose is X0 (on the sphere)
+    assert oracle(root + mpmath.mpf(10) ** -6) != 1
+    report = certify(ORTHOGLIDE.replace("LO", "0"), trajectory(*interval,
+                                                               **along(X0_TEXT, scale)))
+    at_root = [c for c in report.candidates
+               if float(c.t.lower()) <= root <= float(c.t.upper())]
+    assert len(at_root) == 1
+    expected = modes_singular_on_sphere(X0)
+    assert len(expected) == 4
+    assert set(at_root[0].singular_modes) == expected
+    proofs = {m.mode: m.proof for m in at_root[0].modes}
+    assert "det A = 0 exactly (algebraic time, transcendental sin and cos)" in \
+        {proofs[m] for m in expected}
+    assert all(m.status != "unknown" for m in at_root[0].modes)
+    assert report.verdict != "unknown"
+
+
 def test_mixed_path_touching_the_sphere_at_zero_from_outside_is_singular():
     # scale 1 + t²/16 + (1 - cos t)/8 ≥ 1, = 1 only at t = 0: a tangency of order 2
     report = certify(orthoglide(), trajectory(

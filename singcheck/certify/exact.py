@@ -332,12 +332,72 @@ class TimeTranscendentalPoint:
         return evaluate(a, [t, alpha])
 
 
-def exact_point(time: ExactTime, root=None):
+_A_S_C = fmpq_mpoly_ctx.get(("a", "s", "c"), "lex")
+_S2 = _A_S_C.from_dict({(0, 2, 0): 1, (0, 0, 2): 1, (0, 0, 0): -1})
+
+
+class CircleAtAlgebraicTime:
+    """t = τ algebraic and non-zero (a root of a factor of μ in t alone, on a path that
+    mixes t with sin t, cos t, or with the cos, sin of a pose angle G(t) = g(t) + qπ
+    where g(τ) ≠ 0): the elements are polynomials in α = τ, s and c, reduced with
+    s² = 1 - c² and modulo α's minimal polynomial f.
+
+    **Why the zero test is exact.**  The angle θ at τ (τ itself, or G(τ)) is θ = β + qπ
+    with β a non-zero algebraic number (τ, or g(τ)), so e^{iθ} = e^{iβ}·e^{iqπ} is
+    transcendental (Hermite–Lindemann: e^{iβ} is, and e^{iqπ} is a root of unity), and so
+    is cos θ (e^{iθ} is a root of z² - 2·cos θ·z + 1).  An element a₀(c) + s·a₁(c), with
+    coefficients in Q(τ), vanishes at (sin θ, cos θ) exactly when a₀ = a₁ = 0: otherwise
+    a₀² - (1 - c²)·a₁², a polynomial over Q(τ) that is not zero (1 - c² is not a square),
+    would vanish at the transcendental cos θ.  So an element is 0 exactly when it is the
+    zero polynomial: no ball is needed, as in :class:`TimeTranscendentalPoint` with the
+    roles of t and the angle swapped.  ``circle`` (the pose angle's, renamed c, s) gives
+    the balls of G; g(τ) ≠ 0 is proven exactly (f does not divide g)."""
+
+    def __init__(self, time: ExactTime, circle=None) -> None:
+        self.inner = AlgebraicPoint(time)
+        f = self.inner.f
+        if circle is None and f.degree() == 1 and f[0] == 0:
+            raise NotExact("t = 0: sin t and cos t are algebraic there")
+        if circle is not None:
+            g = fmpq_poly([0] * (circle.g.degrees()[0] + 1))
+            for (i, _, _), coeff in circle.g.terms():
+                g += fmpq_poly([0] * i + [coeff])
+            if (g % f).is_zero():
+                raise NotExact("the pose angle's polynomial g vanishes at the root, where the "
+                               "point is algebraic")
+        self.circle = circle
+        self.f = _A_S_C.from_dict({(i, 0, 0): c for i, c in enumerate(f.coeffs())})
+
+    def of(self, p: fmpq_mpoly) -> fmpq_mpoly:
+        return self._reduce(_A_S_C.from_dict(dict(p.terms())))
+
+    def _reduce(self, a: fmpq_mpoly) -> fmpq_mpoly:
+        return (a % _S2) % self.f
+
+    def mul(self, a: fmpq_mpoly, b: fmpq_mpoly) -> fmpq_mpoly:
+        return self._reduce(a * b)
+
+    def is_zero(self, a: fmpq_mpoly) -> bool:
+        return a.is_zero()
+
+    def ball(self, a: fmpq_mpoly, bits: int) -> arb:
+        t = self.inner.ball(fmpq_poly([0, 1]), bits)  # α is t itself
+        p = TRIG.from_dict(dict(a.terms()))
+        if self.circle is not None:
+            return self.circle.evaluate(p, t)
+        return evaluate_trig(p, t)
+
+
+def exact_point(time: ExactTime, root=None, circle=None, mixed: bool = False):
     """The base field of the exact decisions at a root with this exact time; ``root``
     (its :class:`~singcheck.roots.enclosures.RealRoot`) only for a path that uses the
-    bare t, where sin t, cos t algebraic leave t itself transcendental."""
+    bare t, where sin t, cos t algebraic leave t itself transcendental; ``mixed`` for a
+    path that mixes t with sin t, cos t or with a pose angle's (``circle``), where an
+    algebraic t leaves them transcendental."""
     if time.kind == IN_MIXED:
         return TranscendentalPoint(time)
+    if time.kind == IN_T and (mixed or circle is not None):
+        return CircleAtAlgebraicTime(time, circle)
     if time.kind in (IN_U, AT_POINT) and time.t_value is None and root is not None and \
             excludes_zero(root.t):
         return TimeTranscendentalPoint(time, root)
@@ -520,7 +580,8 @@ def vanishes_at_root(p: fmpq_mpoly, root) -> bool | None:
         return None
     try:
         element = _RadicalElement(p)
-        tower = _Tower(element, exact_point(root.exact, root), [1] * len(element.D))
+        point = exact_point(root.exact, root, mixed=uses_trig(p) and uses_t(p))
+        tower = _Tower(element, point, [1] * len(element.D))
         return tower.reduce() is None
     except NotExact:
         return None

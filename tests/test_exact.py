@@ -307,6 +307,38 @@ def test_mixed_path_meeting_the_sphere_at_an_algebraic_time_is_decided(interval,
     assert report.verdict != "unknown"
 
 
+@pytest.mark.parametrize("interval, scale, oracle, end", [
+    (("0", "pi/4"), "1 + (cos(t) - sin(t))^2*(1 + t)/64",
+     lambda t: 1 + (mpmath.cos(t) - mpmath.sin(t)) ** 2 * (1 + t) / 64, "end"),
+    (("pi/4", "1"), "1 + (cos(t) - sin(t))^2*(1 + t)/64",
+     lambda t: 1 + (mpmath.cos(t) - mpmath.sin(t)) ** 2 * (1 + t) / 64, "start"),
+    (("0", "pi/4"), "1 + (cos(t) - sin(t))*(1 + t)/64",
+     lambda t: 1 + (mpmath.cos(t) - mpmath.sin(t)) * (1 + t) / 64, "end"),
+    (("0", "pi/6"), "1 + (sin(3*t) - 1)^2*(1 + t)/64",
+     lambda t: 1 + (mpmath.sin(3 * t) - 1) ** 2 * (1 + t) / 64, "end"),
+])
+def test_mixed_path_meeting_the_sphere_at_a_range_end_a_pi_is_decided(interval, scale,
+                                                                        oracle, end):
+    """The range ends at π/4 or π/6, exactly where the path (mixing t with sin t, cos t)
+    meets the sphere: the joints sit on their limit 0 there in four modes, so the limit
+    polynomials vanish at the range end, where no sign change can bracket them (the
+    branch-and-bound left `limit crossing … not decided`).  The zero at the end is
+    decided exactly (π transcendental over Q(sin aπ, cos aπ)); issue 13, class 3."""
+    mpmath.mp.dps = 50
+    e = {"pi/4": mpmath.pi / 4, "pi/6": mpmath.pi / 6}[interval[0 if end == "start" else 1]]
+    assert abs(oracle(e) - 1) < mpmath.mpf(10) ** -45  # the pose is X0, on the sphere
+    inside = e + (mpmath.mpf(10) ** -3 if end == "start" else -mpmath.mpf(10) ** -3)
+    assert oracle(inside) > 1 or "*(1 + t)/64" in scale and "^2" not in scale
+    report = certify(ORTHOGLIDE.replace("LO", "0"), trajectory(*interval,
+                                                               **along(X0_TEXT, scale)))
+    assert report.verdict == "singular", report.reason
+    at_end = [c for c in report.candidates if float(c.t.lower()) <= e <= float(c.t.upper())]
+    assert len(at_end) == 1
+    assert set(at_end[0].singular_modes) == modes_singular_on_sphere(X0)
+    assert all(m.status != "unknown" for m in at_end[0].modes)
+    assert all(m.status != "unknown" for m in report.modes)
+
+
 def test_mixed_path_touching_the_sphere_at_zero_from_outside_is_singular():
     # scale 1 + t²/16 + (1 - cos t)/8 ≥ 1, = 1 only at t = 0: a tangency of order 2
     report = certify(orthoglide(), trajectory(

@@ -39,8 +39,11 @@ from singcheck.algebra.radicals import path_derivative as derivative
 from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
 from singcheck.budget import checkpoint
 from singcheck.roots.enclosures import (
+    AT_POINT,
     BRANCH_AND_BOUND,
     IN_MIXED,
+    IN_T,
+    IN_U,
     ExactTime,
     RealRoot,
     RootIsolation,
@@ -49,7 +52,14 @@ from singcheck.roots.enclosures import (
     locate_root,
     point_time,
 )
-from singcheck.roots.rational import arb_to_fmpq, bits_for, exact_tolerance, rational_ball
+from singcheck.roots.rational import (
+    RationalRoot,
+    arb_to_fmpq,
+    bits_for,
+    exact_tolerance,
+    rational_ball,
+    real_roots_exact,
+)
 from singcheck.roots.transcendental import angle_circle
 
 _MAX_BOXES = 200_000
@@ -180,6 +190,104 @@ def _angle_zeros(p: fmpq_mpoly, interval: TimeRange
     return out
 
 
+#: a range end aπ is tested exactly only when cos aπ's minimal polynomial (a factor of
+#: the Chebyshev polynomial T_q, q = a's denominator) stays small
+_MAX_END_DENOMINATOR = 60
+
+
+def _end_zeros(p: fmpq_mpoly, interval: TimeRange, lo0: fmpq, hi0: fmpq
+               ) -> list[tuple[RealRoot, fmpq, fmpq]]:
+    """(root, a, b) for a zero of p exactly at a range end e: a rational e ≠ 0, or
+    e = aπ (a not an integer: t = kπ is :func:`_exact_zeros`'), where p(e) = 0 is
+    decided exactly (:func:`~singcheck.algebra.trig_values.sum_is_zero`: π is
+    transcendental over Q(sin aπ, cos aπ), and (sin e, cos e) is a generic point of the
+    circle for a rational e ≠ 0).  The derivatives give its multiplicity m, and a
+    one-sided box [lo0, b] (or [a, hi0]) on which p⁽ᵐ⁾ excludes 0 holds no other root
+    (the Taylor argument of the module docstring): a zero the branch-and-bound could not
+    bracket, since the range ends there."""
+    if p.context() is not TRIG or interval.start == interval.end:
+        return []
+    from singcheck.algebra.trig_values import sum_is_zero
+
+    out = []
+    for end, side in ((interval.start, 1), (interval.end, -1)):
+        checkpoint()
+        a_pi = end.pi_coefficient
+        if (end.rational == 0 and a_pi.denominator == 1) or \
+                (end.rational != 0 and a_pi != 0) or a_pi.denominator > _MAX_END_DENOMINATOR \
+                or excludes_zero(evaluate_trig(p, end.ball())):
+            continue
+        dk, order = p, 0
+        while order < _MAX_ORDER and sum_is_zero([(dk, end)]) is True:
+            checkpoint()
+            dk, order = derivative(dk), order + 1
+        if order == 0 or sum_is_zero([(dk, end)]) is not False:
+            continue
+        with working_precision(128):
+            z = end.ball()
+        for e in range(1, 64):
+            checkpoint()
+            with working_precision(128):
+                a, b = (lo0, arb_to_fmpq((z + arb(2) ** -e).upper())) if side > 0 else \
+                    (arb_to_fmpq((z - arb(2) ** -e).lower()), hi0)
+            if excludes_zero(_eval(dk, a, b)):
+                out.append((_end_root(end, order), a, b))
+                break
+    return out
+
+
+def _end_root(end: LinearInPi, order: int) -> RealRoot:
+    def make(tol: float) -> arb:
+        with working_precision(bits_for(tol)):
+            return end.ball()
+
+    return RealRoot(make(1e-9), order, make, exact=_end_time(end))
+
+
+def _end_time(end: LinearInPi) -> ExactTime | None:
+    """A range end's exact time: t = a rational (≠ 0) in Q; t = aπ with sin, cos
+    exact (a half-integer); else u = tan(aπ/2) on its minimal polynomial."""
+    if end.pi_coefficient == 0:
+        a = fmpq(end.rational.numerator, end.rational.denominator)
+        root = RationalRoot(fmpq_poly([-a, 1]), a, a)
+        return ExactTime(IN_T, lambda: root, end=end)
+    a_pi = end.pi_coefficient
+    if (2 * a_pi).denominator == 1:
+        k = int(2 * a_pi) % 4
+        return ExactTime(AT_POINT, None, Fraction((0, 1, 0, -1)[k]), Fraction((1, 0, -1, 0)[k]),
+                         end=end)
+    root = _tan_half_root(a_pi)
+    return None if root is None else ExactTime(IN_U, lambda: root, end=end)
+
+
+def _tan_half_root(a: Fraction) -> RationalRoot | None:
+    """u = tan(aπ/2) as a root of a squarefree polynomial with an isolating interval:
+    cos aπ = (1 - u²)/(1 + u²), so u is a root of m((1 - u²)/(1 + u²))·(1 + u²)^d for m
+    the minimal polynomial of cos aπ; the interval that holds Arb's ball of tan(aπ/2)
+    is singled out by refining the candidates until one is left (None if not)."""
+    from singcheck.algebra.trig_values import _minimal_polynomial_of_cos
+
+    g = a - 2 * (a // 2)
+    m = _minimal_polynomial_of_cos(g)
+    d = m.degree()
+    one_minus, one_plus = fmpq_poly([1, 0, -1]), fmpq_poly([1, 0, 1])
+    poly = sum((m[i] * one_minus ** i * one_plus ** (d - i) for i in range(d + 1)),
+               fmpq_poly([]))
+    with working_precision(256):
+        u = (arb.pi() * arb(fmpq(g.numerator, g.denominator)) / 2).tan()
+    hits = [r for r, _ in real_roots_exact(poly)
+            if not (r.hi < arb_to_fmpq(u.lower()) or r.lo > arb_to_fmpq(u.upper()))]
+    for _ in range(64):
+        if len(hits) <= 1:
+            break
+        checkpoint()
+        for r in hits:
+            r.bisect_to(r.width() / 4)
+        hits = [r for r in hits
+                if not (r.hi < arb_to_fmpq(u.lower()) or r.lo > arb_to_fmpq(u.upper()))]
+    return hits[0] if len(hits) == 1 else None
+
+
 def _without(lo: fmpq, hi: fmpq, boxes: list[tuple[fmpq, fmpq]]) -> list[tuple[fmpq, fmpq]]:
     """[lo, hi] minus the open insides of the boxes (sorted, disjoint)."""
     pieces, at = [], lo
@@ -209,8 +317,10 @@ def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Ro
     min_width = exact_tolerance(max(tolerance, 1e-12) / 1000)
     exact_zeros = _exact_zeros(p, interval)
     angle_zeros = _angle_zeros(p, interval)
+    end_zeros = _end_zeros(p, interval, lo0, hi0)
     stack = _without(lo0, hi0, [(za, zb) for _, _, za, zb in exact_zeros] +
-                     [(za, zb) for *_, za, zb in angle_zeros])[::-1]
+                     [(za, zb) for *_, za, zb in angle_zeros] +
+                     [(za, zb) for _, za, zb in end_zeros])[::-1]
     found: list[tuple[fmpq, fmpq]] = []
     exact_points: list[fmpq] = []
     ambiguous: list[tuple[fmpq, fmpq, str]] = []
@@ -249,7 +359,8 @@ def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Ro
                                     [_exact_root(k, order) for k, order, _, _ in exact_zeros]
                                     + [RealRoot(fraction_ball(t0), order, None,
                                                 exact=point_time(t0, s0, c0))
-                                       for t0, s0, c0, order, _, _ in angle_zeros])
+                                       for t0, s0, c0, order, _, _ in angle_zeros]
+                                    + [r for r, _, _ in end_zeros])
 
 
 @dataclass

@@ -70,6 +70,8 @@ class ExactTime:
     c: Fraction | None = None
     t_value: Fraction | None = None
     pi_multiple: int | None = None
+    #: the range end the root is exactly at (a zero met there, decided exactly)
+    end: LinearInPi | None = None
 
 
 def point_time(t: Fraction | None, s: int, c: int, pi_multiple: int | None = None

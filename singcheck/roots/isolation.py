@@ -209,6 +209,10 @@ def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
     time = root.exact
     if time is None:
         return None
+    if time.end is not None and p.context() is TRIG:  # a zero met exactly at a range end
+        from singcheck.algebra.trig_values import sum_is_zero
+
+        return sum_is_zero([(p, time.end)])
     if time.kind == IN_MIXED:
         try:
             return TranscendentalPoint(time).is_zero(p)

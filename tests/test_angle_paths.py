@@ -172,3 +172,89 @@ def test_a_touch_at_a_zero_of_the_angle_polynomial_is_an_exact_point(tmp_path):
     assert result.verdict == "singular"
     assert len(result.candidates) == 1
     assert result.candidates[0].t.is_exact() and result.candidates[0].t == 0
+
+
+# -- zeros of the angle's polynomial g at irrational times, and with 2q not an integer ----
+
+ANGLE_ZERO = """\
+name: angle-zero
+parameter: t
+range: [{lo}, {hi}]
+pose:
+  x: {x}
+  y: {y}
+  phi: {phi}
+"""
+
+# a pose on the 3-RPR's singular surface at φ = π/3, found in Q(√3) (rational points of
+# that conic: only (0, 0)): (1/2 + 3√3/10, -1/2 - 3√3/10); P(t) = 3t/2 - t³/6 has
+# P(√3) = √3 and P'(√3) = 0, so x = 1/2 + 3P(t)/10 sits there at t = √3 with speed 0
+_X_SQRT3 = "1/2 + 9*t/20 - t^3/20{dx}"
+_Y_SQRT3 = "-1/2 - 9*t/20 + t^3/20"
+
+
+def _det_along(x, y, phi):
+    return lambda t: oracles.three_rpr().det_A(None, [x(t), y(t), phi(t)])
+
+
+@pytest.mark.parametrize("case", ["sqrt2-touch", "sqrt3-third-pi-touch"])
+def test_a_touch_at_an_irrational_zero_of_the_angle_polynomial_is_singular(tmp_path, case):
+    """At a zero τ of g the point (τ, cos qπ, sin qπ) is algebraic: τ = √2 for
+    phi = (t² - 2)² at the constant position (2, 2) (on the surface at φ = 0, as above);
+    τ = √3 for phi = (t² - 3)² + π/3, where cos, sin = 1/2, √3/2 (2q not an integer),
+    at a position on the surface at φ = π/3 reached with speed 0.  det A touches 0 there
+    (50-digit mpmath) and singcheck proves the touch exactly (issue 13)."""
+    mp.mp.dps = 50
+    if case == "sqrt2-touch":
+        tau, lo, hi = mp.sqrt(2), "1", "2"
+        det = _det_along(lambda t: mp.mpf(2), lambda t: mp.mpf(2), lambda t: (t * t - 2) ** 2)
+        text = ANGLE_ZERO.format(lo=lo, hi=hi, x="2", y="2", phi="(t^2 - 2)^2")
+    else:
+        tau, lo, hi = mp.sqrt(3), "8/5", "9/5"
+        det = _det_along(lambda t: mp.mpf(1) / 2 + 9 * t / 20 - t ** 3 / 20,
+                         lambda t: -mp.mpf(1) / 2 - 9 * t / 20 + t ** 3 / 20,
+                         lambda t: (t * t - 3) ** 2 + mp.pi / 3)
+        text = ANGLE_ZERO.format(lo=lo, hi=hi, x=_X_SQRT3.format(dx=""), y=_Y_SQRT3,
+                                 phi="(t^2 - 3)^2 + pi/3")
+    assert abs(det(tau)) < mp.mpf(10) ** -40  # on the surface at τ
+    eps = mp.mpf(10) ** -3
+    assert det(tau - eps) * det(tau + eps) > 0  # the same sign on both sides: a touch
+    result = _run(tmp_path, text)
+    assert result.verdict == "singular", result.reason
+    [candidate] = [c for c in result.candidates
+                   if float(c.t.lower()) <= tau <= float(c.t.upper())]
+    assert candidate.root.multiplicity % 2 == 0
+
+
+def test_a_near_miss_of_a_touch_with_two_q_not_an_integer_is_proven_free(tmp_path):
+    """The same path moved by 1/1000 in x: det A keeps one sign on the whole range
+    (50-digit samples), and singcheck proves it free rather than `unknown`."""
+    mp.mp.dps = 50
+    det = _det_along(lambda t: mp.mpf(1) / 2 + 9 * t / 20 - t ** 3 / 20 + mp.mpf(1) / 1000,
+                     lambda t: -mp.mpf(1) / 2 - 9 * t / 20 + t ** 3 / 20,
+                     lambda t: (t * t - 3) ** 2 + mp.pi / 3)
+    values = [det(mp.mpf(8) / 5 + k * mp.mpf(1) / 2000) for k in range(401)]
+    assert all(v > 0 for v in values) or all(v < 0 for v in values)
+    text = ANGLE_ZERO.format(lo="8/5", hi="9/5", x=_X_SQRT3.format(dx=" + 1/1000"),
+                             y=_Y_SQRT3, phi="(t^2 - 3)^2 + pi/3")
+    assert _run(tmp_path, text).verdict == "singularity-free"
+
+
+def test_the_zero_test_at_a_zero_of_g_with_two_q_not_an_integer():
+    """AngleZero decides exactly at (√3, sin π/3, cos π/3): s - √3/2·… written with t:
+    2s - t vanishes there (sin π/3 = √3/2), 2s - t + 10⁻³⁰ does not, 4c² - 1 does, and
+    2c - 1 + s - t/2 (a sum of two zeros) does; decided by the annihilating polynomial
+    and its root bound, never by a ball alone."""
+    from flint import fmpq, fmpq_poly
+
+    from singcheck.roots.angle_zeros import AngleZero
+    from singcheck.roots.rational import real_roots_exact
+
+    [(root, _)] = [(r, m) for r, m in real_roots_exact(fmpq_poly([-3, 0, 1])) if r.lo > 0]
+    point = AngleZero(root, Fraction(1, 3))
+    t, s, c = TRIG.gens()
+    assert point.is_zero(2 * s - t)
+    assert not point.is_zero(2 * s - t + fmpq(1, 10 ** 30))
+    assert point.is_zero(4 * c * c - 1)
+    assert point.is_zero(2 * c - 1 + s - t / 2)
+    assert not point.is_zero(c - 1)

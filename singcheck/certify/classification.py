@@ -240,6 +240,7 @@ def _decide_exactly(path, modes, root: RealRoot) -> tuple[dict[str, ModeAtCandid
                     "k·t + qπ, or a zero met at a rational end of a branch-and-bound box)")
     from singcheck.certify.exact import (
         AlgebraicPoint,
+        AngleZero,
         CircleAtAlgebraicTime,
         NotExact,
         det_a_vanishes_at,
@@ -253,7 +254,8 @@ def _decide_exactly(path, modes, root: RealRoot) -> tuple[dict[str, ModeAtCandid
         point = exact_point(root.exact, None if _periodic(path) else root, circle,
                             mixed=_mixed(path))
         zero, nonzero = (BY_ALGEBRAIC_ZERO, BY_ALGEBRAIC_NONZERO) \
-            if isinstance(point, AlgebraicPoint) else (BY_CIRCLE_ZERO, BY_CIRCLE_NONZERO) \
+            if isinstance(point, (AlgebraicPoint, AngleZero)) else \
+            (BY_CIRCLE_ZERO, BY_CIRCLE_NONZERO) \
             if isinstance(point, CircleAtAlgebraicTime) else (BY_MIXED_ZERO, BY_MIXED_NONZERO)
         for mode in modes:
             if det_a_vanishes_at(path, point, mode.label):

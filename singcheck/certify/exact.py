@@ -53,7 +53,8 @@ from singcheck.algebra.radicals import radical_prime
 from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig, uses_t, uses_trig
 from singcheck.budget import checkpoint
 from singcheck.certify.path import PathModel
-from singcheck.roots.enclosures import AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
+from singcheck.roots.angle_zeros import AngleZero
+from singcheck.roots.enclosures import AT_ANGLE_ZERO, AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t
 from singcheck.roots.rational import RationalRoot, minimal_polynomial, rational_ball
@@ -396,6 +397,8 @@ def exact_point(time: ExactTime, root=None, circle=None, mixed: bool = False):
     algebraic t leaves them transcendental."""
     if time.kind == IN_MIXED:
         return TranscendentalPoint(time)
+    if time.kind == AT_ANGLE_ZERO:
+        return AngleZero(time.locate(), time.angle_q)
     if time.kind == IN_T and (mixed or circle is not None):
         return CircleAtAlgebraicTime(time, circle)
     if time.kind in (IN_U, AT_POINT) and time.t_value is None and root is not None and \

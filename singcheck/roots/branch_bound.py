@@ -39,6 +39,7 @@ from singcheck.algebra.radicals import path_derivative as derivative
 from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
 from singcheck.budget import checkpoint
 from singcheck.roots.enclosures import (
+    AT_ANGLE_ZERO,
     AT_POINT,
     BRANCH_AND_BOUND,
     IN_MIXED,
@@ -146,48 +147,38 @@ def _exact_zeros(p: fmpq_mpoly, interval: TimeRange) -> list[tuple[int, int, fmp
     return out
 
 
-def _angle_zeros(p: fmpq_mpoly, interval: TimeRange
-                 ) -> list[tuple[Fraction, int, int, int, fmpq, fmpq]]:
-    """(t₀, s, c, m, a, b) for a path polynomial in t and one pose angle's C, S
-    (G = g(t) + qπ, 2q an integer): at a rational zero t₀ of g, C = cos qπ and
-    S = sin qπ are exact (0, ±1), so whether p and its derivatives vanish there is
-    decided exactly, and the Taylor argument of the module docstring proves t₀ the only
-    root in [a, b], of multiplicity m (a touch when m is even: phi = t² at t = 0)."""
+def _angle_zeros(p: fmpq_mpoly, interval: TimeRange) -> list[tuple[RealRoot, fmpq, fmpq]]:
+    """(root, a, b) for a path polynomial in t and one pose angle's C, S
+    (G = g(t) + qπ): at a zero τ of g the point is algebraic, so whether p and its
+    derivatives vanish there is decided exactly
+    (:func:`~singcheck.roots.angle_zeros.angle_zeros`), and the Taylor argument of the
+    module docstring proves τ the only root in [a, b], of its multiplicity (a touch when
+    even: phi = t² at t = 0, phi = t² - 2 at t = ±√2).  A rational τ with 2q an integer
+    keeps the exact time of a rational point (s, c in {0, ±1})."""
+    from singcheck.roots.angle_zeros import angle_zeros, exact_sin_cos
+
     circle = angle_circle(p)
-    if circle is None or (2 * circle.q).denominator != 1:
+    if circle is None:
         return []
-    k = int(2 * circle.q) % 4
-    s0, c0 = (0, 1, 0, -1)[k], (1, 0, -1, 0)[k]
-    cos_name, sin_name = circle.names
-    g = fmpq_poly([0] * (circle.g.degrees()[0] + 1))
-    for (i, _, _), coeff in circle.g.terms():
-        g += fmpq_poly([0] * i + [coeff])
     out = []
-    for f, _ in g.factor()[1]:
-        checkpoint()
-        if f.degree() != 1:
+    for rr, order, a, b in angle_zeros(p, circle, interval, derivative, _eval):
+        sc = exact_sin_cos(circle.q)
+        if rr.lo == rr.hi and sc is not None:
+            t0 = Fraction(int(rr.lo.p), int(rr.lo.q))
+            out.append((RealRoot(fraction_ball(t0), order, None,
+                                 exact=point_time(t0, *sc)), a, b))
             continue
-        t0 = -f[0] / f[1]
-        if not inside_range(arb(t0), LinearInPi(Fraction(int(t0.p), int(t0.q))), interval,
-                            128):
-            continue
-
-        def zero(q: fmpq_mpoly, t0=t0) -> bool:
-            return q.subs({"t": t0, cos_name: c0, sin_name: s0}).is_zero()
-
-        dk, order = p, 0
-        while order < _MAX_ORDER and zero(dk):
-            checkpoint()
-            dk, order = derivative(dk), order + 1
-        if order == 0 or zero(dk):
-            continue
-        for e in range(1, 64):
-            checkpoint()
-            a, b = t0 - fmpq(1, 2 ** e), t0 + fmpq(1, 2 ** e)
-            if excludes_zero(_eval(dk, a, b)):
-                out.append((Fraction(int(t0.p), int(t0.q)), s0, c0, order, a, b))
-                break
+        out.append((_angle_zero_root(rr, order, circle.q), a, b))
     return out
+
+
+def _angle_zero_root(rr: RationalRoot, order: int, q: Fraction) -> RealRoot:
+    def make(tol: float) -> arb:
+        rr.bisect_to(exact_tolerance(tol) / 2)
+        return rational_ball(rr.lo, rr.hi)
+
+    return RealRoot(make(1e-9), order, make,
+                    exact=ExactTime(AT_ANGLE_ZERO, lambda: rr, angle_q=q))
 
 
 #: a range end aπ is tested exactly only when cos aπ's minimal polynomial (a factor of
@@ -319,8 +310,7 @@ def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Ro
     angle_zeros = _angle_zeros(p, interval)
     end_zeros = _end_zeros(p, interval, lo0, hi0)
     stack = _without(lo0, hi0, [(za, zb) for _, _, za, zb in exact_zeros] +
-                     [(za, zb) for *_, za, zb in angle_zeros] +
-                     [(za, zb) for _, za, zb in end_zeros])[::-1]
+                     [(za, zb) for _, za, zb in angle_zeros + end_zeros])[::-1]
     found: list[tuple[fmpq, fmpq]] = []
     exact_points: list[fmpq] = []
     ambiguous: list[tuple[fmpq, fmpq, str]] = []
@@ -357,10 +347,7 @@ def branch_and_bound(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> Ro
         stack += [(cut, hi), (lo, cut)]
     return _finish_branch_and_bound(p, interval, tolerance, found, exact_points, ambiguous,
                                     [_exact_root(k, order) for k, order, _, _ in exact_zeros]
-                                    + [RealRoot(fraction_ball(t0), order, None,
-                                                exact=point_time(t0, s0, c0))
-                                       for t0, s0, c0, order, _, _ in angle_zeros]
-                                    + [r for r, _, _ in end_zeros])
+                                    + [r for r, _, _ in angle_zeros + end_zeros])
 
 
 @dataclass

@@ -31,6 +31,7 @@ from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig, use
 from singcheck.budget import checkpoint
 from singcheck.roots.branch_bound import branch_and_bound, vanishes_at_multiple_of_pi
 from singcheck.roots.enclosures import (
+    AT_ANGLE_ZERO,
     AT_POINT,
     BRANCH_AND_BOUND,
     EXACT,
@@ -216,6 +217,13 @@ def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
     if time.kind == IN_MIXED:
         try:
             return TranscendentalPoint(time).is_zero(p)
+        except NotExact:
+            return None
+    if time.kind == AT_ANGLE_ZERO and angle_circle(p) is not None:
+        from singcheck.roots.angle_zeros import AngleZero
+
+        try:
+            return AngleZero(time.locate(), time.angle_q).is_zero(angle_circle(p).to_trig(p))
         except NotExact:
             return None
     if time.kind == AT_POINT and (time.t_value == 0 or time.pi_multiple is not None):

@@ -258,3 +258,30 @@ def test_the_zero_test_at_a_zero_of_g_with_two_q_not_an_integer():
     assert point.is_zero(4 * c * c - 1)
     assert point.is_zero(2 * c - 1 + s - t / 2)
     assert not point.is_zero(c - 1)
+
+
+def test_a_polynomial_in_t_and_the_angle_is_enclosed_at_the_angles_balls():
+    """evaluate_path on a ring (t, s, c, cos(t^2), sin(t^2)) goes through one Horner form
+    in C with S and t outside (the 3-PRR's phi = t² path: 6 s → 0.4 s); its balls hold
+    the 50-digit values at points and over small boxes."""
+    from flint import arb
+
+    from singcheck.algebra.radicals import evaluate_path
+
+    mp.mp.dps = 50
+    ring = path_ring([], [angle_function(TRIG.gens()[0] ** 2, 0)])
+    t, C, S = ring.gens()[0], ring.gens()[3], ring.gens()[4]
+    p = 3 * t ** 2 * C ** 3 - t * S * C + 5 * S ** 2 - 7 * C / 3 + t ** 4
+    for x in ("0.3", "-1.7", "2.25"):
+        tm = mp.mpf(x)
+        exact = (3 * tm ** 2 * mp.cos(tm ** 2) ** 3 - tm * mp.sin(tm ** 2) * mp.cos(tm ** 2)
+                 + 5 * mp.sin(tm ** 2) ** 2 - mp.mpf(7) / 3 * mp.cos(tm ** 2) + tm ** 4)
+        ball = evaluate_path(p, arb(x))
+        assert ball.rad() < 1e-10
+        assert abs(float(ball.mid()) - float(exact)) <= float(ball.rad()) + 1e-15
+        box = evaluate_path(p, arb(x, "0.01"))  # every value on [x - 0.01, x + 0.01]
+        for k in range(-10, 11):
+            tk = tm + mp.mpf(k) / 1000
+            v = (3 * tk ** 2 * mp.cos(tk ** 2) ** 3 - tk * mp.sin(tk ** 2) * mp.cos(tk ** 2)
+                 + 5 * mp.sin(tk ** 2) ** 2 - mp.mpf(7) / 3 * mp.cos(tk ** 2) + tk ** 4)
+            assert float(box.lower()) <= float(v) <= float(box.upper())

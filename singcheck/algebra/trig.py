@@ -181,6 +181,51 @@ def evaluate_trig(p: fmpq_mpoly, t: arb, tight: bool = False) -> arb:
     return total
 
 
+def evaluate_trig_at(p: fmpq_mpoly, t: arb, s: arb, c: arb) -> arb:
+    """Rigorous enclosure of ``p(t, s, c)`` for every point of the balls t, s, c (any
+    values: a pose angle's sin and cos, not t's), in the form of :func:`evaluate_trig`:
+    Σᵢ tⁱ (P₀ᵢ(c) + s·P₁ᵢ(c)) with ball polynomials (``p`` reduced or not: its own
+    terms are used, and s² is not replaced, so no relation between s and c is assumed)."""
+    split = _split_raw(p)
+    if isinstance(split, arb_poly):
+        return split(t)
+    total = arb(0)
+    for parts in reversed(split):
+        value = arb(0)
+        for part in reversed(parts):
+            value = value * s + part(c)
+        total = total * t + value
+    return total
+
+
+_RAW_SPLITS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, object]] = OrderedDict()
+
+
+def _split_raw(p: fmpq_mpoly):
+    """[[P_ij(c) for each power j of s] for each power i of t] as ball polynomials at the
+    current precision (p as it is, not reduced), or one polynomial in t when p is free
+    of s and c; memoised like :func:`_split`."""
+    key = (id(p), ctx.prec)
+    hit = _RAW_SPLITS.get(key)
+    if hit is not None and hit[0] is p:
+        return hit[1]
+    dt, ds, dc = p.degrees()
+    if ds == 0 and dc == 0:
+        by_t = [fmpq(0)] * (dt + 1)
+        for (i, _, _), a in p.terms():
+            by_t[i] = a
+        split = arb_poly(fmpq_poly(by_t))
+    else:
+        coeffs = [[[fmpq(0)] * (dc + 1) for _ in range(ds + 1)] for _ in range(dt + 1)]
+        for (i, j, k), a in p.terms():
+            coeffs[i][j][k] = a
+        split = [[arb_poly([arb(a) for a in row]) for row in by_t] for by_t in coeffs]
+    _RAW_SPLITS[key] = (p, split)
+    if len(_RAW_SPLITS) > _SPLITS_KEPT:
+        _RAW_SPLITS.popitem(last=False)
+    return split
+
+
 #: balls wider than this (radius) are also enclosed through the Fourier form
 _WIDE = 1e-3
 #: ... for polynomials of at least this degree in c (lower ones barely wrap)

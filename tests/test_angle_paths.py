@@ -285,3 +285,22 @@ def test_a_polynomial_in_t_and_the_angle_is_enclosed_at_the_angles_balls():
             v = (3 * tk ** 2 * mp.cos(tk ** 2) ** 3 - tk * mp.sin(tk ** 2) * mp.cos(tk ** 2)
                  + 5 * mp.sin(tk ** 2) ** 2 - mp.mpf(7) / 3 * mp.cos(tk ** 2) + tk ** 4)
             assert float(box.lower()) <= float(v) <= float(box.upper())
+
+
+def test_a_pose_angle_offset_with_a_huge_denominator_is_not_taken_exactly(tmp_path):
+    """q = 1/1000001: cos qπ's minimal polynomial would come from a Chebyshev polynomial
+    of degree 10⁶ (the process was killed for memory); the exact test declines it up
+    front and the path is certified as before, in well under a second of work."""
+    import time
+
+    mp.mp.dps = 50
+    det = _det_along(lambda t: mp.mpf(2), lambda t: mp.mpf(2),
+                     lambda t: (t * t - 2) ** 2 + mp.pi / 1000001)
+    tau = mp.findroot(det, mp.mpf("1.937"))  # φ ≈ π there: a crossing
+    assert det(tau - mp.mpf("0.001")) * det(tau + mp.mpf("0.001")) < 0
+    start = time.process_time()
+    text = ANGLE_ZERO.format(lo="1", hi="2", x="2", y="2", phi="(t^2 - 2)^2 + pi/1000001")
+    result = _run(tmp_path, text)
+    assert time.process_time() - start < 20
+    assert result.verdict == "singular"
+    assert any(float(c.t.lower()) <= tau <= float(c.t.upper()) for c in result.candidates)

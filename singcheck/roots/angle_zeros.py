@@ -47,6 +47,11 @@ from singcheck.roots.transcendental import NotExact
 
 #: precision cap of the ball side of the zero test (far past any separation seen)
 _MAX_BITS = 4096
+#: what the exact test takes on: g of degree at most 64 (factored, its roots isolated),
+#: q with a denominator at most 60 (cos qπ's minimal polynomial is a factor of the
+#: Chebyshev polynomial of that degree), and deg f · deg m at most 64 (the degree of the
+#: annihilating polynomial, over two); beyond, the zero is left to the branch-and-bound
+_MAX_G_DEGREE, _MAX_Q_DENOMINATOR, _MAX_FIELD_DEGREE = 64, 60, 64
 _Z = fmpq_mpoly_ctx.get(("z", "t", "s", "c"), "lex")
 _CIRCLE = TRIG.from_dict({(0, 2, 0): 1, (0, 0, 2): 1, (0, 0, 0): -1})
 
@@ -104,7 +109,13 @@ class AngleZero:
         if self._m is None:
             from singcheck.algebra.trig_values import _minimal_polynomial_of_cos
 
+            if self.q.denominator > _MAX_Q_DENOMINATOR:
+                raise NotExact(f"cos({self.q}π) has a minimal polynomial of too high a degree "
+                               "for the exact test")
             self._m = _minimal_polynomial_of_cos(self.q - 2 * (self.q // 2))
+            if self._m.degree() * self.f.degree() > _MAX_FIELD_DEGREE:
+                raise NotExact("the point at a zero of the pose angle's polynomial has too "
+                               "high a degree for the exact test")
         return self._m
 
     def _annihilator(self, a: fmpq_mpoly) -> fmpq_poly:
@@ -171,6 +182,9 @@ def angle_zeros(p: fmpq_mpoly, circle, interval: TimeRange, derivative, eval_box
     of p in the rational box [a, b] (module docstring).  ``derivative`` differentiates p
     along the path, ``eval_box(p, a, b)`` encloses it over [a, b]."""
     g = univariate(circle.g)
+    if g.degree() > _MAX_G_DEGREE or (exact_sin_cos(circle.q) is None
+                                      and circle.q.denominator > _MAX_Q_DENOMINATOR):
+        return []
     out = []
     for factor, _ in g.numer().factor()[1]:
         f = fmpq_poly(factor)
@@ -187,12 +201,15 @@ def angle_zeros(p: fmpq_mpoly, circle, interval: TimeRange, derivative, eval_box
             if not where:
                 continue
             point = AngleZero(rr, circle.q)
-            dk, order = p, 0
-            while order < 64 and point.is_zero(circle.to_trig(dk)):
-                checkpoint()
-                dk, order = derivative(dk), order + 1
-            if order == 0 or point.is_zero(circle.to_trig(dk)):
-                continue
+            try:
+                dk, order = p, 0
+                while order < 64 and point.is_zero(circle.to_trig(dk)):
+                    checkpoint()
+                    dk, order = derivative(dk), order + 1
+                if order == 0 or point.is_zero(circle.to_trig(dk)):
+                    continue
+            except NotExact:
+                continue  # left to the branch-and-bound (an undecided window, if a root)
             for e in range(1, 64):
                 checkpoint()
                 rr.bisect_to(fmpq(1, 2 ** (e + 1)))

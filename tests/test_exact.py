@@ -307,6 +307,18 @@ def test_mixed_path_meeting_the_sphere_at_an_algebraic_time_is_decided(interval,
     assert report.verdict != "unknown"
 
 
+def test_mixed_path_meeting_the_sphere_at_t_zero_through_a_factor_t_is_decided():
+    """scale = 1 + t(1 + cos t)/64: μ's factor t gives an algebraic root t = 0 (found by
+    a campaign: the exact step refused t = 0, where sin t and cos t are exact); four
+    modes are singular there at once, decided exactly in Q."""
+    report = certify(ORTHOGLIDE.replace("LO", "0"),
+                     trajectory("0", "pi/4", **along(X0_TEXT, "1 + t*(1 + cos(t))/64")))
+    [at_zero] = [c for c in report.candidates if c.t.contains(0)]
+    assert set(at_zero.singular_modes) == modes_singular_on_sphere(X0)
+    assert all(m.status != "unknown" for m in at_zero.modes)
+    assert report.verdict == "singular"
+
+
 @pytest.mark.parametrize("interval, scale, oracle, end", [
     (("0", "pi/4"), "1 + (cos(t) - sin(t))^2*(1 + t)/64",
      lambda t: 1 + (mpmath.cos(t) - mpmath.sin(t)) ** 2 * (1 + t) / 64, "end"),

@@ -53,8 +53,16 @@ from singcheck.algebra.radicals import radical_prime
 from singcheck.algebra.trig import TRIG, evaluate_trig, reduce_trig, uses_t, uses_trig
 from singcheck.budget import checkpoint
 from singcheck.certify.path import PathModel
-from singcheck.roots.angle_zeros import AngleZero
-from singcheck.roots.enclosures import AT_ANGLE_ZERO, AT_POINT, IN_MIXED, IN_T, IN_U, ExactTime
+from singcheck.roots.angle_zeros import AngleZero, univariate
+from singcheck.roots.enclosures import (
+    AT_ANGLE_ZERO,
+    AT_POINT,
+    IN_MIXED,
+    IN_T,
+    IN_U,
+    ExactTime,
+    point_time,
+)
 from singcheck.roots.half_angle import half_angle_polynomial
 from singcheck.roots.isolation import as_univariate_t
 from singcheck.roots.rational import RationalRoot, minimal_polynomial, rational_ball
@@ -360,10 +368,7 @@ class CircleAtAlgebraicTime:
         if circle is None and f.degree() == 1 and f[0] == 0:
             raise NotExact("t = 0: sin t and cos t are algebraic there")
         if circle is not None:
-            g = fmpq_poly([0] * (circle.g.degrees()[0] + 1))
-            for (i, _, _), coeff in circle.g.terms():
-                g += fmpq_poly([0] * i + [coeff])
-            if (g % f).is_zero():
+            if (univariate(circle.g) % f).is_zero():
                 raise NotExact("the pose angle's polynomial g vanishes at the root, where the "
                                "point is algebraic")
         self.circle = circle
@@ -389,6 +394,19 @@ class CircleAtAlgebraicTime:
         return evaluate_trig(p, t)
 
 
+def _at_algebraic_time(time: ExactTime, circle):
+    """The base field at an algebraic root τ of a mixed or pose-angle path: at t = 0
+    (sin, cos exact) Q itself; at a zero of the pose angle's g the algebraic point
+    (τ, cos qπ, sin qπ); elsewhere the generic point of the circle over Q(τ)."""
+    root = minimal_polynomial(time.locate())
+    f = root.poly
+    if circle is None and f.degree() == 1 and f[0] == 0:
+        return AlgebraicPoint(point_time(Fraction(0), 0, 1))
+    if circle is not None and (univariate(circle.g) % f).is_zero():
+        return AngleZero(root, circle.q)
+    return CircleAtAlgebraicTime(time, circle)
+
+
 def exact_point(time: ExactTime, root=None, circle=None, mixed: bool = False):
     """The base field of the exact decisions at a root with this exact time; ``root``
     (its :class:`~singcheck.roots.enclosures.RealRoot`) only for a path that uses the
@@ -400,7 +418,7 @@ def exact_point(time: ExactTime, root=None, circle=None, mixed: bool = False):
     if time.kind == AT_ANGLE_ZERO:
         return AngleZero(time.locate(), time.angle_q)
     if time.kind == IN_T and (mixed or circle is not None):
-        return CircleAtAlgebraicTime(time, circle)
+        return _at_algebraic_time(time, circle)
     if time.kind in (IN_U, AT_POINT) and time.t_value is None and root is not None and \
             excludes_zero(root.t):
         return TimeTranscendentalPoint(time, root)

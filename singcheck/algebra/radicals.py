@@ -31,7 +31,7 @@ import math
 import re
 from fractions import Fraction
 
-from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
+from flint import arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
 
 from singcheck.algebra.trig import TRIG, evaluate_trig, evaluate_trig_at
 
@@ -490,21 +490,50 @@ def _on_angle_circle(p: fmpq_mpoly) -> fmpq_mpoly | None:
     return out
 
 
-def _extra_balls(ctx: fmpq_mpoly_ctx, t: arb, signs) -> list:
-    """Balls of the variables after t, s, c: ±√q, or cos/sin of an angle function."""
-    signs = signs or {}
+_DESCRIPTORS: dict[int, tuple[fmpq_mpoly_ctx, list]] = {}
+_LAST_EXTRA: tuple = (None, None, 0, None, [])  # (ctx, t, precision, signs, balls)
+
+
+def _descriptors(ctx: fmpq_mpoly_ctx) -> list:
+    """Per variable after t, s, c: ("sqrt", q) or ("angle", key, g, k, is_cos), once per
+    ring (a ring lives as long as the process: FLINT keeps its contexts)."""
+    hit = _DESCRIPTORS.get(id(ctx))
+    if hit is not None and hit[0] is ctx:
+        return hit[1]
     out = []
-    cache: dict[str, arb] = {}
     for name in ctx.names()[3:]:
         q = radical_prime(name)
         if q is not None:
-            out.append(arb(q).sqrt() * signs.get(q, 1))
+            out.append(("sqrt", q))
             continue
-        p, k = angle_function_of(name)
-        key = name[4:-1]
+        g, k = angle_function_of(name)
+        out.append(("angle", name[4:-1], g, k, name.startswith("cos(")))
+    _DESCRIPTORS[id(ctx)] = (ctx, out)
+    return out
+
+
+def _extra_balls(ring: fmpq_mpoly_ctx, t: arb, signs) -> list:
+    """Balls of the variables after t, s, c: ±√q, or cos/sin of an angle function;
+    remembered for the last ball, ring and precision asked for (a polynomial and its
+    derivative are enclosed on the same box one after the other).  The list returned
+    is shared: callers only read it."""
+    global _LAST_EXTRA
+    last = _LAST_EXTRA
+    if last[1] is t and last[0] is ring and last[2] == ctx.prec and last[3] == signs:
+        return last[4]
+    signs_ = signs or {}
+    out = []
+    cache: dict[str, tuple[arb, arb]] = {}
+    for d in _descriptors(ring):
+        if d[0] == "sqrt":
+            out.append(arb(d[1]).sqrt() * signs_.get(d[1], 1))
+            continue
+        _, key, g, k, is_cos = d
         if key not in cache:
-            cache[key] = evaluate_trig(p, t) + arb.pi() * arb(fmpq(k.numerator, k.denominator))
-        out.append(cache[key].cos() if name.startswith("cos(") else cache[key].sin())
+            angle = evaluate_trig(g, t) + arb.pi() * arb(fmpq(k.numerator, k.denominator))
+            cache[key] = angle.sin_cos()
+        out.append(cache[key][1] if is_cos else cache[key][0])
+    _LAST_EXTRA = (ring, t, ctx.prec, signs, out)
     return out
 
 

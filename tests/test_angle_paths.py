@@ -14,6 +14,7 @@ from fractions import Fraction
 
 import mpmath as mp
 import pytest
+from flint import fmpq
 
 from singcheck import api
 from singcheck.algebra.radicals import angle_function, path_ring
@@ -129,12 +130,16 @@ def test_cos_of_the_angle_in_a_coordinate_needs_that_angle(tmp_path, angle):
         api.load_trajectory(path, _ROBOT[0])
 
 
-def test_two_independent_angles_stay_undecided_with_the_reason():
+def test_two_independent_angles_a_structural_touch_is_found_through_the_norm():
     """(sin(t²) - sin(t)/2)²: a touch at a point (τ, cos τ, cos τ²) whose transcendence
-    degree is not known (Schanuel's conjecture), so no exact test applies: the window
-    stays undecided, with the reason, and nothing is claimed there."""
+    degree is not known (Schanuel's conjecture), so no generic-point test applies.  The
+    norm over both sines is a square, its factor changes sign at τ (bracketed), and the
+    conjugates other than p itself ((sin t²+ sin(t)/2)²) are enclosed away from 0 there:
+    so p vanishes at τ, proven.  The same path lifted by 10⁻⁶ has no zero, and none is
+    claimed."""
     mp.mp.dps = 50
     tau = mp.findroot(lambda t: mp.sin(t * t) - mp.sin(t) / 2, mp.mpf("0.47"))
+    assert mp.sin(tau * tau) + mp.sin(tau) / 2 > mp.mpf("0.1")  # the conjugate is not 0
     g = TRIG.gens()[0] ** 2
     names = angle_function(g, Fraction(0))
     ring = path_ring([], [names])
@@ -143,9 +148,12 @@ def test_two_independent_angles_stay_undecided_with_the_reason():
     p = (S - s / 2) ** 2
     interval = TimeRange(LinearInPi(Fraction(484, 1000)), LinearInPi(Fraction(486, 1000)))
     iso = isolate_real_roots(p, interval, tolerance=1e-5)  # coarse: fewer boxes
-    assert not iso.roots
-    assert any(w.t.lower() - 1e-9 <= float(tau) <= w.t.upper() + 1e-9 for w in iso.undecided)
-    assert all("tangency" in w.reason for w in iso.undecided)
+    assert not iso.undecided
+    [root] = iso.roots
+    assert float(root.t.lower()) <= tau <= float(root.t.upper())
+    lift = ring.from_dict({(0,) * len(ring.names()): fmpq(1, 10 ** 6)})
+    lifted = isolate_real_roots(p + lift, interval, tolerance=1e-5)
+    assert not lifted.roots and not lifted.undecided
     assert angle_circle(p) is None
     assert angle_circle(S * S + c) is None  # any use of sin t, cos t with the angle
 

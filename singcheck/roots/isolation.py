@@ -20,6 +20,7 @@ from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 from singcheck.algebra.intervals import excludes_zero, working_precision
 from singcheck.algebra.polynomials import restrict
 from singcheck.algebra.radicals import (
+    angle_function_of,
     conjugates,
     evaluate_path,
     norm_radicals,
@@ -205,6 +206,95 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
     return RootIsolation(tuple(roots), tuple(undecided + apart), BRANCH_AND_BOUND)
 
 
+#: the norm over two circles is factored only for a polynomial this small (FLINT's
+#: multivariate factoring is one uninterruptible call): larger ones keep the plain
+#: branch-and-bound
+_MAX_DOUBLE_NORM_TERMS, _MAX_DOUBLE_NORM_DEGREE = 300, 24
+
+
+def _split_odd(p: fmpq_mpoly, i: int, j: int) -> tuple[fmpq_mpoly, fmpq_mpoly]:
+    """(a, b) free of variable i with p ≡ a + xᵢ·b modulo xᵢ² + xⱼ² - 1."""
+    ctx = p.context()
+    gens = ctx.gens()
+    one_minus = 1 - gens[j] * gens[j]
+    parts: list[fmpq_mpoly] = [ctx.from_dict({}), ctx.from_dict({})]
+    for exps, coeff in p.terms():
+        e = list(exps)
+        k = e[i]
+        e[i] = 0
+        parts[k % 2] += ctx.from_dict({tuple(e): coeff}) * one_minus ** (k // 2)
+    return parts[0], parts[1]
+
+
+def _through_double_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
+                         ) -> RootIsolation | None:
+    """The zeros of p(t, sin t, cos t, sin G, cos G) (one pose angle G = g(t) + qπ
+    besides t's own sin and cos: two independent trig arguments) when its norm over both
+    sines has a repeated factor — a structural tangency, e.g. (sin(t²) - sin(t)/2)²,
+    which no sign change can prove; None otherwise (then plain branch-and-bound).
+
+    The norm N = ∏ p(±s, ±S) (s = sin t, S = sin G; reduced, a polynomial in t, c, C) is
+    zero wherever p is.  Each irreducible factor k of N is isolated by branch-and-bound
+    on its own (a bracketed zero is proven by a sign change).  At such a zero N = 0, so
+    some conjugate p(σs, τS) vanishes; when every conjugate that is not p itself (as a
+    reduced polynomial) is enclosed away from 0 there, p vanishes: the zero is p's,
+    proven without knowing whether the point (τ, cos τ, cos G(τ)) is generic on k = 0
+    (which would need Schanuel's conjecture).  If p's own enclosure excludes 0 the zero
+    is a conjugate's only; anything else is an undecided window, with the reason."""
+    ctx = p.context()
+    names = ctx.names()
+    if len(names) != 5 or not names[3].startswith("cos(") or \
+            angle_function_of(names[3]) is None or not names[4].startswith("sin("):
+        return None
+    if len(p) > _MAX_DOUBLE_NORM_TERMS or p.total_degree() > _MAX_DOUBLE_NORM_DEGREE:
+        return None
+    a, b = _split_odd(p, 1, 2)  # over s = sin t
+    n1 = a * a - (1 - ctx.gens()[2] ** 2) * b * b
+    a2, b2 = _split_odd(n1, 4, 3)  # over S = sin G
+    norm = a2 * a2 - (1 - ctx.gens()[3] ** 2) * b2 * b2
+    if norm.is_zero() or all(m == 1 for _, m in norm.factor_squarefree()[1]):
+        return None
+    gens = ctx.gens()
+    conjugates = []
+    for sigma, tau in ((1, -1), (-1, 1), (-1, -1)):
+        q = reduce_relations(p.compose(gens[0], sigma * gens[1], gens[2], gens[3],
+                                       tau * gens[4]))
+        if q != p:
+            conjugates.append(q)
+    roots: list[RealRoot] = []
+    undecided: list[Undecided] = []
+    for k, _ in norm.factor()[1]:
+        if k.is_constant():
+            continue
+        checkpoint()
+        iso = branch_and_bound(k, interval, tolerance)
+        undecided += [Undecided(w.t, "possible tangency: the zeros of μ there are zeros of "
+                                "a factor of its norm over sin t and the angle's sine, "
+                                f"which could not be isolated ({w.reason})")
+                      for w in iso.undecided]
+        for r in iso.roots:
+            checkpoint()
+            verdict = None
+            for step in range(4):
+                rr = r.refined(tolerance * 10.0 ** (-4 * step)) if step else r
+                with working_precision(64 << step):
+                    if excludes_zero(evaluate_path(p, rr.t)):
+                        verdict = False
+                    elif all(excludes_zero(evaluate_path(q, rr.t)) for q in conjugates):
+                        verdict = True
+                if verdict is not None:
+                    break
+            if verdict:
+                roots.append(RealRoot(r.t, None, r._refine, exact=None))
+            elif verdict is None:
+                undecided.append(Undecided(r.t, "possible tangency: p and a conjugate "
+                                           "(sin t or the angle's sine negated) may both "
+                                           f"vanish near t ≈ {float(r.t.mid()):.9g}"))
+    roots, apart = _merge_apart(roots, tolerance, "two zeros of factors of the norm of μ "
+                                "over two sines could not be separated")
+    return RootIsolation(tuple(roots), tuple(undecided + apart), BRANCH_AND_BOUND)
+
+
 def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
     """Whether p is exactly 0 at a bracketed zero of a norm factor (None: undecided)."""
     time = root.exact
@@ -252,7 +342,10 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
             return isolate_real_roots(restrict(p, TRIG), interval, tolerance)
         if angle_circle(p) is not None:  # t and one pose angle g(t) + qπ, g ∈ Q[t]
             return _mixed(p, interval, tolerance)
-        return branch_and_bound(p, interval, tolerance)  # angle functions: t mixed with them
+        # angle functions: t mixed with them (two arguments: a structural tangency
+        # through the norm over both sines)
+        return _through_double_norm(p, interval, tolerance) or \
+            branch_and_bound(p, interval, tolerance)
     p = reduce_trig(poly)
     if p.is_zero():
         raise IdenticallyZeroError("the function is identically zero along the path")

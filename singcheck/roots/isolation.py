@@ -261,11 +261,12 @@ def _through_double_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
                                        tau * gens[4]))
         if q != p:
             conjugates.append(q)
+    factors = [k for k, _ in norm.factor()[1] if not k.is_constant()]
+    if sum(len(k) for k in factors) > 2 * len(p) + 64:
+        return None  # the branch-and-bound on factors this large costs more than on p
     roots: list[RealRoot] = []
     undecided: list[Undecided] = []
-    for k, _ in norm.factor()[1]:
-        if k.is_constant():
-            continue
+    for k in factors:
         checkpoint()
         iso = branch_and_bound(k, interval, tolerance)
         undecided += [Undecided(w.t, "possible tangency: the zeros of μ there are zeros of "

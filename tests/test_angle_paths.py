@@ -312,3 +312,21 @@ def test_a_pose_angle_offset_with_a_huge_denominator_is_not_taken_exactly(tmp_pa
     assert time.process_time() - start < 20
     assert result.verdict == "singular"
     assert any(float(c.t.lower()) <= tau <= float(c.t.upper()) for c in result.candidates)
+
+
+def test_a_zero_at_t_0_of_a_path_with_two_arguments_is_an_exact_point(tmp_path):
+    """x = 2 + (sin(t)/2 - sin(t²))²/4, y = 2, phi = t²: at t = 0 the pose is (2, 2) at
+    φ = 0, on the 3-RPR's surface (det A = 0, computed here), and there sin t, cos t and
+    the angle's cos, sin are all exact (g(0) = 0), so the zero and its multiplicity are
+    decided exactly; it stayed a cloud of undecided windows around 0 (campaign)."""
+    mp.mp.dps = 50
+    oracle = oracles.three_rpr()
+    assert oracle.det_A(None, [mp.mpf(2), mp.mpf(2), mp.mpf(0)]) == 0
+    text = ANGLE_ZERO.format(lo="-1/2", hi="3/4", x="2 + (sin(t)/2 - sin(t^2))^2/4",
+                             y="2", phi="t^2")
+    result = _run(tmp_path, text)
+    assert result.verdict == "singular", result.reason
+    at_zero = [c for c in result.candidates if c.t.is_exact() and c.t == 0]
+    assert len(at_zero) == 1
+    assert not any(float(u[0].lower()) <= 0 <= float(u[0].upper())
+                   for u in result.certificate.undecided)

@@ -110,11 +110,36 @@ _MAX_ORDER = 64
 
 
 def vanishes_at_multiple_of_pi(p: fmpq_mpoly, k: int) -> bool:
-    """Exactly: p(kπ, 0, (-1)^k) = 0 (see the module docstring)."""
+    """Exactly: p(kπ, 0, (-1)^k) = 0 (see the module docstring).  At t = 0 a pose angle
+    G = g(t) + qπ with g(0) = 0 and 2q an integer is exact too (cos G, sin G in
+    {0, ±1}): it is substituted, so that a zero of μ at t = 0 on a path mixing sin t
+    with such an angle is decided (otherwise the angle's cos, sin stay unknowns, and only
+    "zero whatever their values" counts)."""
     q = p.subs({"s": 0, "c": 1 if k % 2 == 0 else -1})
     if k == 0:
-        q = q.subs({"t": 0})
+        q = q.subs({"t": 0, **_exact_angles_at_zero(q.context())})
     return q.is_zero()
+
+
+def _exact_angles_at_zero(ring) -> dict[str, int]:
+    """{cos(g): cos qπ, sin(g): sin qπ} for the ring's angle functions with g(0) = 0 and
+    2q an integer."""
+    from singcheck.algebra.radicals import angle_function_of
+    from singcheck.roots.angle_zeros import exact_sin_cos
+
+    out: dict[str, int] = {}
+    for name in ring.names()[3:]:
+        if not name.startswith("cos("):
+            continue
+        found = angle_function_of(name)
+        if found is None:
+            continue
+        g, q = found
+        sc = exact_sin_cos(q)
+        if sc is None or not g.subs({"t": 0, "s": 0, "c": 1}).is_zero():
+            continue
+        out[name], out["sin(" + name[4:]] = sc[1], sc[0]
+    return out
 
 
 def _exact_zeros(p: fmpq_mpoly, interval: TimeRange) -> list[tuple[int, int, fmpq, fmpq]]:

@@ -47,6 +47,7 @@ from singcheck.roots.enclosures import (
 )
 from singcheck.roots.half_angle import _half_angle
 from singcheck.roots.rational import (
+    arb_to_fmpq,
     exact_tolerance,
     no_root_between,
     nonzero_on,
@@ -296,6 +297,28 @@ def _through_double_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
     return RootIsolation(tuple(roots), tuple(undecided + apart), BRANCH_AND_BOUND)
 
 
+def _windows_through_double_norm(p: fmpq_mpoly, iso: RootIsolation, tolerance: float
+                                 ) -> RootIsolation:
+    """Each window the branch-and-bound left undecided, tried again through the norm
+    over both sines (:func:`_through_double_norm`) on that window alone: its roots
+    replace the window when that decides it.  The branch-and-bound proved every other
+    stretch, so a root of p lies in a window; only the windows cost the norm's work."""
+    if not iso.undecided:
+        return iso
+    roots, undecided = list(iso.roots), []
+    for window in iso.undecided:
+        checkpoint()
+        lo, hi = arb_to_fmpq(window.t.lower()), arb_to_fmpq(window.t.upper())
+        sub = TimeRange(LinearInPi(to_fraction(lo)), LinearInPi(to_fraction(hi)))
+        found = _through_double_norm(p, sub, tolerance) if lo < hi else None
+        if found is None or found.undecided:
+            undecided.append(window)
+            continue
+        roots += found.roots
+    roots.sort(key=lambda r: float(r.t.mid()))
+    return RootIsolation(tuple(roots), tuple(undecided), iso.method, iso.exact)
+
+
 def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
     """Whether p is exactly 0 at a bracketed zero of a norm factor (None: undecided)."""
     time = root.exact
@@ -343,10 +366,10 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
             return isolate_real_roots(restrict(p, TRIG), interval, tolerance)
         if angle_circle(p) is not None:  # t and one pose angle g(t) + qπ, g ∈ Q[t]
             return _mixed(p, interval, tolerance)
-        # angle functions: t mixed with them (two arguments: a structural tangency
-        # through the norm over both sines)
-        return _through_double_norm(p, interval, tolerance) or \
-            branch_and_bound(p, interval, tolerance)
+        # angle functions: t mixed with them (two arguments: the windows the
+        # branch-and-bound leaves, a structural tangency, through the norm over both sines)
+        return _windows_through_double_norm(p, branch_and_bound(p, interval, tolerance),
+                                            tolerance)
     p = reduce_trig(poly)
     if p.is_zero():
         raise IdenticallyZeroError("the function is identically zero along the path")

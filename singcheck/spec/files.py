@@ -245,6 +245,10 @@ def _yaml_error(e, path: str, offset: int = 0) -> SpecError:
         mark = e.problem_mark or e.context_mark
         line = mark.line + 1 + offset if mark else None
         problem = (e.problem or e.context or "invalid YAML").strip()
+        if "maximum nesting depth" in problem:  # libyaml ≥ 0.2.6 stops at 1000 levels,
+            # scanning ahead of the events our own bound counts: the same refusal
+            return SpecError(f"lists and mappings are nested more than {MAX_YAML_DEPTH} "
+                             "levels deep", path=path, line=line)
         return SpecError(f"not valid YAML: {problem}", path=path, line=line)
     return SpecError(f"not valid YAML: {str(e).splitlines()[0]}", path=path)
 

@@ -163,21 +163,29 @@ def evaluate_trig(p: fmpq_mpoly, t: arb, tight: bool = False) -> arb:
     returned: each contains every value.
     """
     split = _split(p)
-    if type(split) is tuple:  # free of t: P₀(c) + s·P₁(c)
-        s, c = _sin_cos_multiple(t, 1)
-        p0, p1 = split
-        total = p0(c) if p1 is None else p0(c) + s * p1(c)
-    elif isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
+    if isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
         return split(t)
-    else:
-        s, c = _sin_cos_multiple(t, 1)
-        total = arb(0)
-        for p0, p1 in reversed(split):
-            total = total * t + p0(c) + s * p1(c)
+    s, c = _sin_cos_multiple(t, 1)
+    total = evaluate_split(split, t, s, c)
     if tight and t.rad() > _WIDE:
         fourier = _fourier_value(p, t)
         if fourier is not None:  # each of the three balls holds every value: the narrowest
             return min((total, fourier, total.intersection(fourier)), key=lambda b: b.rad())
+    return total
+
+
+def evaluate_split(split, t: arb, s: arb, c: arb) -> arb:
+    """The enclosure :func:`evaluate_trig` (not ``tight``) makes from ``_split(p)`` at
+    the current precision, given Arb's balls of sin t and cos t over the ball t: for
+    callers that enclose several polynomials over one ball (sin t, cos t once)."""
+    if type(split) is tuple:  # free of t: P₀(c) + s·P₁(c)
+        p0, p1 = split
+        return p0(c) if p1 is None else p0(c) + s * p1(c)
+    if isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
+        return split(t)
+    total = arb(0)
+    for p0, p1 in reversed(split):
+        total = total * t + p0(c) + s * p1(c)
     return total
 
 
@@ -386,3 +394,7 @@ def _split_at_precision(p: fmpq_mpoly):
     if dt == 0:
         return (split[0][0], split[0][1] if ds > 0 else None)
     return split
+
+
+#: :func:`_split` under a public name: the ball polynomials :func:`evaluate_split` takes
+ball_split = _split

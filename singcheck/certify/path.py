@@ -343,7 +343,7 @@ def _det_a_by_joints(model: RobotModel) -> list[tuple[tuple[tuple[int, int], ...
 _LIMIT_BALLS: dict = {}
 
 
-def _limit_balls(limits) -> tuple[arb, arb]:
+def limit_balls(limits) -> tuple[arb, arb]:
     """The balls of a prismatic joint's rational limits (exact when dyadic), once per
     limits object and working precision: feasibility proofs compare against them
     thousands of times (keyed by the object, not by hashing its Fractions each time)."""
@@ -372,7 +372,7 @@ def inside_limits(leg: Leg, value, limits) -> bool | None:
         mid = (lo + hi) / 2
         margin = value[0] * mid.cos() + value[1] * mid.sin() - (width / 2).cos()
         return True if margin > 0 else False if margin < 0 else None
-    lo, hi = _limit_balls(limits)
+    lo, hi = limit_balls(limits)
     if value > lo and value < hi:
         return True
     if value < lo or value > hi:

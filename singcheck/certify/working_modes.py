@@ -36,6 +36,7 @@ from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
 from singcheck.budget import checkpoint
 from singcheck.certify.exact import vanishes_at_root
 from singcheck.certify.path import LegAlongPath, PathModel, joint_float
+from singcheck.certify.sweep import sweep_quick_proofs
 from singcheck.roots.enclosures import IN_MIXED, IdenticallyZeroError, RootIsolation
 from singcheck.roots.isolation import isolate_real_roots
 
@@ -239,13 +240,14 @@ def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True,
 
 
 def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when,
-                 cover: _Cover | None = None):
+                 cover: _Cover | None = None, quick: bool = True):
     """Status of both branches of a quadratic leg with respect to step 1 (``when``
-    writes a time ball in the user's parameter)."""
+    writes a time ball in the user's parameter; ``quick=False`` when the quick proof
+    was tried already, by :mod:`.sweep`)."""
     joint = leg.leg.joint
     cover = cover or _Cover(leg, interval)
-    if _everywhere(lambda t, tight: cover.discriminant(t, tight) > 0, cover.range,
-                   cover.retry_tight, cover):
+    if quick and _everywhere(lambda t, tight: cover.discriminant(t, tight) > 0,
+                             cover.range, cover.retry_tight, cover):
         return FEASIBLE, "", None
     iso = _isolate(leg.discriminant, interval, tolerance)
     if iso is None:
@@ -273,19 +275,21 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when,
 
 def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
                    tolerance: float, crossings: dict, when,
-                   cover: _Cover | None = None) -> BranchFeasibility:
+                   cover: _Cover | None = None, quick: bool = True) -> BranchFeasibility:
     """Whether this branch stays strictly inside the joint limits along the whole path.
 
     ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
     the leg equals it (one polynomial serves both branches); ``cover`` shares the quick
-    proofs' enclosures with the leg's other proofs."""
+    proofs' enclosures with the leg's other proofs; ``quick=False`` when the quick proof
+    was tried already (by :mod:`.sweep`)."""
     joint = leg.leg.joint
     cover = cover or _Cover(leg, interval)
     if leg.inside(cover.branches(cover.start)[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
                                  f"{joint} is outside {_bounds(limits)} from the start")
-    if _everywhere(lambda t, tight: leg.inside(cover.branches(t, tight)[label], limits) is True,
-                   cover.range, cover.retry_tight, cover):
+    if quick and _everywhere(lambda t, tight: leg.inside(cover.branches(t, tight)[label],
+                                                          limits) is True,
+                             cover.range, cover.retry_tight, cover):
         return BranchFeasibility(joint, label, FEASIBLE)
     events: list[arb] = []
     undecided = []
@@ -391,15 +395,19 @@ def leg_branches(path: PathModel, tolerance: float,
     interval = path.trajectory.range
     limits_of = path.projection.model.spec.joint_limits
     covers = covers or [_Cover(leg, interval) for leg in path.legs]
+    proven, tried = sweep_quick_proofs(path, covers, limits_of, _pieces, _halves, _budget)
 
     def when(t: arb) -> str:
         return f"{float(path.trajectory.to_global(arb(t)).mid()):.6g}"
 
     out = []
-    for leg, cover in zip(path.legs, covers, strict=True):
+    for i, (leg, cover) in enumerate(zip(path.legs, covers, strict=True)):
         joint = leg.leg.joint
-        if leg.discriminant is not None:
-            status, reason, event = _leg_reality(leg, interval, tolerance, when, cover)
+        if (i, None) in proven:
+            status, reason, event = FEASIBLE, "", None
+        elif leg.discriminant is not None:
+            status, reason, event = _leg_reality(leg, interval, tolerance, when, cover,
+                                                 quick=(i, None) not in tried)
         else:
             status, reason, event = FEASIBLE, "", None
         branches = []
@@ -407,9 +415,12 @@ def leg_branches(path: PathModel, tolerance: float,
         for label in leg.labels:
             if status != FEASIBLE:
                 branches.append(BranchFeasibility(joint, label, status, reason, event))
+            elif (i, label) in proven:
+                branches.append(BranchFeasibility(joint, label, FEASIBLE))
             elif joint in limits_of:
                 branches.append(_branch_limits(leg, label, interval, limits_of[joint],
-                                               tolerance, crossings, when, cover))
+                                               tolerance, crossings, when, cover,
+                                               quick=(i, label) not in tried))
             else:
                 branches.append(BranchFeasibility(joint, label, FEASIBLE))
         out.append(branches)

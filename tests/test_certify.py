@@ -86,3 +86,64 @@ def test_roots_at_range_ends_are_kept(start, end):
     report = certify(BIGLIDE, ellipse(start, end))
     assert len(report.candidates) == 2  # y = 0 at both ends
     assert report.verdict == "singular"
+
+
+def _biglide_path(limits: str, x: str):
+    model = build_model(parse_robot(BIGLIDE.replace("{p: [-4, 4], q: [-4, 4]}", limits),
+                                    "r.yaml"))
+    projection = project_robot(model, get_backend("sympy"))
+    text = f"name: e\nparameter: t\nrange: [0, 2*pi]\npose:\n  x: {x}\n  y: 1 + sin(t)/4\n"
+    return build_path(projection, parse_trajectory(text, "t.yaml", model.spec))
+
+
+def _branch(t, sign: int, length2, x_of) -> object:
+    import mpmath as mp
+
+    y = 1 + mp.sin(t) / 4
+    return x_of(t) + sign * mp.sqrt(length2 - y * y)
+
+
+def test_the_leg_sweep_proves_only_what_holds_at_every_sample():
+    """The one-walk quick proofs (certify/sweep.py): every fact it proves holds at 2000
+    points of the path at 50 digits, and the facts that fail there are not proven."""
+    import mpmath as mp
+
+    from singcheck.certify.sweep import sweep_quick_proofs
+    from singcheck.certify.working_modes import _budget, _Cover, _halves, _pieces
+
+    mp.mp.dps = 50
+    path = _biglide_path("{p: [0, 4], q: [-1, 1]}", "cos(t)")
+    covers = [_Cover(leg, path.trajectory.range) for leg in path.legs]
+    limits = path.projection.model.spec.joint_limits
+    proven, tried = sweep_quick_proofs(path, covers, limits, _pieces, _halves, _budget)
+    samples = [2 * mp.pi * k / 1999 for k in range(2000)]
+    legs = {0: (4, (0, 4)), 1: (mp.mpf(9) / 4, (-1, 1))}  # l², limits
+    for (i, label) in tried:
+        length2, (lo, hi) = legs[i]
+        if label is None:
+            holds = all(length2 - (1 + mp.sin(t) / 4) ** 2 > 0 for t in samples)
+        else:
+            sign = 1 if label == "+" else -1
+            holds = all(lo < _branch(t, sign, length2, mp.cos) < hi for t in samples)
+        assert holds == ((i, label) in proven), (i, label)
+    # p = cos t + √(4 - y²) stays in (0, 4); q = cos t + √(9/4 - y²) starts outside
+    # [-1, 1] (not swept: decided at the start), q = cos t - √(…) starts inside, leaves
+    assert {(0, None), (1, None), (0, "+")} <= proven
+    assert (1, "+") not in tried and (0, "-") not in tried
+    assert (1, "-") in tried and (1, "-") not in proven
+
+
+def test_a_branch_the_sweep_cannot_prove_leaves_its_limits_at_the_right_time():
+    """p = 2 cos t + √(4 - y²) starts inside [0, 4] and goes below 0: the sweep tries and
+    fails, the limit crossing is isolated; its time agrees with mpmath's root."""
+    import mpmath as mp
+
+    from singcheck.certify.working_modes import working_modes
+
+    mp.mp.dps = 50
+    path = _biglide_path("{p: [0, 4], q: [-4, 4]}", "2*cos(t)")
+    modes = {m.label: m for m in working_modes(path)}
+    branch = next(b for b in modes["++"].branches if b.joint == "p")
+    assert branch.status == "infeasible" and "p leaves [0, 4]" in branch.reason
+    root = mp.findroot(lambda t: _branch(t, 1, 4, lambda u: 2 * mp.cos(u)), 2.5)
+    assert abs(float(branch.event_time.mid()) - float(root)) < 1e-8

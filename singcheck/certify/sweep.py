@@ -25,7 +25,7 @@ from flint import arb
 
 from singcheck.algebra.trig import TRIG, ball_split, evaluate_split
 from singcheck.budget import checkpoint
-from singcheck.certify.path import limit_balls, inside_limits
+from singcheck.certify.path import inside_limits, limit_balls
 from singcheck.model.robot import REVOLUTE
 
 #: a fact: (leg index, None) for "D > 0", (leg index, label) for "the branch is inside"

@@ -380,6 +380,8 @@ def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | tuple | arb_poly:
 
 
 def _split_at_precision(p: fmpq_mpoly):
+    """:func:`_split` at the current precision (FLINT rounds each rational coefficient
+    outward when it makes the ball polynomial from an exact one)."""
     q = reduce_trig(p)
     dt, ds, dc = q.degrees()
     if ds == 0 and dc == 0:
@@ -387,13 +389,19 @@ def _split_at_precision(p: fmpq_mpoly):
         for (i, _, _), a in q.terms():
             by_t[i] = a
         return arb_poly(fmpq_poly(by_t))
+    if dt <= 0 and ds <= 0 and dc >= 0:
+        cs = q.coeffs()
+        if len(cs) == dc + 1:  # dense in c: its terms are c^dc, …, c^0 in that order
+            return (arb_poly(fmpq_poly(cs[::-1])), None)
+    if dt <= 0 and dc >= 0:
+        rows = [[fmpq(0)] * (dc + 1), [fmpq(0)] * (dc + 1)]
+        for (_, j, k), a in q.terms():
+            rows[j][k] = a
+        return (arb_poly(fmpq_poly(rows[0])), arb_poly(fmpq_poly(rows[1])) if ds > 0 else None)
     coeffs = [[[fmpq(0)] * (dc + 1) for _ in range(2)] for _ in range(dt + 1)]
     for (i, j, k), a in q.terms():
         coeffs[i][j][k] = a
-    split = [tuple(arb_poly([arb(a) for a in row]) for row in by_t) for by_t in coeffs]
-    if dt == 0:
-        return (split[0][0], split[0][1] if ds > 0 else None)
-    return split
+    return [tuple(arb_poly(fmpq_poly(row)) for row in by_t) for by_t in coeffs]
 
 
 #: :func:`_split` under a public name: the ball polynomials :func:`evaluate_split` takes

@@ -189,9 +189,12 @@ def isolation_degree(mu: fmpq_mpoly) -> int:
     if any(d > 0 for i, (v, d) in enumerate(zip(names, degrees, strict=True))
            if v not in ("s", "c") and i not in radicals):
         return 0
+    used = sum(1 for i in radicals if degrees[i] > 0)
+    if not used:  # only s and c occur: the degree in them is the total degree
+        return 2 * max(int(mu.total_degree()), 0)
     si, ci = names.index("s"), names.index("c")
     trig = max((e[si] + e[ci] for e in mu.monoms()), default=0)
-    return 2 * trig * 2 ** sum(1 for i in radicals if degrees[i] > 0)
+    return 2 * trig * 2 ** used
 
 
 def _too_costly(what: str, trajectory: TrajectorySpec) -> SpecError:

@@ -17,6 +17,7 @@ from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.trig import LinearInPi, TimeRange
+from singcheck.algebra.trig import S as _S
 from singcheck.budget import checkpoint
 from singcheck.roots.enclosures import (
     HALF_ANGLE,
@@ -60,23 +61,37 @@ def _half_angle_parts(p: fmpq_mpoly) -> tuple[fmpq_poly, fmpq_poly | None, int]:
 
     Writing c = (1-w)/(1+w) = -1 + 2y with y = 1/(1+w),
     (1+w)^m P(c) = y^(-m) P(-1 + 2y) is the reversal of P(-1 + 2y) taken at 1 + w: two
-    compositions with linear polynomials in FLINT and a reversal.
+    compositions with linear polynomials in FLINT and a reversal.  P₀ = p(s = 0) and
+    s·P₁ = p - P₀ (p has degree ≤ 1 in s), d the total degree of p (free of t).
     """
-    by_s: list[dict[int, fmpq]] = [{}, {}]
-    d = 0
-    for (_i, j, k), c in p.terms():
-        by_s[j][k] = c
-        d = max(d, j + k)
+    d = max(int(p.total_degree()), 0)
+    p0 = p.subs({"s": 0})
+    even = _homogenised(_in_c(p0), d)
+    if p.degrees()[1] <= 0:
+        return even, None, d
+    return even, _homogenised(_in_c((p - p0) / _S), d - 1), d
 
-    def homogenised(coeffs: dict[int, fmpq], n: int) -> fmpq_poly:
-        if not coeffs:
-            return fmpq_poly([])
-        top = max(coeffs)
-        shifted = fmpq_poly([coeffs.get(k, 0) for k in range(top + 1)])(_MINUS_ONE_PLUS_2Y)
-        cs = list(shifted.coeffs()) + [fmpq(0)] * (top + 1 - len(shifted.coeffs()))
-        return fmpq_poly(cs[::-1])(_ONE_PLUS_W) * _ONE_PLUS_W ** (n - top)
 
-    return homogenised(by_s[0], d), homogenised(by_s[1], d - 1) if by_s[1] else None, d
+def _in_c(q: fmpq_mpoly) -> fmpq_poly:
+    """A polynomial of the trig ring in c alone as a univariate polynomial in c."""
+    cs = q.coeffs()
+    top = q.degrees()[2]
+    if len(cs) == top + 1:  # dense: its terms are c^top, …, c^0 in that order
+        return fmpq_poly(cs[::-1])
+    by_power = [fmpq(0)] * (top + 1)
+    for (_, _, k), a in q.terms():
+        by_power[k] = a
+    return fmpq_poly(by_power)
+
+
+def _homogenised(poly: fmpq_poly, n: int) -> fmpq_poly:
+    """(1+w)^n P((1-w)/(1+w)) for P of degree ≤ n, as a polynomial in w."""
+    if poly.is_zero():
+        return fmpq_poly([])
+    top = poly.degree()
+    shifted = poly(_MINUS_ONE_PLUS_2Y)
+    cs = list(shifted.coeffs()) + [fmpq(0)] * (top + 1 - len(shifted.coeffs()))
+    return fmpq_poly(cs[::-1])(_ONE_PLUS_W) * _ONE_PLUS_W ** (n - top)
 
 
 def deflated_half_angle(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:

@@ -21,7 +21,7 @@ enclosures needed); the others keep the leg-by-leg proofs.
 
 from __future__ import annotations
 
-from flint import arb
+from flint import arb, arb_poly
 
 from singcheck.algebra.trig import TRIG, ball_split, evaluate_split
 from singcheck.budget import checkpoint
@@ -94,9 +94,11 @@ def _walk(path, facts: list[Fact], todo: list[arb], halves, budget: int,
         if i not in legs:
             leg = path.legs[i]
             limits = limits_of.get(leg.leg.joint)
-            legs[i] = ([ball_split(p) for p in (leg.coefficients[0], leg.coefficients[1],
-                                                leg.discriminant)],
-                       limit_balls(limits) if limits is not None else None)
+            pa, pb, pd = (ball_split(p) for p in (leg.coefficients[0], leg.coefficients[1],
+                                                  leg.discriminant))
+            if isinstance(pa, arb_poly) and pa.degree() <= 0:  # a constant a: its ball
+                pa = pa(arb(0))
+            legs[i] = (pa, pb, pd, limit_balls(limits) if limits is not None else None)
     work = [(piece, facts) for piece in todo]
     queued = dict.fromkeys(facts, len(todo))
     spent = dict.fromkeys(facts, 0)
@@ -105,7 +107,7 @@ def _walk(path, facts: list[Fact], todo: list[arb], halves, budget: int,
         piece, pending = work.pop()
         checkpoint()
         s, c = piece.sin_cos()
-        values: dict[int, tuple] = {}
+        values: dict[int, list] = {}  # leg -> [D, D > 0, 2a, -b (when asked for)]
         still = []
         for f in pending:
             if f in failed:
@@ -113,21 +115,23 @@ def _walk(path, facts: list[Fact], todo: list[arb], halves, budget: int,
             queued[f] -= 1
             spent[f] += 1
             i, label = f
+            pa, pb, pd, limits = legs[i]
             hit = values.get(i)
             if hit is None:
-                (pa, pb, pd), _ = legs[i]
                 d = evaluate_split(pd, piece, s, c)
-                hit = values[i] = (evaluate_split(pa, piece, s, c),
-                                   evaluate_split(pb, piece, s, c), d, d > 0)
-            a, b, d, real = hit
-            if not real:
+                hit = values[i] = [d, d > 0, None, None]
+            if not hit[1]:
                 still.append(f)
-            elif label is not None:
-                root = d.sqrt()
-                rho = (-b + root if label == "+" else -b - root) / (2 * a)
-                lo, hi = legs[i][1]
-                if not (rho > lo and rho < hi):
-                    still.append(f)
+                continue
+            if label is None:
+                continue
+            if hit[2] is None:
+                a = pa if isinstance(pa, arb) else evaluate_split(pa, piece, s, c)
+                hit[2], hit[3] = 2 * a, -evaluate_split(pb, piece, s, c)
+            root = hit[0].sqrt()
+            rho = (hit[3] + root if label == "+" else hit[3] - root) / hit[2]
+            if not (rho > limits[0] and rho < limits[1]):
+                still.append(f)
         for f in still:
             if spent[f] + queued[f] + 2 > budget:
                 failed.add(f)

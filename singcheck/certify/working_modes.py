@@ -116,26 +116,30 @@ _TIGHT_ABOVE = 0.05  # radius above which a piece gets tight enclosures (high-de
 _TIGHT_DEGREE = 10  # ... when the leg's polynomials have at least this degree in (s, c)
 
 
-def _high_degree(leg: LegAlongPath) -> bool:
-    """Whether Horner in cos t is likely to overestimate badly on wide pieces."""
-    return max(p.degrees()[1] + p.degrees()[2] for p in _leg_polys(leg)
-               if p is not None) >= _TIGHT_DEGREE
+def _high_degree(degrees: list) -> bool:
+    """Whether Horner in cos t is likely to overestimate badly on wide pieces (from the
+    degrees in (t, s, c, …) of the leg's polynomials)."""
+    return max(d[1] + d[2] for d in degrees) >= _TIGHT_DEGREE
 
 
 def _leg_polys(leg: LegAlongPath):
     return (*leg.coefficients, leg.discriminant)
 
 
-def one_period(interval: TimeRange, polys) -> TimeRange:
-    """The part of the range a quick proof about ``polys`` needs to cover.
+def one_period(interval: TimeRange, polys, periodic: bool | None = None) -> TimeRange:
+    """The part of the range a quick proof about ``polys`` needs to cover (``periodic``:
+    whether they are all free of t, when the caller knows).
 
     Trig polynomials free of the bare t are 2π-periodic, so over a range longer than 2π
     they take no value that they do not take on its first 2π: proving a property of
     their values on [start, start + 2π] proves it on the whole range.
     """
     start, end = interval.start, interval.end
-    if any(uses_t(p) for p in polys if p is not None) or \
-            float(end) - float(start) <= 2 * math.pi + 1e-9:
+    if float(end) - float(start) <= 2 * math.pi + 1e-9:
+        return interval
+    if periodic is None:
+        periodic = not any(uses_t(p) for p in polys if p is not None)
+    if not periodic:
         return interval
     return TimeRange(start, LinearInPi(start.rational, start.pi_coefficient + 2))
 
@@ -161,11 +165,12 @@ class _Cover:
 
     def __init__(self, leg: LegAlongPath, interval: TimeRange) -> None:
         self.leg = leg
-        self.range = one_period(interval, _leg_polys(leg))
-        self.retry_tight = _high_degree(leg)
+        degrees = [p.degrees() for p in _leg_polys(leg) if p is not None]
+        self.range = one_period(interval, (), periodic=all(d[0] <= 0 for d in degrees))
+        self.retry_tight = _high_degree(degrees)
         self.start = interval.start.ball()
         self.budget = _budget(self.range)
-        self.constant = all(p is None or p.is_constant() for p in _leg_polys(leg))
+        self.constant = all(max(d) <= 0 for d in degrees)
         self._pieces: list[arb] | None = None
         self._halves: dict[int, tuple[arb, arb, arb]] = {}
         self._seen: dict[tuple[int, bool, int], list] = {}  # -> [ball, D, branches]

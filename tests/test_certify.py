@@ -109,13 +109,12 @@ def test_the_leg_sweep_proves_only_what_holds_at_every_sample():
     import mpmath as mp
 
     from singcheck.certify.sweep import sweep_quick_proofs
-    from singcheck.certify.working_modes import _budget, _Cover, _halves, _pieces
+    from singcheck.certify.working_modes import start_branches
 
     mp.mp.dps = 50
     path = _biglide_path("{p: [0, 4], q: [-1, 1]}", "cos(t)")
-    covers = [_Cover(leg, path.trajectory.range) for leg in path.legs]
     limits = path.projection.model.spec.joint_limits
-    proven, tried = sweep_quick_proofs(path, covers, limits, _pieces, _halves, _budget)
+    proven, tried = sweep_quick_proofs(path, limits, start_branches(path))
     samples = [2 * mp.pi * k / 1999 for k in range(2000)]
     legs = {0: (4, (0, 4)), 1: (mp.mpf(9) / 4, (-1, 1))}  # l², limits
     for (i, label) in tried:
@@ -147,3 +146,50 @@ def test_a_branch_the_sweep_cannot_prove_leaves_its_limits_at_the_right_time():
     assert branch.status == "infeasible" and "p leaves [0, 4]" in branch.reason
     root = mp.findroot(lambda t: _branch(t, 1, 4, lambda u: 2 * mp.cos(u)), 2.5)
     assert abs(float(branch.event_time.mid()) - float(root)) < 1e-8
+
+
+@pytest.mark.parametrize("lo, hi", [(-1, 1), (-3, 1), (0, 2), (-2, -1), (1, 3), (-1, 0)])
+@pytest.mark.parametrize("e", [2, 3, 4, 5])
+def test_a_balls_power_holds_every_power_and_an_even_one_no_negative(lo, hi, e):
+    """intervals.power: x^e for 41 exact points of [lo, hi] lies in the ball, an even
+    power of a ball around 0 stays ≥ 0 and the far end is tight (python-flint's ``**``
+    gives NaN for a ball around 0)."""
+    from fractions import Fraction
+
+    from singcheck.algebra.intervals import power
+
+    ball = arb(fmpq(lo)).union(arb(fmpq(hi)))
+    p = power(ball, e)
+    assert p.is_finite()
+    for k in range(41):
+        x = Fraction(lo) + (Fraction(hi) - Fraction(lo)) * k / 40
+        assert p.contains(arb(fmpq(x.numerator, x.denominator) ** e)), (x, p)
+    powers = [Fraction(lo) ** e, Fraction(hi) ** e] + ([0] if lo < 0 < hi else [])
+    least, most = min(powers) if e % 2 or lo >= 0 or hi <= 0 else 0, max(powers)
+    slack = 1e-6 * float(max(abs(least), abs(most)))  # a ball's radius has 30 bits
+    low, high = float(p.lower()), float(p.upper())  # (outward-rounded ends, exact floats)
+    assert least - slack <= low <= least and most <= high <= most + slack
+
+
+def test_a_path_whose_quick_proofs_pass_never_composes_its_legs(orthoglide_projection):
+    """heart 1: the sweep proves every feasible branch from the pose's balls and the
+    candidates are classified from them too; the legs along the path stay uncomposed
+    (and compose, when asked, to the leg constraint along the path)."""
+    from pathlib import Path
+
+    from singcheck.algebra.trig import TRIG
+    from singcheck.spec.files import load_trajectory
+
+    root = Path(__file__).resolve().parent.parent
+    spec = load_trajectory(root / "trajectories" / "heart1.yaml",
+                           orthoglide_projection.model.spec)
+    path = build_path(orthoglide_projection, spec)
+    report = certify_path(path)
+    assert report.verdict == "singular"
+    assert all(leg._along is None for leg in path.legs)
+    # leg 1: ρ² - 2xρ + (x² + y² + 1 - 4) with x = 8/7 sin³ t, along the path
+    s = TRIG.gens()[1]
+    a, b, c = path.legs[0].coefficients
+    assert a == TRIG.from_dict({(0, 0, 0): 1})
+    assert b == -2 * path.coordinates[0] and path.coordinates[0] == fmpq(8, 7) * s**3 \
+        or b == -2 * path.coordinates[0]

@@ -30,6 +30,42 @@ def fraction_ball(q: Fraction | int) -> arb:
     return arb(fmpq(q.numerator, q.denominator))
 
 
+def power(x: Ball, e: int) -> Ball:
+    """An enclosure of ``x**e`` (e ≥ 1) for every point of the ball ``x``.
+
+    A real ball's power is taken at its ends, where x ↦ x^e reaches its extremes over an
+    interval (it is monotone on each side of 0): [L^e, U^e], or for an even e [U^e, L^e]
+    below 0 and [0, max(|L|, |U|)^e] across it; each end power is a product of exact
+    ends, rounded outward.  (python-flint's ``**`` takes Arb's real power, exp(e·log x):
+    NaN for a ball around 0, and wide for a wide positive one.)  A complex ball is
+    multiplied out."""
+    if e == 1:
+        return x
+    if not isinstance(x, arb):
+        out = x
+        for _ in range(e - 1):
+            out = out * x
+        return out
+    lo, hi = x.lower(), x.upper()
+    if e % 2 == 1 or lo >= 0:
+        return _point_power(lo, e).union(_point_power(hi, e))
+    if hi <= 0:
+        return _point_power(hi, e).union(_point_power(lo, e))
+    return arb(0).union(_point_power(max(-lo, hi), e))
+
+
+def _point_power(p: arb, e: int) -> arb:
+    """p^e for an exact ball p, by squaring and multiplying (each step rounded outward)."""
+    out, base = arb(1), p
+    while e:
+        if e & 1:
+            out = out * base
+        e >>= 1
+        if e:
+            base = base * base
+    return out
+
+
 def evaluate(poly: fmpq_mpoly, values: Sequence[Ball]) -> Ball:
     """Enclose ``poly(values)``; ``values[i]`` is the ball of the i-th generator.
 
@@ -47,7 +83,7 @@ def evaluate(poly: fmpq_mpoly, values: Sequence[Ball]) -> Ball:
             else:
                 p = powers.get((i, e))
                 if p is None:
-                    p = powers[i, e] = values[i] ** e
+                    p = powers[i, e] = power(values[i], e)
                 term = term * p
         total = total + term
     return total
@@ -126,3 +162,8 @@ class working_precision:  # noqa: N801 (used as a function: ``with working_preci
 
     def __exit__(self, *exc) -> None:
         ctx.prec = self.old
+
+
+#: :func:`_terms` under a public name: for callers enclosing several polynomials at the
+#: same balls, who share the powers between them
+ball_terms = _terms

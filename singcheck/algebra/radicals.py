@@ -33,6 +33,7 @@ from fractions import Fraction
 
 from flint import arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
 
+from singcheck.algebra.intervals import power
 from singcheck.algebra.trig import TRIG, evaluate_trig, evaluate_trig_at
 
 MAX_RADICAND_BITS = 64
@@ -555,7 +556,7 @@ def evaluate_path(p: fmpq_mpoly, t: arb, signs: dict[int, int] | None = None,
         term = evaluate_trig(part, t, tight)
         for v, e in zip(values, exps, strict=True):
             if e:
-                term *= v ** e
+                term *= power(v, e)
         total += term
     return total
 

@@ -137,7 +137,7 @@ class TrajectoryReport:
 
 def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
     pose, variables = path.pose_and_variables_at(t)
-    per_leg = [leg.branches(t) for leg in path.legs]
+    per_leg = path.branches_at_pose(variables)
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}
     complete = {}
@@ -307,12 +307,11 @@ def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot
 
 def _periodic(path: PathModel) -> bool:
     """Whether everything along the path is 2π-periodic in t: no polynomial of it
-    (pose, pose coordinates, legs, μ) involves the bare t."""
+    (pose, pose coordinates, μ) involves the bare t — nor do the legs then, which are
+    polynomials in the pose coordinates."""
     from singcheck.algebra.trig import uses_t
 
     polys = [*path.phi, *path.coordinates, path.mu, *path.degenerate]
-    for leg in path.legs:
-        polys += [*leg.coefficients, leg.discriminant]
     return not any(uses_t(p) for p in polys if p is not None)
 
 

@@ -20,7 +20,7 @@ their norm (:mod:`singcheck.roots.isolation`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
@@ -32,7 +32,7 @@ from singcheck.algebra.composition import (
     composition_work,
     crude_work,
 )
-from singcheck.algebra.intervals import evaluate, fraction_ball
+from singcheck.algebra.intervals import evaluate, fraction_ball, power
 from singcheck.algebra.polynomials import (
     coefficient_in,
     constant_value,
@@ -242,15 +242,41 @@ def _small_composition(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> int | None:
     return None
 
 
-@dataclass(frozen=True)
 class LegAlongPath:
     """One leg's constraint along the path: ``a ρ² + b(t) ρ + c(t)`` (or ``b ρ + c``), or
-    ``a(t) cos θ + b(t) sin θ + d(t)`` for a revolute leg."""
+    ``a(t) cos θ + b(t) sin θ + d(t)`` for a revolute leg.
 
-    leg: Leg
-    coefficients: tuple[fmpq_mpoly, ...]  # path polys, highest degree first / (a, b, d)
-    discriminant: fmpq_mpoly | None  # b² - 4ac for a quadratic leg, Δ for a revolute one
-    limits: dict = field(default_factory=dict)  # limit value -> its polynomial along the path
+    Its polynomials along the path (``coefficients``, highest degree first or (a, b, d);
+    ``discriminant``, b² - 4ac or Δ; ``limits``, a revolute joint's limit constraints)
+    are composed on first use: the quick feasibility proofs and the classification
+    enclose a leg from the balls of the pose (:func:`branches_at_pose`), so a path whose
+    quick proofs all pass never composes them.  Whether composing them could cost too
+    much was checked when the path was built (:func:`build_path`)."""
+
+    __slots__ = ("leg", "_composer", "_along")
+
+    def __init__(self, leg: Leg, composer: _LegComposer) -> None:
+        self.leg = leg
+        self._composer = composer
+        self._along: tuple | None = None
+
+    def _composed(self) -> tuple:
+        if self._along is None:
+            self._along = self._composer.leg(self.leg)
+        return self._along
+
+    @property
+    def coefficients(self) -> tuple[fmpq_mpoly, ...]:
+        return self._composed()[0]
+
+    @property
+    def discriminant(self) -> fmpq_mpoly | None:
+        return self._composed()[1]
+
+    @property
+    def limits(self) -> dict:
+        """Limit value -> its constraint along the path (revolute joints only)."""
+        return self._composed()[2]
 
     @property
     def revolute(self) -> bool:
@@ -454,10 +480,18 @@ class PathModel:
             for (alpha, _), factor in zip(split, factors, strict=True):
                 term = factor
                 for v, e in alpha:
-                    term = term * (flat[v] if e == 1 else flat[v] ** e)
+                    term = term * power(flat[v], e)
                 total = total + term
             out[label] = total
         return out
+
+    def branches_at_pose(self, pose: list[arb]) -> list[dict]:
+        """Per leg, its branches at the pose given by balls of the pose variables (ball
+        evaluation of the leg's coefficients in the robot's variables:
+        :func:`branches_at_pose`)."""
+        model = self.projection.model
+        point = _pose_point(model, pose)
+        return [_branches_at_point(model, leg.leg, point) for leg in self.legs]
 
     def conjugate_branches(self, t: arb, pose: list[arb], signs: dict[int, int]):
         """Per leg, the branches of the conjugate robot (its square roots' signs flipped
@@ -469,14 +503,46 @@ class PathModel:
 def branches_at_pose(model: RobotModel, leg: Leg, pose: list, signs=None) -> dict:
     """The leg's branches at a pose given by balls of the model's pose variables (cos φ,
     sin φ for an angle), the square roots' signs as ``signs`` says (default: the robot's
-    own, all positive): ball evaluation of the leg's coefficients and discriminant."""
-    n_joint = len(model.joint_variables)
+    own, all positive): ball evaluation of the leg's coefficients and discriminant, as
+    polynomials in the robot's variables, at those balls (each encloses its polynomial
+    over every pose in the balls, hence the branches)."""
+    return _branches_at_point(model, leg, _pose_point(model, pose, signs))
+
+
+def _pose_point(model: RobotModel, pose: list, signs=None) -> list:
+    """The balls of the robot's variables: joints (unused: 0), pose, square roots."""
     radicals = [b for _, b in sorted(radical_balls(model.context, signs).items())]
+    return [_ZERO] * len(model.joint_variables) + list(pose) + radicals
+
+
+_ZERO = arb(0)
+
+
+def _branches_at_point(model: RobotModel, leg: Leg, point: list) -> dict:
     coefficients = _leg_coefficients(leg)
-    point = [arb(0)] * n_joint + list(pose) + radicals
-    values = [evaluate(c, point) for c in coefficients]
-    disc = leg_discriminant(leg, coefficients)
+    disc = _model_discriminant(leg)
+    if leg.kind != REVOLUTE and leg.degree == 2:  # (-b ± √D)/(2a): c is in D already
+        values = [evaluate(coefficients[0], point), evaluate(coefficients[1], point), None]
+    else:
+        values = [evaluate(c, point) for c in coefficients]
     return branch_values(leg, values, evaluate(disc, point) if disc is not None else None)
+
+
+def leg_polynomials(leg: Leg) -> tuple[fmpq_mpoly, fmpq_mpoly, fmpq_mpoly]:
+    """(a, b, D = b² - 4ac) of a quadratic prismatic leg a ρ² + b ρ + c, polynomials in
+    the robot's variables (the pose's), once per leg."""
+    a, b, _ = _leg_coefficients(leg)
+    return a, b, _model_discriminant(leg)
+
+
+_MODEL_DISCRIMINANTS: dict = {}
+
+
+def _model_discriminant(leg: Leg) -> fmpq_mpoly | None:
+    """:func:`~singcheck.model.robot.leg_discriminant` of the leg's own coefficients (in
+    the robot's variables), once per leg."""
+    return memo_per_object(_MODEL_DISCRIMINANTS, leg,
+                           lambda leg: leg_discriminant(leg, _leg_coefficients(leg)))
 
 
 def _angle_k(p: fmpq_mpoly, q) -> int | None:
@@ -750,31 +816,67 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
 
 def _legs_along(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
                 ) -> tuple[LegAlongPath, ...]:
-    pose_vars = model.pose_variables
-    legs = []
-    composed: list[tuple[fmpq_mpoly, fmpq_mpoly]] = []  # (coefficient, along the path)
+    """The legs along the path, their polynomials composed on first use (refused up front
+    by :class:`TooCostly` when a composition would cost too much)."""
+    composer = _LegComposer(model, coordinates)
+    composer.check()
+    return tuple(LegAlongPath(leg, composer) for leg in model.legs)
 
-    def along(c: fmpq_mpoly) -> fmpq_mpoly:
-        """The coefficient along the path, composed once: legs often share one (the
-        Orthoglide's constant a = 1 and c = x² + y² + z² - l²)."""
-        for known, image in composed:
+
+class _LegComposer:
+    """Composes the legs' polynomials along one path, each distinct coefficient once
+    (legs often share one: the Orthoglide's constant a = 1 and c = x² + y² + z² - l²)."""
+
+    def __init__(self, model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]) -> None:
+        self.model = model
+        self.coordinates = coordinates
+        self._composed: list[tuple[fmpq_mpoly, fmpq_mpoly]] = []  # (coefficient, image)
+
+    def _sources(self) -> list[fmpq_mpoly]:
+        polys = []
+        for leg in self.model.legs:
+            polys += list(_leg_coefficients(leg))
+            if leg.kind == REVOLUTE and leg.joint in self.model.spec.joint_limits:
+                polys += [limit_constraint(self.model, leg, value)
+                          for value in self.model.spec.joint_limits[leg.joint]]
+        return polys
+
+    def check(self) -> None:
+        """:class:`TooCostly` when composing some leg polynomial would cost more than
+        :data:`~singcheck.algebra.composition.MAX_COMPOSE_WORK` (the estimate
+        :func:`compose_pose` refuses on), before anything is composed."""
+        pose_vars = self.model.pose_variables
+        seen: list[fmpq_mpoly] = []
+        for p in self._sources():
+            if p.is_constant() or any(p == q for q in seen):
+                continue
+            seen.append(p)
+            _, args = _pose_args(p, self.coordinates, pose_vars)
+            if crude_work(p, args)[0] <= PIECE_WORK:
+                continue
+            work = composition_work(p, args)[0]
+            if work > MAX_COMPOSE_WORK:
+                raise TooCostly(f"composing would cost {work:.3g} by its a-priori estimate "
+                                f"(at most {MAX_COMPOSE_WORK:.3g})")
+
+    def along(self, c: fmpq_mpoly) -> fmpq_mpoly:
+        for known, image in self._composed:
             if known == c:
                 return image
-        image = compose_pose(c, coordinates, pose_vars)
-        composed.append((c, image))
+        image = compose_pose(c, self.coordinates, self.model.pose_variables)
+        self._composed.append((c, image))
         return image
 
-    for leg in model.legs:
-        coeffs = tuple(along(c) for c in _leg_coefficients(leg))
+    def leg(self, leg: Leg) -> tuple:
+        """(coefficients, discriminant, limits) of one leg along the path."""
+        coeffs = tuple(self.along(c) for c in _leg_coefficients(leg))
         disc = leg_discriminant(leg, coeffs)
         limits = {}
-        if leg.kind == REVOLUTE and leg.joint in model.spec.joint_limits:
-            for value in model.spec.joint_limits[leg.joint]:
-                limits[value] = compose_pose(limit_constraint(model, leg, value), coordinates,
-                                             pose_vars)
-        legs.append(LegAlongPath(leg, coeffs, _reduce(disc) if disc is not None else None,
-                                 limits))
-    return tuple(legs)
+        if leg.kind == REVOLUTE and leg.joint in self.model.spec.joint_limits:
+            for value in self.model.spec.joint_limits[leg.joint]:
+                limits[value] = compose_pose(limit_constraint(self.model, leg, value),
+                                             self.coordinates, self.model.pose_variables)
+        return coeffs, _reduce(disc) if disc is not None else None, limits
 
 
 def exact_point(q) -> arb:

@@ -1,104 +1,106 @@
 """The legs' quick feasibility proofs, every leg in one walk over the pieces.
 
 :mod:`.working_modes` first tries to prove, by ball arithmetic on balls covering the
-range, that a leg's discriminant D is > 0 (both branches real and apart) and that a
-branch stays strictly inside its joint limits.  Made leg after leg, each leg encloses
-sin t and cos t over every piece again and goes through its own memo of enclosures.
-Here the pieces are walked once for all the legs that allow it: per piece, sin t and
-cos t are enclosed once and each leg's a, b and D are enclosed from them by the ball
-polynomials :func:`~singcheck.algebra.trig.evaluate_trig` uses (Horner in cos t,
-outward rounding), and the branches by the same formulas as
-:meth:`~singcheck.certify.path.LegAlongPath.branches`.
+range (:mod:`.covers`), that a leg's discriminant D is > 0 (both branches real and
+apart) and that a branch stays strictly inside its joint limits.  Here the pieces are
+walked once for all the legs: per piece, the pose coordinates φ(t) are enclosed over
+the piece (Horner in cos t, or through the Fourier form on a wide piece for a
+high-degree coordinate: :func:`~singcheck.algebra.trig.evaluate_trig`), and each leg's
+a, b and D, polynomials in the robot's pose variables, are enclosed at those balls.
+Each encloses its polynomial's values over every pose the piece reaches, hence over
+every t of the piece; the branches are (-b ± √D)/(2a) where D > 0, as
+:func:`~singcheck.certify.path.branch_values` makes them, and a branch is inside when
+its ball lies strictly between the limits' balls, as
+:func:`~singcheck.certify.path.inside_limits` decides.  Nothing is composed along the
+path: a path whose quick proofs all pass never composes its legs.
 
-What is proven is what the leg-by-leg walk proves: a fact holds on every ball of a
-cover of the range (the same pieces, a piece where it fails halved until the same
-budget of evaluations is spent), hence on the whole range.  A fact the sweep does not
-prove is left to :mod:`.working_modes`, which then goes straight to root isolation
-(the quick proof was tried).  Swept: prismatic quadratic legs whose polynomials are
-plain trig polynomials (no square root, no angle function) of low degree (no tight
-enclosures needed); the others keep the leg-by-leg proofs.
+A fact is proven when it holds on every ball of a cover of the range (a piece where it
+fails is halved until the budget of evaluations is spent), hence on the whole range.
+A fact the sweep does not prove is left to :mod:`.working_modes`, which then isolates
+the roots that decide it.  Swept: prismatic quadratic legs of a robot free of square
+roots and angles, along a path whose coordinates are plain trig polynomials; the
+others keep the leg-by-leg proofs.
 """
 
 from __future__ import annotations
 
-from flint import arb, arb_poly
+from flint import arb
 
-from singcheck.algebra.trig import TRIG, ball_split, evaluate_split
+from singcheck.algebra.intervals import ball_terms, power
+from singcheck.algebra.trig import TRIG, ball_split, evaluate_split, evaluate_trig
 from singcheck.budget import checkpoint
-from singcheck.certify.path import inside_limits, limit_balls
+from singcheck.certify.covers import TIGHT_ABOVE, TIGHT_DEGREE, budget, halves, one_period, pieces
+from singcheck.certify.path import inside_limits, leg_polynomials, limit_balls
 from singcheck.model.robot import REVOLUTE
 
 #: a fact: (leg index, None) for "D > 0", (leg index, label) for "the branch is inside"
 Fact = tuple[int, str | None]
 
+#: a coordinate of at least this degree in (sin t, cos t) is enclosed through its
+#: Fourier form on wide pieces (a leg, quadratic in it, reaches the leg threshold)
+TIGHT_COORDINATE = TIGHT_DEGREE // 2
 
-def sweep_quick_proofs(path, covers, limits_of: dict,
-                       pieces, halves, budget_of) -> tuple[set[Fact], set[Fact]]:
+
+def sweep_quick_proofs(path, limits_of: dict, starts: list[dict]
+                       ) -> tuple[set[Fact], set[Fact]]:
     """(proven, tried): the facts proven on a cover of the range, and every fact tried.
 
-    ``covers`` are the legs' :class:`~singcheck.certify.working_modes._Cover`; ``pieces``,
-    ``halves`` and ``budget_of`` the working-mode module's own cover functions (passed in
-    so that both walks cut the range alike)."""
-    groups: list[tuple[object, list[int]]] = []  # (range, legs covering it)
-    for i, (leg, cover) in enumerate(zip(path.legs, covers, strict=True)):
-        if not _sweepable(leg, cover):
+    ``starts``: each leg's branches enclosed at the range start; a branch is tried only
+    when it is real and proven inside its limits there (one outside is decided at the
+    start; an undecided one would fail)."""
+    model = path.projection.model
+    if not model.polynomial or any(x.context() is not TRIG for x in path.coordinates):
+        return set(), set()
+    facts: list[Fact] = []
+    for i, leg in enumerate(path.legs):
+        if leg.leg.kind == REVOLUTE or leg.leg.degree != 2:
             continue
-        for rng, members in groups:
-            if rng == cover.range:
-                members.append(i)
+        facts.append((i, None))
+        limits = limits_of.get(leg.leg.joint)
+        if limits is not None:
+            facts += [(i, label) for label in leg.labels if isinstance(starts[i][label], arb)
+                      and inside_limits(leg.leg, starts[i][label], limits) is True]
+    groups: list[tuple[object, list[Fact]]] = []  # (range, facts of the legs covering it)
+    ranges: dict[int, object] = {}
+    for f in facts:
+        rng = ranges.get(f[0])
+        if rng is None:
+            rng = ranges[f[0]] = _leg_range(path, f[0])
+        for known, members in groups:
+            if known == rng:
+                members.append(f)
                 break
         else:
-            groups.append((cover.range, [i]))
+            groups.append((rng, [f]))
     proven: set[Fact] = set()
-    tried: set[Fact] = set()
     for rng, members in groups:
-        facts = _facts(path, covers, members, limits_of)
-        tried |= set(facts)
-        proven |= _walk(path, facts, pieces(rng), halves, budget_of(rng), limits_of)
-    return proven, tried
+        proven |= _walk(path, members, pieces(rng), budget(rng), limits_of)
+    return proven, set(facts)
 
 
-def _sweepable(leg, cover) -> bool:
-    polys = [p for p in (*leg.coefficients, leg.discriminant) if p is not None]
-    return leg.leg.kind != REVOLUTE and leg.leg.degree == 2 and not cover.retry_tight \
-        and all(p.context() is TRIG for p in polys)
+def _leg_range(path, i: int):
+    """The part of the range the quick proofs about leg ``i`` cover: one period when the
+    coordinates its polynomials involve are free of the bare t (:func:`one_period`)."""
+    offset = len(path.projection.model.joint_variables)
+    degrees = [p.degrees() for p in leg_polynomials(path.legs[i].leg)]
+    used = [x for k, x in enumerate(path.coordinates) if any(d[offset + k] > 0 for d in degrees)]
+    return one_period(path.trajectory.range, used)
 
 
-def _facts(path, covers, members: list[int], limits_of: dict) -> list[Fact]:
-    """D > 0 for each leg, and "inside" for each branch proven real and inside at the
-    range start (one outside there, or complex, is decided without a sweep; an
-    undecided one would fail)."""
-    out: list[Fact] = []
-    for i in members:
-        leg, cover = path.legs[i], covers[i]
-        out.append((i, None))
-        limits = limits_of.get(leg.leg.joint)
-        if limits is None:
-            continue
-        at_start = cover.branches(cover.start)
-        out += [(i, label) for label in leg.labels if isinstance(at_start[label], arb)
-                and inside_limits(leg.leg, at_start[label], limits) is True]
-    return out
-
-
-def _walk(path, facts: list[Fact], todo: list[arb], halves, budget: int,
+def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
           limits_of: dict) -> set[Fact]:
-    """The facts that hold on every ball of the cover ``todo``, refined by halving.
-
-    A quadratic leg's branches are (-b ± √D)/(2a) where D > 0, as
-    :func:`~singcheck.certify.path.branch_values` makes them; a branch is inside when
-    its ball lies strictly between the limits' balls, as
-    :func:`~singcheck.certify.path.inside_limits` decides."""
+    """The facts that hold on every ball of the cover ``todo``, refined by halving."""
+    model = path.projection.model
     legs = {}
     for i, _ in facts:
         if i not in legs:
-            leg = path.legs[i]
-            limits = limits_of.get(leg.leg.joint)
-            pa, pb, pd = (ball_split(p) for p in (leg.coefficients[0], leg.coefficients[1],
-                                                  leg.discriminant))
-            if isinstance(pa, arb_poly) and pa.degree() <= 0:  # a constant a: its ball
-                pa = pa(arb(0))
-            legs[i] = (pa, pb, pd, limit_balls(limits) if limits is not None else None)
+            leg = path.legs[i].leg
+            limits = limits_of.get(leg.joint)
+            legs[i] = (*(ball_terms(p) for p in leg_polynomials(leg)),
+                       limit_balls(limits) if limits else None)
+    coordinates = [(x, ball_split(x), x.degrees()[1] + x.degrees()[2] >= TIGHT_COORDINATE)
+                   for x in path.coordinates]
+    head = [arb(0)] * len(model.joint_variables)
     work = [(piece, facts) for piece in todo]
     queued = dict.fromkeys(facts, len(todo))
     spent = dict.fromkeys(facts, 0)
@@ -107,6 +109,10 @@ def _walk(path, facts: list[Fact], todo: list[arb], halves, budget: int,
         piece, pending = work.pop()
         checkpoint()
         s, c = piece.sin_cos()
+        wide = piece.rad() > TIGHT_ABOVE
+        point = head + [evaluate_trig(x, piece, tight=True) if wide and high else
+                        evaluate_split(split, piece, s, c) for x, split, high in coordinates]
+        powers: dict = {}
         values: dict[int, list] = {}  # leg -> [D, D > 0, 2a, -b (when asked for)]
         still = []
         for f in pending:
@@ -115,25 +121,24 @@ def _walk(path, facts: list[Fact], todo: list[arb], halves, budget: int,
             queued[f] -= 1
             spent[f] += 1
             i, label = f
-            pa, pb, pd, limits = legs[i]
+            a, b, d, limits = legs[i]
             hit = values.get(i)
             if hit is None:
-                d = evaluate_split(pd, piece, s, c)
-                hit = values[i] = [d, d > 0, None, None]
+                dv = _enclose(d, point, powers)
+                hit = values[i] = [dv, dv > 0, None, None]
             if not hit[1]:
                 still.append(f)
                 continue
             if label is None:
                 continue
             if hit[2] is None:
-                a = pa if isinstance(pa, arb) else evaluate_split(pa, piece, s, c)
-                hit[2], hit[3] = 2 * a, -evaluate_split(pb, piece, s, c)
+                hit[2], hit[3] = 2 * _enclose(a, point, powers), -_enclose(b, point, powers)
             root = hit[0].sqrt()
             rho = (hit[3] + root if label == "+" else hit[3] - root) / hit[2]
             if not (rho > limits[0] and rho < limits[1]):
                 still.append(f)
         for f in still:
-            if spent[f] + queued[f] + 2 > budget:
+            if spent[f] + queued[f] + 2 > allowed:
                 failed.add(f)
         still = [f for f in still if f not in failed]
         if still:
@@ -142,3 +147,22 @@ def _walk(path, facts: list[Fact], todo: list[arb], halves, budget: int,
             for f in still:
                 queued[f] += 2
     return {f for f in facts if f not in failed}
+
+
+def _enclose(terms, point: list, powers: dict) -> arb:
+    """:func:`~singcheck.algebra.intervals.evaluate` of a polynomial given by its
+    :func:`~singcheck.algebra.intervals.ball_terms`, the powers of the point's balls
+    shared through ``powers`` by the polynomials enclosed at the same point."""
+    total = arb(0)
+    for coeff, factors in terms:
+        term = coeff
+        for i, e in factors:
+            if e == 1:
+                term = term * point[i]
+            else:
+                p = powers.get((i, e))
+                if p is None:
+                    p = powers[i, e] = power(point[i], e)
+                term = term * p
+        total = total + term
+    return total

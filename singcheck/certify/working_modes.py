@@ -24,16 +24,20 @@ Whatever cannot be proven makes the branch ``unknown``, with the reason.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from itertools import product
 
 from flint import arb, ctx
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.radicals import evaluate_path
-from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
+from singcheck.algebra.trig import TimeRange
 from singcheck.budget import checkpoint
+from singcheck.certify.covers import TIGHT_ABOVE, TIGHT_DEGREE, one_period
+from singcheck.certify.covers import budget as _budget
+from singcheck.certify.covers import halves as _halves
+from singcheck.certify.covers import pieces as _pieces
 from singcheck.certify.exact import vanishes_at_root
 from singcheck.certify.path import LegAlongPath, PathModel, joint_float
 from singcheck.certify.sweep import sweep_quick_proofs
@@ -93,61 +97,14 @@ def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | Non
         return None
 
 
-_PIECES = 8
-_BUDGET = 64  # ball evaluations per 2π of range spent before falling back to a root isolation
-
-
-def _budget(interval: TimeRange) -> int:
-    """The evaluation budget grows with the range: a longer path needs more pieces."""
-    periods = (float(interval.end) - float(interval.start)) / (2 * math.pi)
-    return max(_BUDGET, math.ceil(_BUDGET * periods))
-
-
-def _pieces(interval: TimeRange) -> list[arb]:
-    """Balls covering the closed range (slightly more at irrational ends)."""
-    lo, hi = interval.start.ball().lower(), interval.end.ball().upper()
-    step = (hi - lo) / _PIECES
-    edges = [(lo + step * i).mid() for i in range(_PIECES)] + [hi]
-    edges[0] = lo
-    return [a.union(b) for a, b in zip(edges, edges[1:], strict=False)]
-
-
-_TIGHT_ABOVE = 0.05  # radius above which a piece gets tight enclosures (high-degree legs)
-_TIGHT_DEGREE = 10  # ... when the leg's polynomials have at least this degree in (s, c)
-
-
 def _high_degree(degrees: list) -> bool:
     """Whether Horner in cos t is likely to overestimate badly on wide pieces (from the
     degrees in (t, s, c, …) of the leg's polynomials)."""
-    return max(d[1] + d[2] for d in degrees) >= _TIGHT_DEGREE
+    return max(d[1] + d[2] for d in degrees) >= TIGHT_DEGREE
 
 
 def _leg_polys(leg: LegAlongPath):
     return (*leg.coefficients, leg.discriminant)
-
-
-def one_period(interval: TimeRange, polys, periodic: bool | None = None) -> TimeRange:
-    """The part of the range a quick proof about ``polys`` needs to cover (``periodic``:
-    whether they are all free of t, when the caller knows).
-
-    Trig polynomials free of the bare t are 2π-periodic, so over a range longer than 2π
-    they take no value that they do not take on its first 2π: proving a property of
-    their values on [start, start + 2π] proves it on the whole range.
-    """
-    start, end = interval.start, interval.end
-    if float(end) - float(start) <= 2 * math.pi + 1e-9:
-        return interval
-    if periodic is None:
-        periodic = not any(uses_t(p) for p in polys if p is not None)
-    if not periodic:
-        return interval
-    return TimeRange(start, LinearInPi(start.rational, start.pi_coefficient + 2))
-
-
-def _halves(piece: arb) -> tuple[arb, arb]:
-    lo, hi = piece.lower(), piece.upper()
-    mid = piece.mid()
-    return lo.union(mid), mid.union(hi)
 
 
 class _Cover:
@@ -165,15 +122,32 @@ class _Cover:
 
     def __init__(self, leg: LegAlongPath, interval: TimeRange) -> None:
         self.leg = leg
-        degrees = [p.degrees() for p in _leg_polys(leg) if p is not None]
-        self.range = one_period(interval, (), periodic=all(d[0] <= 0 for d in degrees))
-        self.retry_tight = _high_degree(degrees)
+        self.interval = interval
         self.start = interval.start.ball()
-        self.budget = _budget(self.range)
-        self.constant = all(max(d) <= 0 for d in degrees)
         self._pieces: list[arb] | None = None
         self._halves: dict[int, tuple[arb, arb, arb]] = {}
         self._seen: dict[tuple[int, bool, int], list] = {}  # -> [ball, D, branches]
+
+    @cached_property
+    def _degrees(self) -> list:
+        """The degrees of the leg's polynomials along the path (composing them)."""
+        return [p.degrees() for p in _leg_polys(self.leg) if p is not None]
+
+    @cached_property
+    def range(self) -> TimeRange:
+        return one_period(self.interval, (), periodic=all(d[0] <= 0 for d in self._degrees))
+
+    @cached_property
+    def retry_tight(self) -> bool:
+        return _high_degree(self._degrees)
+
+    @cached_property
+    def budget(self) -> int:
+        return _budget(self.range)
+
+    @cached_property
+    def constant(self) -> bool:
+        return all(max(d) <= 0 for d in self._degrees)
 
     def pieces(self) -> list[arb]:
         """:func:`_pieces` of the range (the same balls every time they are asked for)."""
@@ -236,7 +210,7 @@ def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True,
         piece = todo.pop()
         checkpoint()
         spent += 1
-        if predicate(piece, retry_tight and piece.rad() > _TIGHT_ABOVE):
+        if predicate(piece, retry_tight and piece.rad() > TIGHT_ABOVE):
             continue
         if spent + len(todo) + 2 > budget:
             return False
@@ -280,16 +254,19 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when,
 
 def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
                    tolerance: float, crossings: dict, when,
-                   cover: _Cover | None = None, quick: bool = True) -> BranchFeasibility:
+                   cover: _Cover | None = None, quick: bool = True,
+                   at_start: dict | None = None) -> BranchFeasibility:
     """Whether this branch stays strictly inside the joint limits along the whole path.
 
     ``crossings`` memoises, per limit value, the isolated times at which *some* branch of
     the leg equals it (one polynomial serves both branches); ``cover`` shares the quick
     proofs' enclosures with the leg's other proofs; ``quick=False`` when the quick proof
-    was tried already (by :mod:`.sweep`)."""
+    was tried already (by :mod:`.sweep`); ``at_start``, the leg's branches enclosed at
+    the range start when the caller has them."""
     joint = leg.leg.joint
     cover = cover or _Cover(leg, interval)
-    if leg.inside(cover.branches(cover.start)[label], limits) is False:
+    start = at_start if at_start is not None else cover.branches(cover.start)
+    if leg.inside(start[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
                                  f"{joint} is outside {_bounds(limits)} from the start")
     if quick and _everywhere(lambda t, tight: leg.inside(cover.branches(t, tight)[label],
@@ -393,14 +370,16 @@ def _sits_on_limit(leg: LegAlongPath, label: str, on_limit: dict, point: arb) ->
     return any(sigma * evaluate_path(w, point) > 0 for w in on_limit.values())
 
 
-def leg_branches(path: PathModel, tolerance: float,
-                 covers: list[_Cover] | None = None) -> list[list[BranchFeasibility]]:
+def leg_branches(path: PathModel, tolerance: float, covers: list[_Cover] | None = None,
+                 starts: list[dict] | None = None) -> list[list[BranchFeasibility]]:
     """Feasibility of every branch of every leg (outer list in joint order); ``covers``
-    (one per leg, :class:`_Cover`) when the caller shares them."""
+    (one per leg, :class:`_Cover`) and ``starts`` (:func:`start_branches`) when the
+    caller shares them."""
     interval = path.trajectory.range
     limits_of = path.projection.model.spec.joint_limits
     covers = covers or [_Cover(leg, interval) for leg in path.legs]
-    proven, tried = sweep_quick_proofs(path, covers, limits_of, _pieces, _halves, _budget)
+    starts = starts or start_branches(path)
+    proven, tried = sweep_quick_proofs(path, limits_of, starts)
 
     def when(t: arb) -> str:
         return f"{float(path.trajectory.to_global(arb(t)).mid()):.6g}"
@@ -425,24 +404,30 @@ def leg_branches(path: PathModel, tolerance: float,
             elif joint in limits_of:
                 branches.append(_branch_limits(leg, label, interval, limits_of[joint],
                                                tolerance, crossings, when, cover,
-                                               quick=(i, label) not in tried))
+                                               quick=(i, label) not in tried,
+                                               at_start=starts[i]))
             else:
                 branches.append(BranchFeasibility(joint, label, FEASIBLE))
         out.append(branches)
     return out
 
 
-def _start_values(covers: list[_Cover]) -> list[dict[str, float | None]]:
+def start_branches(path: PathModel) -> list[dict]:
+    """Each leg's branches enclosed at the range start, from the pose's balls there."""
+    return path.branches_at_pose(path.pose_variables_at(path.trajectory.range.start.ball()))
+
+
+def _start_values(starts: list[dict]) -> list[dict[str, float | None]]:
     """Each leg's branches at the range start, for display."""
-    return [{label: joint_float(v) for label, v in cover.branches(cover.start).items()}
-            for cover in covers]
+    return [{label: joint_float(v) for label, v in start.items()} for start in starts]
 
 
 def working_modes(path: PathModel, tolerance: float = 1e-9) -> list[WorkingMode]:
     """Every working mode (sign choice per leg) with its proven feasibility."""
     covers = [_Cover(leg, path.trajectory.range) for leg in path.legs]
-    per_leg = leg_branches(path, tolerance, covers)
-    starts = _start_values(covers)
+    at_start = start_branches(path)
+    per_leg = leg_branches(path, tolerance, covers, at_start)
+    starts = _start_values(at_start)
     joints = [leg.leg.joint for leg in path.legs]
     modes = []
     for choice in product(*per_leg):  # 2^legs

@@ -480,7 +480,7 @@ class PathModel:
             for (alpha, _), factor in zip(split, factors, strict=True):
                 term = factor
                 for v, e in alpha:
-                    term = term * power(flat[v], e)
+                    term = term * (flat[v] if e == 1 else power(flat[v], e))
                 total = total + term
             out[label] = total
         return out

@@ -47,6 +47,13 @@ def power(x: Ball, e: int) -> Ball:
             out = out * x
         return out
     lo, hi = x.lower(), x.upper()
+    if e == 2:  # (x·x would be m² ± (2|m|r + r²), 2r² wider than the ends' squares)
+        if lo >= 0:
+            return (lo * lo).union(hi * hi)
+        if hi <= 0:
+            return (hi * hi).union(lo * lo)
+        top = max(-lo, hi)
+        return arb(0).union(top * top)
     if e % 2 == 1 or lo >= 0:
         return _point_power(lo, e).union(_point_power(hi, e))
     if hi <= 0:

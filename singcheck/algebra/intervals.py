@@ -73,16 +73,21 @@ def _point_power(p: arb, e: int) -> arb:
     return out
 
 
-def evaluate(poly: fmpq_mpoly, values: Sequence[Ball]) -> Ball:
+def evaluate(poly: fmpq_mpoly, values: Sequence[Ball], powers: dict | None = None) -> Ball:
     """Enclose ``poly(values)``; ``values[i]`` is the ball of the i-th generator.
 
-    Powers are computed once per generator and exponent; each term is summed in
+    Powers are computed once per generator and exponent (``powers``, when the caller
+    shares them between polynomials enclosed at the same balls); each term is summed in
     ball arithmetic, so the result encloses the exact value for every point of the
     input balls.
     """
-    powers: dict[tuple[int, int], Ball] = {}  # (generator, exponent ≥ 2) -> its power
+    if powers is None:
+        powers = {}  # (generator, exponent ≥ 2) -> its power
     total: Ball = arb(0)
     for coeff, factors in _terms(poly):
+        if not factors:
+            total = total + coeff
+            continue
         term: Ball = coeff
         for i, e in factors:
             if e == 1:
@@ -169,8 +174,3 @@ class working_precision:  # noqa: N801 (used as a function: ``with working_preci
 
     def __exit__(self, *exc) -> None:
         ctx.prec = self.old
-
-
-#: :func:`_terms` under a public name: for callers enclosing several polynomials at the
-#: same balls, who share the powers between them
-ball_terms = _terms

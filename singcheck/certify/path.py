@@ -491,7 +491,8 @@ class PathModel:
         :func:`branches_at_pose`)."""
         model = self.projection.model
         point = _pose_point(model, pose)
-        return [_branches_at_point(model, leg.leg, point) for leg in self.legs]
+        powers: dict = {}  # the pose's powers, shared by the legs
+        return [_branches_at_point(model, leg.leg, point, powers) for leg in self.legs]
 
     def conjugate_branches(self, t: arb, pose: list[arb], signs: dict[int, int]):
         """Per leg, the branches of the conjugate robot (its square roots' signs flipped
@@ -518,14 +519,17 @@ def _pose_point(model: RobotModel, pose: list, signs=None) -> list:
 _ZERO = arb(0)
 
 
-def _branches_at_point(model: RobotModel, leg: Leg, point: list) -> dict:
+def _branches_at_point(model: RobotModel, leg: Leg, point: list,
+                       powers: dict | None = None) -> dict:
     coefficients = _leg_coefficients(leg)
     disc = _model_discriminant(leg)
     if leg.kind != REVOLUTE and leg.degree == 2:  # (-b ± √D)/(2a): c is in D already
-        values = [evaluate(coefficients[0], point), evaluate(coefficients[1], point), None]
+        values = [evaluate(coefficients[0], point, powers),
+                  evaluate(coefficients[1], point, powers), None]
     else:
-        values = [evaluate(c, point) for c in coefficients]
-    return branch_values(leg, values, evaluate(disc, point) if disc is not None else None)
+        values = [evaluate(c, point, powers) for c in coefficients]
+    return branch_values(leg, values,
+                         evaluate(disc, point, powers) if disc is not None else None)
 
 
 def leg_polynomials(leg: Leg) -> tuple[fmpq_mpoly, fmpq_mpoly, fmpq_mpoly]:

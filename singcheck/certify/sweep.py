@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from flint import arb
 
-from singcheck.algebra.intervals import ball_terms, power
+from singcheck.algebra.intervals import evaluate
 from singcheck.algebra.trig import TRIG, ball_split, evaluate_split, evaluate_trig
 from singcheck.budget import checkpoint
 from singcheck.certify.covers import TIGHT_ABOVE, TIGHT_DEGREE, budget, halves, one_period, pieces
@@ -96,7 +96,7 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
         if i not in legs:
             leg = path.legs[i].leg
             limits = limits_of.get(leg.joint)
-            legs[i] = (*(ball_terms(p) for p in leg_polynomials(leg)),
+            legs[i] = (*leg_polynomials(leg),
                        limit_balls(limits) if limits else None)
     coordinates = [(x, ball_split(x), x.degrees()[1] + x.degrees()[2] >= TIGHT_COORDINATE)
                    for x in path.coordinates]
@@ -124,7 +124,7 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
             a, b, d, limits = legs[i]
             hit = values.get(i)
             if hit is None:
-                dv = _enclose(d, point, powers)
+                dv = evaluate(d, point, powers)
                 hit = values[i] = [dv, dv > 0, None, None]
             if not hit[1]:
                 still.append(f)
@@ -132,7 +132,7 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
             if label is None:
                 continue
             if hit[2] is None:
-                hit[2], hit[3] = 2 * _enclose(a, point, powers), -_enclose(b, point, powers)
+                hit[2], hit[3] = 2 * evaluate(a, point, powers), -evaluate(b, point, powers)
             root = hit[0].sqrt()
             rho = (hit[3] + root if label == "+" else hit[3] - root) / hit[2]
             if not (rho > limits[0] and rho < limits[1]):
@@ -148,21 +148,3 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
                 queued[f] += 2
     return {f for f in facts if f not in failed}
 
-
-def _enclose(terms, point: list, powers: dict) -> arb:
-    """:func:`~singcheck.algebra.intervals.evaluate` of a polynomial given by its
-    :func:`~singcheck.algebra.intervals.ball_terms`, the powers of the point's balls
-    shared through ``powers`` by the polynomials enclosed at the same point."""
-    total = arb(0)
-    for coeff, factors in terms:
-        term = coeff
-        for i, e in factors:
-            if e == 1:
-                term = term * point[i]
-            else:
-                p = powers.get((i, e))
-                if p is None:
-                    p = powers[i, e] = power(point[i], e)
-                term = term * p
-        total = total + term
-    return total

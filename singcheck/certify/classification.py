@@ -137,7 +137,7 @@ class TrajectoryReport:
 
 def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
     pose, variables = path.pose_and_variables_at(t)
-    per_leg = path.branches_at_pose(variables)
+    per_leg = path.leg_branches_at(t, variables)
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}
     complete = {}

@@ -485,6 +485,24 @@ class PathModel:
             out[label] = total
         return out
 
+    @property
+    def legs_from_pose(self) -> bool:
+        """Whether the legs are enclosed from the pose's balls (the quick feasibility
+        proofs of :mod:`.sweep`, the classification): a robot free of square roots and
+        angles, whose few-term leg polynomials cost little to evaluate, along plain trig
+        coordinates.  Otherwise the legs are composed along the path and enclosed there
+        (a polynomial in the robot's pose variables can have many terms — the
+        Gough–Stewart platform's — where the path fixes most of them)."""
+        return _legs_from_pose(self.projection.model, self.coordinates)
+
+    def leg_branches_at(self, t: arb, variables: list[arb] | None = None) -> list[dict]:
+        """Per leg, its branches enclosed over the ball ``t`` (``variables``: the pose
+        variables' balls there, when the caller has them)."""
+        if self.legs_from_pose:
+            return self.branches_at_pose(variables if variables is not None
+                                         else self.pose_variables_at(t))
+        return [leg.branches(t) for leg in self.legs]
+
     def branches_at_pose(self, pose: list[arb]) -> list[dict]:
         """Per leg, its branches at the pose given by balls of the pose variables (ball
         evaluation of the leg's coefficients in the robot's variables:
@@ -818,13 +836,28 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
     return PathModel(projection, trajectory, phi, mu, legs, coordinates, degenerate)
 
 
+def _legs_from_pose(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]) -> bool:
+    """:attr:`PathModel.legs_from_pose`."""
+    return model.polynomial and all(x.context() is TRIG for x in coordinates)
+
+
 def _legs_along(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
                 ) -> tuple[LegAlongPath, ...]:
-    """The legs along the path, their polynomials composed on first use (refused up front
-    by :class:`TooCostly` when a composition would cost too much)."""
+    """The legs along the path.  Where they are enclosed from the pose
+    (:func:`_legs_from_pose`) their polynomials are composed on first use, after a check
+    that none would cost too much (:class:`TooCostly`, up front); elsewhere the proofs
+    use them at once, and they are composed now (the same refusal)."""
     composer = _LegComposer(model, coordinates)
-    composer.check()
-    return tuple(LegAlongPath(leg, composer) for leg in model.legs)
+    legs = tuple(LegAlongPath(leg, composer) for leg in model.legs)
+    if _legs_from_pose(model, coordinates):
+        composer.check()
+    else:
+        for leg in legs:
+            leg.coefficients  # noqa: B018 - composed now
+    return legs
+
+
+_LIMIT_CONSTRAINTS: dict = {}
 
 
 class _LegComposer:
@@ -836,13 +869,20 @@ class _LegComposer:
         self.coordinates = coordinates
         self._composed: list[tuple[fmpq_mpoly, fmpq_mpoly]] = []  # (coefficient, image)
 
+    def _limit_constraints(self, leg: Leg) -> dict:
+        """A revolute joint's constraint at each of its limits (in the robot's ring),
+        once per leg of the model (exact cos and sin of the limits: costly)."""
+        model = self.model
+        if leg.kind != REVOLUTE or leg.joint not in model.spec.joint_limits:
+            return {}
+        return memo_per_object(_LIMIT_CONSTRAINTS, leg, lambda leg: {
+            value: limit_constraint(model, leg, value)
+            for value in model.spec.joint_limits[leg.joint]})
+
     def _sources(self) -> list[fmpq_mpoly]:
         polys = []
         for leg in self.model.legs:
-            polys += list(_leg_coefficients(leg))
-            if leg.kind == REVOLUTE and leg.joint in self.model.spec.joint_limits:
-                polys += [limit_constraint(self.model, leg, value)
-                          for value in self.model.spec.joint_limits[leg.joint]]
+            polys += [*_leg_coefficients(leg), *self._limit_constraints(leg).values()]
         return polys
 
     def check(self) -> None:
@@ -875,11 +915,8 @@ class _LegComposer:
         """(coefficients, discriminant, limits) of one leg along the path."""
         coeffs = tuple(self.along(c) for c in _leg_coefficients(leg))
         disc = leg_discriminant(leg, coeffs)
-        limits = {}
-        if leg.kind == REVOLUTE and leg.joint in self.model.spec.joint_limits:
-            for value in self.model.spec.joint_limits[leg.joint]:
-                limits[value] = compose_pose(limit_constraint(self.model, leg, value),
-                                             self.coordinates, self.model.pose_variables)
+        limits = {value: compose_pose(p, self.coordinates, self.model.pose_variables)
+                  for value, p in self._limit_constraints(leg).items()}
         return coeffs, _reduce(disc) if disc is not None else None, limits
 
 

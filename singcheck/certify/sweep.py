@@ -27,7 +27,7 @@ from __future__ import annotations
 from flint import arb
 
 from singcheck.algebra.intervals import evaluate
-from singcheck.algebra.trig import TRIG, ball_split, evaluate_split, evaluate_trig
+from singcheck.algebra.trig import ball_split, evaluate_split, evaluate_trig
 from singcheck.budget import checkpoint
 from singcheck.certify.covers import TIGHT_ABOVE, TIGHT_DEGREE, budget, halves, one_period, pieces
 from singcheck.certify.path import inside_limits, leg_polynomials, limit_balls
@@ -48,8 +48,7 @@ def sweep_quick_proofs(path, limits_of: dict, starts: list[dict]
     ``starts``: each leg's branches enclosed at the range start; a branch is tried only
     when it is real and proven inside its limits there (one outside is decided at the
     start; an undecided one would fail)."""
-    model = path.projection.model
-    if not model.polynomial or any(x.context() is not TRIG for x in path.coordinates):
+    if not path.legs_from_pose:
         return set(), set()
     facts: list[Fact] = []
     for i, leg in enumerate(path.legs):

@@ -413,8 +413,9 @@ def leg_branches(path: PathModel, tolerance: float, covers: list[_Cover] | None 
 
 
 def start_branches(path: PathModel) -> list[dict]:
-    """Each leg's branches enclosed at the range start, from the pose's balls there."""
-    return path.branches_at_pose(path.pose_variables_at(path.trajectory.range.start.ball()))
+    """Each leg's branches enclosed at the range start
+    (:meth:`~singcheck.certify.path.PathModel.leg_branches_at`)."""
+    return path.leg_branches_at(path.trajectory.range.start.ball())
 
 
 def _start_values(starts: list[dict]) -> list[dict[str, float | None]]:

@@ -447,3 +447,18 @@ def test_refinement_on_wilkinsons_polynomial():
         lo, hi = (mpmath.mpf(int(q.p)) / int(q.q) for q in (rr.lo, rr.hi))
         assert lo <= x <= hi
         assert rr.poly(rr.lo) * rr.poly(rr.hi) < 0
+
+
+@pytest.mark.parametrize("scale", [1, 10**400])
+def test_refinement_guesses_in_floats_or_balls_and_confirms_exactly(scale):
+    """bisect_to: √2 as a root of scale·(x² - 2) refined to 2⁻⁴⁰, whether the float
+    guess applies (scale 1) or the coefficients do not fit a float (10⁴⁰⁰, the ball
+    guess): the interval is short and holds √2, checked exactly (lo² < 2 < hi²)."""
+    from singcheck.roots.rational import RationalRoot, _float_coefficients
+
+    poly = fmpq_poly([-2 * scale, 0, scale])
+    assert (_float_coefficients(poly) is None) == (scale != 1)
+    rr = RationalRoot(poly, fmpq(1), fmpq(2))
+    rr.bisect_to(fmpq(1, 2**40))
+    assert rr.hi - rr.lo <= fmpq(1, 2**40)
+    assert rr.lo * rr.lo < 2 < rr.hi * rr.hi

@@ -155,10 +155,48 @@ class RationalRoot:
 
     def _guess_and_verify(self, target: fmpq, slo: int) -> bool:
         """Narrow [lo, hi] to about ``target`` around Newton's guess when exact signs
-        confirm it (see :meth:`bisect_to`); False, with nothing changed, otherwise."""
+        confirm it (see :meth:`bisect_to`); False, with nothing changed, otherwise.  The
+        guess is made in floats first (cheap; the polynomial scaled to coefficients of
+        at most 1), then, if that guess is not confirmed, in ball midpoints."""
         w = float(target)
         if not w > 0 or not math.isfinite(w):
             return False
+        for guess in (self._float_guess, self._ball_guess):
+            centre = guess(w, slo)
+            if centre is not None and self._confirm(centre, target, slo):
+                return True
+        return False
+
+    def _float_guess(self, w: float, slo: int) -> fmpq | None:
+        """Safeguarded Newton in floats (unproven); None when the coefficients or the
+        ends do not fit a float, or it does not settle within 40 steps."""
+        coeffs = _float_coefficients(self.poly)
+        if coeffs is None:
+            return None
+        a, b = float(self.lo), float(self.hi)
+        if not a < b:
+            return None
+        x = (a + b) / 2
+        for _ in range(40):
+            f = d = 0.0
+            for c in coeffs:  # Horner for f and f' together, highest degree first
+                d = d * x + f
+                f = f * x + c
+            if (f > 0) == (slo > 0):
+                a = x
+            else:
+                b = x
+            guess = x - f / d if d != 0 else (a + b) / 2
+            if not a < guess < b:
+                guess = (a + b) / 2
+            step = abs(guess - x)
+            x = guess
+            if step < w / 16 or b - a < w / 16:
+                return fmpq(*x.as_integer_ratio())
+        return None
+
+    def _ball_guess(self, w: float, slo: int) -> fmpq | None:
+        """Safeguarded Newton in ball midpoints at a precision the width asks for."""
         bits = max(128, 2 * int(-math.log2(w)) + 64)
         old = ctx.prec
         ctx.prec = bits
@@ -181,10 +219,15 @@ class RationalRoot:
                 if step < w / 16 or b - a < w / 16:
                     break
             else:
-                return False
-            centre = arb_to_fmpq(x)
+                return None
+            return arb_to_fmpq(x)
         finally:
             ctx.prec = old
+
+    def _confirm(self, centre: fmpq, target: fmpq, slo: int) -> bool:
+        """Take the short dyadic interval of width about ``target`` around ``centre`` as
+        the new [lo, hi] when it lies inside [lo, hi] and the exact signs of f at its ends
+        are slo and -slo (or one end is the root itself): then it holds the root."""
         a, b = _short_dyadic_hull(centre - target / 4, centre + target / 4, target)
         if not (self.lo < a < b < self.hi):
             return False
@@ -263,6 +306,24 @@ class RationalRoot:
 
 
 _BALL_POLYS: dict = {}
+_FLOAT_COEFFICIENTS: dict = {}
+
+
+def _float_coefficients(poly: fmpq_poly) -> list[float] | None:
+    """The coefficients, highest degree first, as floats scaled to at most 1 in absolute
+    value (for unproven guesses only); None when one does not fit a float.  Once per
+    polynomial object (the roots of one factor share it)."""
+    def convert(p: fmpq_poly) -> list[float] | None:
+        try:
+            cs = [float(c) for c in p.coeffs()]
+        except OverflowError:
+            return None
+        top = max((abs(c) for c in cs), default=0.0)
+        if not (math.isfinite(top) and top > 0):
+            return None
+        return [c / top for c in reversed(cs)]
+
+    return memo_per_object(_FLOAT_COEFFICIENTS, poly, convert)
 
 
 def _ball_polys_of(poly: fmpq_poly, bits: int) -> tuple[arb_poly, arb_poly]:

@@ -470,19 +470,22 @@ class PathModel:
         n_joint = len(model.joint_variables)
         point = [arb(0)] * n_joint + list(pose)
         point += [b for _, b in sorted(radical_balls(model.context, signs).items())]
-        factors = [evaluate(q, point) for _, q in split]
+        powers: dict = {}
+        terms = [(alpha, evaluate(q, point, powers)) for alpha, q in split]
         out = {}
         for label, joints in joints_by_mode.items():
-            flat: list = []
-            for j in joints:
-                flat += list(j) if isinstance(j, tuple) else [j]
-            total = arb(0)
-            for (alpha, _), factor in zip(split, factors, strict=True):
+            flat: list = joints
+            if any(isinstance(j, tuple) for j in joints):  # revolute: (cos θ, sin θ)
+                flat = []
+                for j in joints:
+                    flat += list(j) if isinstance(j, tuple) else [j]
+            total = None
+            for alpha, factor in terms:
                 term = factor
                 for v, e in alpha:
                     term = term * (flat[v] if e == 1 else power(flat[v], e))
-                total = total + term
-            out[label] = total
+                total = term if total is None else total + term
+            out[label] = arb(0) if total is None else total
         return out
 
     @property

@@ -18,6 +18,7 @@ from __future__ import annotations
 import json
 import os
 import platform
+import random
 import resource
 import statistics
 import subprocess
@@ -58,6 +59,10 @@ from singcheck.report.plots import numpy_polynomial  # noqa: E402
 from singcheck.spec.files import load_robot, load_trajectory, parse_trajectory  # noqa: E402
 
 REPEAT = int(os.environ.get("BENCH_REPEAT", "15"))
+#: the seed of the rounds' orders (:func:`interleaved`); BENCH_FIXED_ORDER=1 runs every
+#: round in the listed order instead, as the bench did before (for comparison)
+ROUND_ORDER_SEED = 17
+FIXED_ORDER = os.environ.get("BENCH_FIXED_ORDER") == "1"
 
 
 def times(fn, repeat: int = REPEAT) -> list[tuple[float, float]]:
@@ -80,13 +85,25 @@ def interleaved(fns: list, repeat: int = REPEAT) -> list[list[tuple[float, float
     round), so that a noisy spell of the machine falls on all of them alike; one list
     per contender.  CPU time counts what the run itself used (a subprocess's too), so
     other developers' processes on the shared cores do not inflate it: the targets
-    are judged on it."""
+    are judged on it.
+
+    Each round runs the contenders in its own order (a permutation drawn from a fixed
+    seed: the same orders on every run), so that none is always timed right after the
+    same one.  In a fixed order the 10⁴-point scan always ran right after the 10³-point
+    scan, the same code on the same polynomials, which warmed it, and singcheck always
+    right after the 10⁵-point scan, whose arrays evicted its code and data from the
+    caches: on heart 1 that order made the scan's median 6-10 % lower and singcheck's
+    a few % higher than in varied orders (README, Speed)."""
     out: list[list[tuple[float, float]]] = [[] for _ in fns]
+    orders = random.Random(ROUND_ORDER_SEED)
     for _ in range(repeat):
-        for fn, ts in zip(fns, out, strict=True):
+        order = list(range(len(fns)))
+        if not FIXED_ORDER:
+            orders.shuffle(order)
+        for i in order:
             cpu, start = _cpu(), time.perf_counter()
-            fn()
-            ts.append((time.perf_counter() - start, _cpu() - cpu))
+            fns[i]()
+            out[i].append((time.perf_counter() - start, _cpu() - cpu))
     return out
 
 
@@ -581,11 +598,13 @@ def ms(x: float) -> str:
 
 
 def main() -> None:
-    results = {"machine": machine(), "repeat": REPEAT}
+    order = "every round in the listed order" if FIXED_ORDER else \
+        f"each round in its own order (seed {ROUND_ORDER_SEED})"
+    results = {"machine": machine(), "repeat": REPEAT, "round_order": order}
     print(f"machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, "
           f"Python {results['machine']['python']}, load average {os.getloadavg()[0]:.1f} "
-          f"at the start; medians of {REPEAT} round-robin runs; glibc malloc thresholds "
-          "fixed high (the sampling scans' best case)\n")
+          f"at the start; medians of {REPEAT} round-robin runs, {order}; glibc malloc "
+          "thresholds fixed high (the sampling scans' best case)\n")
     results["paths"] = rows = []
     for robot, trajectory, label in PATHS:
         rows += compare(robot, trajectory, label)

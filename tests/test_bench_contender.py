@@ -90,3 +90,25 @@ def test_contender_says_unknown_at_a_graze_and_free_on_heart2():
 def _orthoglide_sign(t) -> bool:
     """det A along heart 2 (mode +++) is far from 0 at t: a smoke check of the free path."""
     return abs(_heart_det_a(t, *HEART2)) > mpmath.mpf(10) ** -3
+
+
+def test_the_round_robin_varies_each_rounds_order_reproducibly(monkeypatch):
+    """bench.interleaved: every contender runs once per round and its times stay its
+    own; the rounds' orders vary (no contender always follows the same one) and are the
+    same from run to run; BENCH_FIXED_ORDER keeps the listed order."""
+    import bench
+
+    def rounds(repeat=40):
+        calls = []
+        fns = [lambda k=k: calls.append(k) for k in range(5)]
+        times = bench.interleaved(fns, repeat)
+        assert [len(ts) for ts in times] == [repeat] * 5
+        return [tuple(calls[i:i + 5]) for i in range(0, len(calls), 5)]
+
+    orders = rounds()
+    assert all(sorted(o) == [0, 1, 2, 3, 4] for o in orders)
+    assert orders == rounds() and len(set(orders)) > 10
+    after = {(o[i], o[i + 1]) for o in orders for i in range(4)}
+    assert all((a, 3) in after for a in (0, 1, 4))  # 3 follows others than 2
+    monkeypatch.setattr(bench, "FIXED_ORDER", True)
+    assert set(rounds(3)) == {(0, 1, 2, 3, 4)}

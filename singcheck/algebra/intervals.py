@@ -46,14 +46,7 @@ def power(x: Ball, e: int) -> Ball:
         for _ in range(e - 1):
             out = out * x
         return out
-    lo, hi = x.lower(), x.upper()
-    if e == 2:  # (x·x would be m² ± (2|m|r + r²), 2r² wider than the ends' squares)
-        if lo >= 0:
-            return (lo * lo).union(hi * hi)
-        if hi <= 0:
-            return (hi * hi).union(lo * lo)
-        top = max(-lo, hi)
-        return arb(0).union(top * top)
+    lo, hi = x.lower(), x.upper()  # (x·x would be m² ± (2|m|r + r²): 2r² wider)
     if e % 2 == 1 or lo >= 0:
         return _point_power(lo, e).union(_point_power(hi, e))
     if hi <= 0:
@@ -63,6 +56,8 @@ def power(x: Ball, e: int) -> Ball:
 
 def _point_power(p: arb, e: int) -> arb:
     """p^e for an exact ball p, by squaring and multiplying (each step rounded outward)."""
+    if e == 2:
+        return p * p
     out, base = arb(1), p
     while e:
         if e & 1:

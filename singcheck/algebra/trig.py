@@ -379,6 +379,27 @@ def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | tuple | arb_poly:
     return split
 
 
+def sin_cos_parts(q: fmpq_mpoly) -> tuple[fmpq_poly, fmpq_poly | None]:
+    """(P₀, P₁) with q = P₀(c) + s·P₁(c), univariate in c, for a reduced ``q`` free of t
+    (P₁ None when q is free of s): P₀ = q(s = 0) and s·P₁ = q - P₀."""
+    p0 = q.subs({"s": 0})
+    if q.degrees()[1] <= 0:
+        return _in_c(p0), None
+    return _in_c(p0), _in_c((q - p0) / S)
+
+
+def _in_c(q: fmpq_mpoly) -> fmpq_poly:
+    """A polynomial of the trig ring in c alone as a univariate polynomial in c."""
+    cs = q.coeffs()
+    top = q.degrees()[2]
+    if len(cs) == top + 1:  # dense: its terms are c^top, …, c^0 in that order
+        return fmpq_poly(cs[::-1])
+    by_power = [fmpq(0)] * (top + 1)
+    for (_, _, k), a in q.terms():
+        by_power[k] = a
+    return fmpq_poly(by_power)
+
+
 def _split_at_precision(p: fmpq_mpoly):
     """:func:`_split` at the current precision (FLINT rounds each rational coefficient
     outward when it makes the ball polynomial from an exact one)."""
@@ -389,15 +410,9 @@ def _split_at_precision(p: fmpq_mpoly):
         for (i, _, _), a in q.terms():
             by_t[i] = a
         return arb_poly(fmpq_poly(by_t))
-    if dt <= 0 and ds <= 0 and dc >= 0:
-        cs = q.coeffs()
-        if len(cs) == dc + 1:  # dense in c: its terms are c^dc, …, c^0 in that order
-            return (arb_poly(fmpq_poly(cs[::-1])), None)
     if dt <= 0 and dc >= 0:
-        rows = [[fmpq(0)] * (dc + 1), [fmpq(0)] * (dc + 1)]
-        for (_, j, k), a in q.terms():
-            rows[j][k] = a
-        return (arb_poly(fmpq_poly(rows[0])), arb_poly(fmpq_poly(rows[1])) if ds > 0 else None)
+        p0, p1 = sin_cos_parts(q)
+        return (arb_poly(p0), arb_poly(p1) if p1 is not None else None)
     coeffs = [[[fmpq(0)] * (dc + 1) for _ in range(2)] for _ in range(dt + 1)]
     for (i, j, k), a in q.terms():
         coeffs[i][j][k] = a

@@ -16,8 +16,7 @@ from fractions import Fraction
 from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
 
 from singcheck.algebra.intervals import working_precision
-from singcheck.algebra.trig import LinearInPi, TimeRange
-from singcheck.algebra.trig import S as _S
+from singcheck.algebra.trig import LinearInPi, TimeRange, sin_cos_parts
 from singcheck.budget import checkpoint
 from singcheck.roots.enclosures import (
     HALF_ANGLE,
@@ -65,23 +64,8 @@ def _half_angle_parts(p: fmpq_mpoly) -> tuple[fmpq_poly, fmpq_poly | None, int]:
     s·P₁ = p - P₀ (p has degree ≤ 1 in s), d the total degree of p (free of t).
     """
     d = max(int(p.total_degree()), 0)
-    p0 = p.subs({"s": 0})
-    even = _homogenised(_in_c(p0), d)
-    if p.degrees()[1] <= 0:
-        return even, None, d
-    return even, _homogenised(_in_c((p - p0) / _S), d - 1), d
-
-
-def _in_c(q: fmpq_mpoly) -> fmpq_poly:
-    """A polynomial of the trig ring in c alone as a univariate polynomial in c."""
-    cs = q.coeffs()
-    top = q.degrees()[2]
-    if len(cs) == top + 1:  # dense: its terms are c^top, …, c^0 in that order
-        return fmpq_poly(cs[::-1])
-    by_power = [fmpq(0)] * (top + 1)
-    for (_, _, k), a in q.terms():
-        by_power[k] = a
-    return fmpq_poly(by_power)
+    p0, p1 = sin_cos_parts(p)
+    return _homogenised(p0, d), _homogenised(p1, d - 1) if p1 is not None else None, d
 
 
 def _homogenised(poly: fmpq_poly, n: int) -> fmpq_poly:

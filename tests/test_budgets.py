@@ -280,3 +280,25 @@ def test_the_exact_zeros_at_multiples_of_pi_stop_at_the_time_limit():
     with deadline(0.5), pytest.raises(TimeLimitExceeded):
         _exact_zeros(p, interval)
     assert time.monotonic() - start < 3
+
+
+def test_a_costly_leg_is_refused_up_front_though_legs_compose_lazily(orthoglide_projection,
+                                                                      monkeypatch):
+    """Legs enclosed from the pose are composed along the path only on first use; the
+    refusal of a composition beyond the work bound still comes when the path is built
+    (one line, "too costly"), not in the middle of a proof.  With the bound at 0 (and
+    μ composed as usual), every non-constant leg coefficient is over it."""
+    import singcheck.certify.path as P
+    from singcheck.errors import SpecError
+    from singcheck.spec.files import load_trajectory
+
+    spec = load_trajectory(ROBOTS.parent / "trajectories" / "heart1.yaml",
+                           orthoglide_projection.model.spec)
+    mu = P.build_path(orthoglide_projection, spec).mu  # with the real bound
+    monkeypatch.setattr(P, "_compose_mu", lambda *args: mu)
+    monkeypatch.setattr(P, "MAX_COMPOSE_WORK", 0)
+    monkeypatch.setattr(P, "PIECE_WORK", 0)
+    with pytest.raises(SpecError) as refused:
+        P.build_path(orthoglide_projection, spec)
+    message = str(refused.value)
+    assert "too costly: a leg's constraint along the path" in message and "\n" not in message

@@ -382,9 +382,9 @@ def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | tuple | arb_poly:
 def sin_cos_parts(q: fmpq_mpoly) -> tuple[fmpq_poly, fmpq_poly | None]:
     """(P₀, P₁) with q = P₀(c) + s·P₁(c), univariate in c, for a reduced ``q`` free of t
     (P₁ None when q is free of s): P₀ = q(s = 0) and s·P₁ = q - P₀."""
-    p0 = q.subs({"s": 0})
     if q.degrees()[1] <= 0:
-        return _in_c(p0), None
+        return _in_c(q), None
+    p0 = q.subs({"s": 0})
     return _in_c(p0), _in_c((q - p0) / S)
 
 

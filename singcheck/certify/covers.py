@@ -2,7 +2,7 @@
 
 A quick proof shows a property of a path's polynomials (a leg's D > 0, a branch inside
 its limits) by ball arithmetic on each ball of a cover of the range: :func:`pieces`
-cuts the closed range into 8 balls, :func:`halves` splits a ball where the property
+cuts the closed range into 6 balls, :func:`halves` splits a ball where the property
 is not proven (enclosures tighten as balls shrink), until :func:`budget` evaluations
 are spent; then the proof falls back to a root isolation.  On a wide ball a
 high-degree polynomial is enclosed through its Fourier form (``tight``).
@@ -16,7 +16,7 @@ from flint import arb
 
 from singcheck.algebra.trig import LinearInPi, TimeRange, uses_t
 
-PIECES = 8
+PIECES = 6
 BUDGET = 64  # ball evaluations per 2π of range spent before falling back to a root isolation
 TIGHT_ABOVE = 0.05  # radius above which a piece gets tight enclosures (high-degree legs)
 TIGHT_DEGREE = 10  # ... when the leg's polynomials have at least this degree in (s, c)

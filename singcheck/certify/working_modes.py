@@ -10,7 +10,7 @@ stays inside the joint limits over the whole closed range.  How each part is pro
    arithmetic) proves D > 0 on the whole range by continuity: both branches are real
    and distinct (no serial singularity).  A root means the branches meet: the path
    reaches the workspace boundary (det B = 0) and the leg's modes are infeasible.
-   A quick proof comes first: D > 0 in ball arithmetic on each of 8 pieces covering
+   A quick proof comes first: D > 0 in ball arithmetic on each of 6 pieces covering
    the range; only when it fails are the roots of D isolated.
 2. **Inside the limits.**  A branch equals a limit L only at roots of the leg
    constraint with ρ = L.  Those roots cut the range into open gaps in which the branch
@@ -18,7 +18,7 @@ stays inside the joint limits over the whole closed range.  How each part is pro
    ball evaluation at a point of each gap decides which.  Touching a limit is inside
    (the limits are closed).  Quick proofs come first: a branch certainly outside the
    limits at the range start is infeasible, and one certainly inside them on each of
-   8 pieces covering the range is feasible, without isolating any root.
+   6 pieces covering the range is feasible, without isolating any root.
 Whatever cannot be proven makes the branch ``unknown``, with the reason.
 """
 

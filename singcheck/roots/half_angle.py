@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from fractions import Fraction
 
-from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
+from flint import arb, fmpq, fmpq_mpoly, fmpq_poly, fmpz_poly
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.trig import LinearInPi, TimeRange, sin_cos_parts
@@ -74,8 +74,10 @@ def _homogenised(poly: fmpq_poly, n: int) -> fmpq_poly:
         return fmpq_poly([])
     top = poly.degree()
     shifted = poly(_MINUS_ONE_PLUS_2Y)
-    cs = list(shifted.coeffs()) + [fmpq(0)] * (top + 1 - len(shifted.coeffs()))
-    return fmpq_poly(cs[::-1])(_ONE_PLUS_W) * _ONE_PLUS_W ** (n - top)
+    cs = shifted.numer().coeffs()  # reversed as integers: the denominator is kept
+    cs = [0] * (top + 1 - len(cs)) + cs[::-1]
+    out = fmpq_poly(fmpz_poly(cs), shifted.denom())(_ONE_PLUS_W)
+    return out if n == top else out * _ONE_PLUS_W ** (n - top)
 
 
 def deflated_half_angle(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
@@ -188,11 +190,11 @@ def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
 
 def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
     deflated, k = deflated_half_angle(p)
-    at_pi = p.subs({"s": 0, "c": -1})
+    at_pi = sin_cos_parts(p)[0](-1)  # μ at s = 0, c = -1: P₀(-1)
     bases: list[tuple[Callable[[float], arb], LinearInPi | None, int | None,
                       ExactTime | None]] = [
         (r.ball, r.exact, r.multiplicity, r.time) for r in _deflated_roots(deflated, k)]
-    if at_pi.is_zero():
+    if at_pi == 0:
 
         def base_pi(tol: float) -> arb:
             with working_precision(bits_for(tol)):

@@ -44,6 +44,11 @@ def halves(piece: arb) -> tuple[arb, arb]:
     return lo.union(mid), mid.union(hi)
 
 
+def within_one_period(interval: TimeRange) -> bool:
+    """Whether the range is at most 2π long (then it is its own :func:`one_period`)."""
+    return float(interval.end) - float(interval.start) <= 2 * math.pi + 1e-9
+
+
 def one_period(interval: TimeRange, polys, periodic: bool | None = None) -> TimeRange:
     """The part of the range a quick proof about ``polys`` needs to cover (``periodic``:
     whether they are all free of t, when the caller knows).
@@ -52,8 +57,8 @@ def one_period(interval: TimeRange, polys, periodic: bool | None = None) -> Time
     they take no value that they do not take on its first 2π: proving a property of
     their values on [start, start + 2π] proves it on the whole range.
     """
-    start, end = interval.start, interval.end
-    if float(end) - float(start) <= 2 * math.pi + 1e-9:
+    start = interval.start
+    if within_one_period(interval):
         return interval
     if periodic is None:
         periodic = not any(uses_t(p) for p in polys if p is not None)

@@ -504,16 +504,16 @@ class PathModel:
         point += [b for _, b in sorted(radical_balls(model.context, signs).items())]
         powers: dict = {}
         terms = [(alpha, evaluate(q, point, powers)) for alpha, q in split]
+        revolute = model.angle_joints  # a revolute joint's ball is a (cos θ, sin θ) pair
         out = {}
         for label, joints in joints_by_mode.items():
             flat: list = joints
-            if any(isinstance(j, tuple) for j in joints):  # revolute: (cos θ, sin θ)
+            if revolute:
                 flat = []
                 for j in joints:
                     flat += list(j) if isinstance(j, tuple) else [j]
             total = None
-            for alpha, factor in terms:
-                term = factor
+            for alpha, term in terms:
                 for v, e in alpha:
                     term = term * (flat[v] if e == 1 else power(flat[v], e))
                 total = term if total is None else total + term

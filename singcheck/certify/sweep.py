@@ -29,7 +29,15 @@ from flint import arb
 from singcheck.algebra.intervals import evaluate
 from singcheck.algebra.trig import ball_split, evaluate_split, evaluate_trig
 from singcheck.budget import checkpoint
-from singcheck.certify.covers import TIGHT_ABOVE, TIGHT_DEGREE, budget, halves, one_period, pieces
+from singcheck.certify.covers import (
+    TIGHT_ABOVE,
+    TIGHT_DEGREE,
+    budget,
+    halves,
+    one_period,
+    pieces,
+    within_one_period,
+)
 from singcheck.certify.path import inside_limits, leg_polynomials, limit_balls
 from singcheck.model.robot import REVOLUTE
 
@@ -59,6 +67,9 @@ def sweep_quick_proofs(path, limits_of: dict, starts: list[dict]
         if limits is not None:
             facts += [(i, label) for label in leg.labels if isinstance(starts[i][label], arb)
                       and inside_limits(leg.leg, starts[i][label], limits) is True]
+    interval = path.trajectory.range
+    if within_one_period(interval):  # every leg's proofs cover the whole range
+        return _walk(path, facts, pieces(interval), budget(interval), limits_of), set(facts)
     groups: list[tuple[object, list[Fact]]] = []  # (range, facts of the legs covering it)
     ranges: dict[int, object] = {}
     for f in facts:
@@ -95,7 +106,9 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
         if i not in legs:
             leg = path.legs[i].leg
             limits = limits_of.get(leg.joint)
-            legs[i] = (*leg_polynomials(leg),
+            a, b, d = leg_polynomials(leg)
+            # a constant leading coefficient (the Orthoglide's 1): 2a once for all pieces
+            legs[i] = (2 * evaluate(a, ()) if a.is_constant() else a, b, d,
                        limit_balls(limits) if limits else None)
     coordinates = [(x, ball_split(x), x.degrees()[1] + x.degrees()[2] >= TIGHT_COORDINATE)
                    for x in path.coordinates]
@@ -131,7 +144,8 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
             if label is None:
                 continue
             if hit[2] is None:
-                hit[2], hit[3] = 2 * evaluate(a, point, powers), -evaluate(b, point, powers)
+                hit[2] = a if isinstance(a, arb) else 2 * evaluate(a, point, powers)
+                hit[3] = -evaluate(b, point, powers)
             root = hit[0].sqrt()
             rho = (hit[3] + root if label == "+" else hit[3] - root) / hit[2]
             if not (rho > limits[0] and rho < limits[1]):

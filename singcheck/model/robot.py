@@ -129,6 +129,11 @@ class RobotModel:
         return all(self.det_A.degrees()[names.index(v)] <= 0 for v in self.joint_variables)
 
     @cached_property  # the model is immutable; asked at every candidate
+    def angle_joints(self) -> bool:
+        """Some joint is revolute: its value is a (cos θ, sin θ) pair of variables."""
+        return any(leg.kind == REVOLUTE for leg in self.legs)
+
+    @cached_property  # the model is immutable; asked at every candidate
     def polynomial(self) -> bool:
         """No angle and no square root: the original, purely polynomial class."""
         return not self.spec.angles and not self.spec.radicals

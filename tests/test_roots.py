@@ -462,3 +462,23 @@ def test_refinement_guesses_in_floats_or_balls_and_confirms_exactly(scale):
     rr.bisect_to(fmpq(1, 2**40))
     assert rr.hi - rr.lo <= fmpq(1, 2**40)
     assert rr.lo * rr.lo < 2 < rr.hi * rr.hi
+
+
+@pytest.mark.parametrize("roots", [
+    [Fraction(1, 3), Fraction(2, 3)],            # Descartes' bound met below 1
+    [Fraction(1, 3), Fraction(5, 2)],            # one on each side of 1
+    [Fraction(7, 2), Fraction(9, 2)],            # both above 1
+    [Fraction(1, 5), Fraction(1, 1), Fraction(3)],  # one exactly at 1
+])
+def test_positive_roots_on_both_sides_of_one_are_all_isolated(roots):
+    """Known rational roots, with a complex pair (x² + x + 1, none positive) whose
+    coefficients add sign variations Descartes must not mistake for roots."""
+    from singcheck.roots.rational import real_roots_exact
+
+    f = fmpq_poly([1, 1, 1])
+    for r in roots:
+        f *= fmpq_poly([-fmpq(r.numerator, r.denominator), 1])
+    isolated = [rr for rr, _ in real_roots_exact(f, nonnegative_only=True)]
+    assert len(isolated) == len(roots)
+    for rr, r in zip(isolated, sorted(roots), strict=True):
+        assert rr.lo <= fmpq(r.numerator, r.denominator) <= rr.hi

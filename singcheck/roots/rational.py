@@ -354,6 +354,19 @@ def _qsign(q: fmpq) -> int:
     return (q > 0) - (q < 0)
 
 
+def _variations(coeffs) -> int:
+    """The number of sign variations of ``coeffs`` (zeros skipped): by Descartes' rule of
+    signs, a bound on the number of positive roots (with multiplicity)."""
+    count = last = 0
+    for c in coeffs:
+        if c:
+            s = 1 if c > 0 else -1
+            if last and s != last:
+                count += 1
+            last = s
+    return count
+
+
 def _variations_up_to_two(coeffs) -> int:
     """min(2, number of sign variations of ``coeffs``): Descartes' test only needs to
     tell 0, 1 and more apart, so the count stops at the second variation."""
@@ -394,6 +407,8 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     one = fmpq(1)
     intervals = [(one, one)] if sum(cs) == 0 else []
     intervals += _unit_root_intervals(fmpz_poly(cs))
+    if len(intervals) == _variations(cs):
+        return intervals  # Descartes: f has at most that many positive roots, all found
     reversal = fmpz_poly(cs[::-1])
     for lo, hi in _unit_root_intervals(reversal):
         if lo == 0:

@@ -141,11 +141,16 @@ def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
     values: dict[str, arb | acb | None] = {}
     joints: dict[str, list] = {}
     complete = {}
-    for mode in modes:
-        js = [per_leg[i][b.label] for i, b in enumerate(mode.branches)]
+    for mode in modes:  # (plain loops: this runs for every mode at every candidate)
+        js = []
+        real = True
+        for leg, b in zip(per_leg, mode.branches, strict=True):
+            j = leg[b.label]
+            real = real and j is not None
+            js.append(j)
         joints[mode.label] = js
         values[mode.label] = None
-        if not any(j is None for j in js):
+        if real:
             complete[mode.label] = js
     values.update(path.det_A_modes(complete, variables))  # the pose part once for all
     return pose, joints, values
@@ -292,16 +297,17 @@ def classify_candidate(path: PathModel, modes: list[WorkingMode], root: RealRoot
                                        root)
         decided.update(exactly)
     pose, joints = shown_at
-    per_mode = [decided.get(m.label) or ModeAtCandidate(
-        m.label, UNKNOWN, "neither det A ≠ 0 nor a zero could be proven at this root"
-        + (f" near t ≈ {float(root.t.mid()):.9g}: {why}" if why else ""))
-        for m in modes]
-    feasible = {m.label for m in modes if m.status == FEASIBLE}
-    states = {pm.status for pm in per_mode if pm.mode in feasible}
+    per_mode, states, shown = [], set(), {}
+    for m in modes:  # (one loop: this runs at every candidate)
+        pm = decided.get(m.label) or ModeAtCandidate(
+            m.label, UNKNOWN, "neither det A ≠ 0 nor a zero could be proven at this root"
+            + (f" near t ≈ {float(root.t.mid()):.9g}: {why}" if why else ""))
+        per_mode.append(pm)
+        if m.status == FEASIBLE:
+            states.add(pm.status)
+            shown[m.label] = {leg.leg.joint: joint_float(v)
+                              for leg, v in zip(path.legs, joints[m.label], strict=True)}
     status = "real" if SINGULAR in states else "unknown" if UNKNOWN in states else "spurious"
-    shown = {m.label: {leg.leg.joint: joint_float(v)
-                       for leg, v in zip(path.legs, joints[m.label], strict=True)}
-             for m in modes if m.status == FEASIBLE}
     return Candidate(root, pose, shown, per_mode, status)
 
 
@@ -376,8 +382,9 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
     except IdenticallyZeroError:
         return _certify_on_surface(path, modes, tolerance)
     candidates = _classify_all(path, modes, isolation.roots, tolerance)
+    singular = [(c, set(c.singular_modes)) for c in candidates]
     for mode in modes:
-        mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
+        mode.singular_times = [c for c, labels in singular if mode.label in labels]
     undecided = [(b.t, b.reason) for b in isolation.undecided
                  if not _clear_undecided(path, modes, b)]
     verdict, reason = verdict_of(modes, candidates, undecided)

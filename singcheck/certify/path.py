@@ -21,6 +21,7 @@ their norm (:mod:`singcheck.roots.isolation`).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
@@ -520,7 +521,7 @@ class PathModel:
             out[label] = arb(0) if total is None else total
         return out
 
-    @property
+    @cached_property  # asked at every candidate; the fields it reads do not change
     def legs_from_pose(self) -> bool:
         """Whether the legs are enclosed from the pose's balls (the quick feasibility
         proofs of :mod:`.sweep`, the classification): a robot free of square roots and

@@ -431,20 +431,27 @@ def working_modes(path: PathModel, tolerance: float = 1e-9) -> list[WorkingMode]
     starts = _start_values(at_start)
     joints = [leg.leg.joint for leg in path.legs]
     modes = []
-    for choice in product(*per_leg):  # 2^legs
+    for choice in product(*per_leg):  # 2^legs (plain loops: 64 modes for six legs)
         checkpoint()
-        label = "".join(b.label for b in choice)
-        statuses = {b.status for b in choice}
+        statuses = set()
+        label = ""
+        at_start = {}
+        for i, b in enumerate(choice):
+            label += b.label
+            statuses.add(b.status)
+            at_start[joints[i]] = starts[i][b.label]
         if INFEASIBLE in statuses:
             status = INFEASIBLE
         elif UNKNOWN in statuses:
             status = UNKNOWN
         else:
             status = FEASIBLE
-        reason = "; ".join(b.reason for b in choice if b.status == status and b.reason)
-        proof = "; ".join(b.proof for b in choice
-                          if b.proof and (status == FEASIBLE or b.status == status))
-        at_start = {j: starts[i][b.label] for i, (j, b) in enumerate(zip(joints, choice,
-                                                                           strict=True))}
-        modes.append(WorkingMode(label, tuple(choice), status, reason, at_start, proof=proof))
+        reasons, proofs = [], []
+        for b in choice:
+            if b.status == status and b.reason:
+                reasons.append(b.reason)
+            if b.proof and (status == FEASIBLE or b.status == status):
+                proofs.append(b.proof)
+        modes.append(WorkingMode(label, choice, status, "; ".join(reasons), at_start,
+                                 proof="; ".join(proofs)))
     return modes

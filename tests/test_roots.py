@@ -326,11 +326,11 @@ def test_newton_refinement_keeps_the_root_and_reaches_the_width():
 
 
 def test_descartes_variation_count_stops_at_two():
-    from singcheck.roots.rational import _variations_up_to_two
+    from singcheck.roots.rational import _variations
 
     for coeffs, expected in [([1, 2, 3], 0), ([1, 0, -1], 1), ([1, -1, 1], 2),
                              ([-1, 0, 0, 2, -3, 4], 2), ([0, 0, 5, 0, -5], 1), ([], 0)]:
-        assert _variations_up_to_two(coeffs) == expected
+        assert _variations(coeffs, up_to=2) == expected
 
 
 def test_reduce_trig_is_the_same_function_with_degree_at_most_one_in_sine():

@@ -54,17 +54,19 @@ def half_angle_polynomial(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
     return m, d
 
 
-def _half_angle_parts(p: fmpq_mpoly) -> tuple[fmpq_poly, fmpq_poly | None, int]:
+def _half_angle_parts(p: fmpq_mpoly, parts: tuple | None = None
+                      ) -> tuple[fmpq_poly, fmpq_poly | None, int]:
     """(H(P₀, d), H(P₁, d-1) or None when p is free of s, d) of
     :func:`half_angle_polynomial`, as polynomials in w = u².
 
     Writing c = (1-w)/(1+w) = -1 + 2y with y = 1/(1+w),
     (1+w)^m P(c) = y^(-m) P(-1 + 2y) is the reversal of P(-1 + 2y) taken at 1 + w: two
     compositions with linear polynomials in FLINT and a reversal.  P₀ = p(s = 0) and
-    s·P₁ = p - P₀ (p has degree ≤ 1 in s), d the total degree of p (free of t).
+    s·P₁ = p - P₀ (p has degree ≤ 1 in s; ``parts``: (P₀, P₁) when the caller has
+    them), d the total degree of p (free of t).
     """
     d = max(int(p.total_degree()), 0)
-    p0, p1 = sin_cos_parts(p)
+    p0, p1 = parts or sin_cos_parts(p)
     return _homogenised(p0, d), _homogenised(p1, d - 1) if p1 is not None else None, d
 
 
@@ -80,12 +82,13 @@ def _homogenised(poly: fmpq_poly, n: int) -> fmpq_poly:
     return out if n == top else out * _ONE_PLUS_W ** (n - top)
 
 
-def deflated_half_angle(p: fmpq_mpoly) -> tuple[fmpq_poly, int]:
+def deflated_half_angle(p: fmpq_mpoly, parts: tuple | None = None) -> tuple[fmpq_poly, int]:
     """(N, k) with M(u) = N(u^k) for M = :func:`half_angle_polynomial` (p), k as large as
     FLINT's deflation finds.  For p free of s, M = H(u²) exactly, so N and k are those of
     H's own deflation with k doubled, without forming M (twice H's degree) and
-    deflating it back: the same N and k."""
-    even, odd, _ = _half_angle_parts(p)
+    deflating it back: the same N and k.  ``parts``: p's (P₀, P₁) when the caller has
+    them (:func:`~singcheck.algebra.trig.sin_cos_parts`)."""
+    even, odd, _ = _half_angle_parts(p, parts)
     if odd is None and even.degree() >= 1:
         deflated, k = even.numer().deflation()
         return fmpq_poly(deflated), 2 * max(int(k), 1)
@@ -189,8 +192,9 @@ def _atan_ball(rr: RationalRoot, k: int, sign: int) -> Callable[[float], arb]:
 
 
 def _half_angle(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
-    deflated, k = deflated_half_angle(p)
-    at_pi = sin_cos_parts(p)[0](-1)  # μ at s = 0, c = -1: P₀(-1)
+    parts = sin_cos_parts(p)
+    deflated, k = deflated_half_angle(p, parts)
+    at_pi = parts[0](-1)  # μ at s = 0, c = -1: P₀(-1)
     bases: list[tuple[Callable[[float], arb], LinearInPi | None, int | None,
                       ExactTime | None]] = [
         (r.ball, r.exact, r.multiplicity, r.time) for r in _deflated_roots(deflated, k)]

@@ -354,33 +354,20 @@ def _qsign(q: fmpq) -> int:
     return (q > 0) - (q < 0)
 
 
-def _variations(coeffs) -> int:
-    """The number of sign variations of ``coeffs`` (zeros skipped): by Descartes' rule of
-    signs, a bound on the number of positive roots (with multiplicity)."""
+def _variations(coeffs, up_to: int | None = None) -> int:
+    """The number of sign variations of ``coeffs`` (zeros skipped), or ``up_to`` once it
+    reaches that many: by Descartes' rule of signs, a bound on the number of positive
+    roots (with multiplicity).  Descartes' test on an interval only needs to tell 0, 1
+    and more apart, so it stops at the second variation (``up_to=2``)."""
     count = last = 0
     for c in coeffs:
         if c:
             s = 1 if c > 0 else -1
             if last and s != last:
                 count += 1
+                if count == up_to:
+                    return count
             last = s
-    return count
-
-
-def _variations_up_to_two(coeffs) -> int:
-    """min(2, number of sign variations of ``coeffs``): Descartes' test only needs to
-    tell 0, 1 and more apart, so the count stops at the second variation."""
-    last = 0
-    count = 0
-    for c in coeffs:
-        if c == 0:
-            continue
-        s = 1 if c > 0 else -1
-        if last and s != last:
-            count += 1
-            if count == 2:
-                return 2
-        last = s
     return count
 
 
@@ -402,13 +389,14 @@ def _positive_root_intervals(f: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
     cs = f.coeffs()  # FLINT integers: compared and summed as they are, no conversion
     if cs[-1] < 0:
         cs = [-c for c in cs]
-    if all(c >= 0 for c in cs):
-        return []  # no sign variation: no positive root (Descartes)
+    variations = _variations(cs)  # Descartes: at most that many positive roots
+    if variations == 0:
+        return []
     one = fmpq(1)
     intervals = [(one, one)] if sum(cs) == 0 else []
     intervals += _unit_root_intervals(fmpz_poly(cs))
-    if len(intervals) == _variations(cs):
-        return intervals  # Descartes: f has at most that many positive roots, all found
+    if len(intervals) == variations:
+        return intervals  # all found: none above 1
     reversal = fmpz_poly(cs[::-1])
     for lo, hi in _unit_root_intervals(reversal):
         if lo == 0:
@@ -456,7 +444,7 @@ def _unit_root_intervals(g: fmpz_poly) -> list[tuple[fmpq, fmpq]]:
         coeffs = g.coeffs()
         m = len(coeffs) - 1
         test = fmpz_poly(coeffs[::-1])(_X_PLUS_1).coeffs()  # (x+1)^m g(1/(x+1))
-        v = _variations_up_to_two(test)
+        v = _variations(test, up_to=2)
         if v == 0:
             continue
         ends_are_roots = coeffs[0] == 0 or test[0] == 0  # g(0), g(1)

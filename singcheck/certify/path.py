@@ -485,10 +485,7 @@ class PathModel:
         """Enclosure of det A at the given joint values (a revolute joint's as a (cos,
         sin) pair) and pose-variable balls; ``signs`` picks conjugate square roots."""
         model = self.projection.model
-        point: list = []
-        for j in joints:
-            point += list(j) if isinstance(j, tuple) else [j]
-        point += list(pose)
+        point = _flat_joints(joints) + list(pose)
         point += [b for _, b in sorted(radical_balls(model.context, signs).items())]
         return evaluate(model.det_A, point)
 
@@ -508,11 +505,7 @@ class PathModel:
         revolute = model.angle_joints  # a revolute joint's ball is a (cos θ, sin θ) pair
         out = {}
         for label, joints in joints_by_mode.items():
-            flat: list = joints
-            if revolute:
-                flat = []
-                for j in joints:
-                    flat += list(j) if isinstance(j, tuple) else [j]
+            flat = _flat_joints(joints) if revolute else joints
             total = None
             for alpha, term in terms:
                 for v, e in alpha:
@@ -553,6 +546,15 @@ class PathModel:
         as ``signs`` says), by ball evaluation of the leg's coefficients at the pose."""
         model = self.projection.model
         return [branches_at_pose(model, leg.leg, pose, signs) for leg in self.legs]
+
+
+def _flat_joints(joints: list) -> list:
+    """The joints' balls as the robot's variables: a revolute joint's (cos θ, sin θ)
+    pair as two."""
+    flat: list = []
+    for j in joints:
+        flat += list(j) if isinstance(j, tuple) else [j]
+    return flat
 
 
 def branches_at_pose(model: RobotModel, leg: Leg, pose: list, signs=None) -> dict:

@@ -67,9 +67,6 @@ def sweep_quick_proofs(path, limits_of: dict, starts: list[dict]
         if limits is not None:
             facts += [(i, label) for label in leg.labels if isinstance(starts[i][label], arb)
                       and inside_limits(leg.leg, starts[i][label], limits) is True]
-    interval = path.trajectory.range
-    if within_one_period(interval):  # every leg's proofs cover the whole range
-        return _walk(path, facts, pieces(interval), budget(interval), limits_of), set(facts)
     groups: list[tuple[object, list[Fact]]] = []  # (range, facts of the legs covering it)
     ranges: dict[int, object] = {}
     for f in facts:
@@ -90,7 +87,10 @@ def sweep_quick_proofs(path, limits_of: dict, starts: list[dict]
 
 def _leg_range(path, i: int):
     """The part of the range the quick proofs about leg ``i`` cover: one period when the
-    coordinates its polynomials involve are free of the bare t (:func:`one_period`)."""
+    coordinates its polynomials involve are free of the bare t (:func:`one_period`);
+    the whole range when it is one period long at most (the leg's degrees unread)."""
+    if within_one_period(path.trajectory.range):
+        return path.trajectory.range
     offset = len(path.projection.model.joint_variables)
     degrees = [p.degrees() for p in leg_polynomials(path.legs[i].leg)]
     used = [x for k, x in enumerate(path.coordinates) if any(d[offset + k] > 0 for d in degrees)]

@@ -426,9 +426,9 @@ def _start_values(starts: list[dict]) -> list[dict[str, float | None]]:
 def working_modes(path: PathModel, tolerance: float = 1e-9) -> list[WorkingMode]:
     """Every working mode (sign choice per leg) with its proven feasibility."""
     covers = [_Cover(leg, path.trajectory.range) for leg in path.legs]
-    at_start = start_branches(path)
-    per_leg = leg_branches(path, tolerance, covers, at_start)
-    starts = _start_values(at_start)
+    start_balls = start_branches(path)
+    per_leg = leg_branches(path, tolerance, covers, start_balls)
+    starts = _start_values(start_balls)
     joints = [leg.leg.joint for leg in path.legs]
     modes = []
     for choice in product(*per_leg):  # 2^legs (plain loops: 64 modes for six legs)

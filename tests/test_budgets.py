@@ -170,11 +170,42 @@ def test_a_hostile_path_wise_elimination_is_refused_up_front(rotary, tmp_path):
 
 
 def test_a_costly_path_wise_elimination_stops_at_the_time_limit(rotary, tmp_path):
-    """cos 12t, sin 11t: within the bound, about a second of norms (0.9 s of CPU here
-    before μ's degree is refused); a 0.2 s limit stops it at a checkpoint inside the
-    chain (0.27 s of CPU here), not after it: at most 0.6 s of CPU."""
+    """cos 12t, sin 11t: within the bound, about 1.4 s of CPU here of norms before μ's
+    degree is refused; a 0.2 s limit stops it at a checkpoint inside the chain (0.21 s
+    of CPU here), not after it: at most 0.6 s of CPU.  The longest step between two
+    checkpoints is now one squarefree factorization (0.19 s here); one product of the
+    last revolute norm (0.25 s here, 0.45 s on CI) had overrun this bound on CI."""
     pose = {"x": "cos(12*t)/2", "y": "sin(11*t)/2", "z": "-2"}
     assert_stops(rotary, trajectory(tmp_path, pose), limit=0.2, within=0.6)
+
+
+@pytest.mark.parametrize("reduce", ["identity", "circle"])
+def test_a_product_in_slices_is_the_product_and_stops_between_slices(monkeypatch, reduce):
+    """Random dense polynomials in (a, s, c): the sliced product equals x·y (or its
+    remainder modulo s² + c² - 1, computed here by FLINT's own division) for slices of
+    every size, with a checkpoint before each slice."""
+    import random
+
+    from flint import fmpq_mpoly_ctx
+
+    from singcheck.elimination import requests
+
+    ctx = fmpq_mpoly_ctx.get(("a", "s", "c"), "lex")
+    rng = random.Random(7)
+    x, y = (ctx.from_dict({(i, j, k): rng.randrange(-99, 100) for i in range(4)
+                           for j in range(3) for k in range(3)}) for _ in range(2))
+    a, s, c = ctx.gens()
+    circle = s * s + c * c - 1
+    red = (lambda p: p) if reduce == "identity" else (lambda p: divmod(p, circle)[1])
+    expected = red(x * y)
+    for pairs in (1, 7, len(y), 5 * len(y), len(x) * len(y)):
+        monkeypatch.setattr(requests, "PRODUCT_PAIRS", pairs)
+        assert requests._product(x, y, red) == expected, pairs
+    calls = []
+    monkeypatch.setattr(requests, "checkpoint", lambda: calls.append(1))
+    monkeypatch.setattr(requests, "PRODUCT_PAIRS", 2 * len(y))
+    requests._product(x, y, red)
+    assert len(calls) == 1 + (len(x) + 1) // 2  # one before the product, one per slice
 
 
 @pytest.mark.parametrize("robot, pose", [

@@ -179,6 +179,25 @@ def test_a_costly_path_wise_elimination_stops_at_the_time_limit(rotary, tmp_path
     assert_stops(rotary, trajectory(tmp_path, pose), limit=0.2, within=0.6)
 
 
+@pytest.mark.parametrize("limit, code, verdict", [
+    ("0.2", 3, "verdict unknown: time limit (0.2 s) reached"),
+    ("60", 2, "verdict error: "),
+])
+def test_a_path_stopped_before_its_roots_claims_no_candidate_list(
+        monkeypatch, capsys, tmp_path, cache_env, limit, code, verdict):  # noqa: F811
+    """Stopped by its time limit (exit 3) or refused as too costly (exit 2) before μ's
+    roots were isolated, the console report says that nothing is certified: not that μ
+    has no real root, no isolation method, no empty working-mode table, and the verdict
+    once."""
+    pose = {"x": "cos(12*t)/2", "y": "sin(11*t)/2", "z": "-2"}
+    status, out, _ = run_cli(monkeypatch, capsys, "run", str(ROTARY), trajectory(tmp_path, pose),
+                             "--backend", "flint", "--time-limit", limit)
+    assert status == code
+    assert "not certified: the check ended before the real roots of μ(t) were isolated" in out
+    assert verdict in out and "error: error" not in out and "unknown: unknown" not in out
+    assert "no candidate" not in out and "roots by" not in out and "working modes" not in out
+
+
 @pytest.mark.parametrize("reduce", ["identity", "circle"])
 def test_a_product_in_slices_is_the_product_and_stops_between_slices(monkeypatch, reduce):
     """Random dense polynomials in (a, s, c): the sliced product equals x·y (or its

@@ -215,10 +215,11 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
     for t in trajectories:
         segments = t.get("segments") or []
         pieces = f", {len(segments)} segments" if len(segments) > 1 else ""
+        isolated = t["root_isolation"] is not None
         sought = t["root_isolation"] != NOT_NEEDED
         title = f"{robot['name']} · {t['name']}" + (
             f"  ({t['parameter']} ∈ [{t['range'][0]}, {t['range'][1]}]{pieces}"
-            + (f", roots by {t['root_isolation']})" if sought else ")")
+            + (f", roots by {t['root_isolation']})" if sought and isolated else ")")
             if t["range"] else f"  ({t['path']})")
         feasible = [m["label"] for m in t["working_modes"] if m["feasible"]]
         if t["candidates"]:
@@ -237,6 +238,9 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
                               ", ".join(c["singular_modes"]) or "none",
                               f"[{style}]{c['status']}[/{style}]")
             console.print(table)
+        elif not isolated:
+            console.print(f"[bold]{title}[/bold]\n  not certified: the check ended before "
+                          "the real roots of μ(t) were isolated")
         elif not sought:
             console.print(f"[bold]{title}[/bold]\n  candidates not sought: no working mode "
                           "is feasible, so no singularity can be met (μ not isolated)")
@@ -254,7 +258,8 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
                           *[_num(m["joints_at_start"].get(j), 4) for j in joints],
                           ", ".join(_num(x, 6) for x in m["singular_times"]) or "—",
                           m["reason"] or "")
-        console.print(modes)
+        if t["working_modes"]:
+            console.print(modes)
         if verbose:
             for i, c in enumerate(t["candidates"], 1):
                 lo, hi = c["t_interval"]
@@ -272,4 +277,5 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
         if t.get("workspace"):
             console.print(workspace_line(t["workspace"]))
         style = _VERDICT_STYLE.get(t["verdict"], "bold")
-        console.print(f"verdict [{style}]{t['verdict']}[/{style}]: {t['reason']}\n")
+        reason = t["reason"].removeprefix(f"{t['verdict']}: ")
+        console.print(f"verdict [{style}]{t['verdict']}[/{style}]: {reason}\n")

@@ -692,6 +692,20 @@ def test_junit_validates_against_the_schema(tmp_path, monkeypatch):
     assert "'heart2' is already used by" in cases[5].result[0].message
 
 
+def test_junit_omits_a_property_this_run_does_not_know():
+    """ξ not expanded (the rotary Delta): the document's singularity_surface_degree is
+    null, and the JUnit properties leave it out rather than print Python's ``None``."""
+    import xml.etree.ElementTree as ET
+
+    from singcheck.report.junit import junit_xml
+
+    xml = junit_xml({"name": "rotary-delta"}, [], {"backend": "flint",
+                                                   "singularity_surface_degree": None})
+    props = {p.get("name"): p.get("value") for p in ET.fromstring(xml.split("\n", 1)[1])
+             .iter("property")}
+    assert props == {"backend": "flint"}
+
+
 def test_the_schema_test_can_fail():
     """The schema refuses what CI readers would: a testcase without a name, a time with
     more decimals than Surefire writes, an attribute they do not know, a negative count."""

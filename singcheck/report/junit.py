@@ -82,7 +82,8 @@ def junit_xml(robot: dict[str, Any], trajectories: list[dict[str, Any]],
                           hostname=platform.node() or "localhost")
     props = ET.SubElement(suite, "properties")
     for name, value in properties.items():
-        ET.SubElement(props, "property", name=name, value=str(value))
+        if value is not None:  # not known on this run (ξ not expanded: no degree)
+            ET.SubElement(props, "property", name=name, value=str(value))
     for t in trajectories:
         suite.append(testcase(robot, t))
     ET.indent(root)

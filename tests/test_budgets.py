@@ -173,8 +173,9 @@ def test_a_costly_path_wise_elimination_stops_at_the_time_limit(rotary, tmp_path
     """cos 12t, sin 11t: within the bound, about 1.4 s of CPU here of norms before μ's
     degree is refused; a 0.2 s limit stops it at a checkpoint inside the chain (0.21 s
     of CPU here), not after it: at most 0.6 s of CPU.  The longest step between two
-    checkpoints is now one squarefree factorization (0.19 s here); one product of the
-    last revolute norm (0.25 s here, 0.45 s on CI) had overrun this bound on CI."""
+    checkpoints is now one squarefree factorization (0.19 s here); before, one square of
+    the last revolute norm (0.25 s here) and a squarefree split ran with no checkpoint
+    between them, and CI stopped at 0.64 s."""
     pose = {"x": "cos(12*t)/2", "y": "sin(11*t)/2", "z": "-2"}
     assert_stops(rotary, trajectory(tmp_path, pose), limit=0.2, within=0.6)
 

@@ -201,14 +201,15 @@ def test_a_path_stopped_before_its_roots_claims_no_candidate_list(
 
 @pytest.mark.parametrize("reduce", ["identity", "circle"])
 def test_a_product_in_slices_is_the_product_and_stops_between_slices(monkeypatch, reduce):
-    """Random dense polynomials in (a, s, c): the sliced product equals x·y (or its
-    remainder modulo s² + c² - 1, computed here by FLINT's own division) for slices of
-    every size, with a checkpoint before each slice."""
+    """Random dense polynomials in (a, s, c): the sliced product (as the path-wise
+    revolute norms and the composition take it) equals x·y (or its remainder modulo
+    s² + c² - 1, computed here by FLINT's own division) for slices of every size, with a
+    checkpoint before each slice."""
     import random
 
     from flint import fmpq_mpoly_ctx
 
-    from singcheck.elimination import requests
+    from singcheck.algebra import composition
 
     ctx = fmpq_mpoly_ctx.get(("a", "s", "c"), "lex")
     rng = random.Random(7)
@@ -218,14 +219,12 @@ def test_a_product_in_slices_is_the_product_and_stops_between_slices(monkeypatch
     circle = s * s + c * c - 1
     red = (lambda p: p) if reduce == "identity" else (lambda p: divmod(p, circle)[1])
     expected = red(x * y)
-    for pairs in (1, 7, len(y), 5 * len(y), len(x) * len(y)):
-        monkeypatch.setattr(requests, "PRODUCT_PAIRS", pairs)
-        assert requests._product(x, y, red) == expected, pairs
+    for pairs in (1, 7, len(x), 5 * len(x), len(x) * len(y)):
+        assert composition.multiply_in_pieces(x, y, red, pairs) == expected, pairs
     calls = []
-    monkeypatch.setattr(requests, "checkpoint", lambda: calls.append(1))
-    monkeypatch.setattr(requests, "PRODUCT_PAIRS", 2 * len(y))
-    requests._product(x, y, red)
-    assert len(calls) == 1 + (len(x) + 1) // 2  # one before the product, one per slice
+    monkeypatch.setattr(composition, "checkpoint", lambda: calls.append(1))
+    composition.multiply_in_pieces(x, y, red, 2 * len(x))
+    assert len(calls) == 1 + (len(y) + 1) // 2  # one before the product, one per slice
 
 
 @pytest.mark.parametrize("robot, pose", [

@@ -190,13 +190,17 @@ def _horner(items: list, var: int, source: fmpq_mpoly_ctx, args: list[fmpq_mpoly
 
 
 def multiply_in_pieces(a: fmpq_mpoly, b: fmpq_mpoly,
-                       reduce: Callable[[fmpq_mpoly], fmpq_mpoly]) -> fmpq_mpoly:
-    """``reduce(a·b)``, ``b`` cut so that each product has at most :data:`PIECE_PAIRS`
-    term pairs, with a checkpoint before each."""
+                       reduce: Callable[[fmpq_mpoly], fmpq_mpoly],
+                       pairs: int | None = None) -> fmpq_mpoly:
+    """``reduce(a·b)``, ``b`` cut so that each product has at most ``pairs`` (default
+    :data:`PIECE_PAIRS`) term pairs, with a checkpoint before each.  The same polynomial
+    as one product: ``reduce`` (a normal form modulo fixed relations, or the identity)
+    is linear."""
+    pairs = PIECE_PAIRS if pairs is None else pairs
     checkpoint()
-    if len(a) * len(b) <= PIECE_PAIRS:
+    if len(a) * len(b) <= pairs:
         return reduce(a * b)
-    step = max(1, PIECE_PAIRS // max(len(a), 1))
+    step = max(1, pairs // max(len(a), 1))
     terms = list(zip(b.monoms(), b.coeffs(), strict=True))
     ctx = b.context()
     out = ctx.from_dict({})

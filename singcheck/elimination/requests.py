@@ -15,6 +15,7 @@ from typing import Protocol
 
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
+from singcheck.algebra.composition import multiply_in_pieces
 from singcheck.algebra.polynomials import coefficient_in, squarefree_part
 from singcheck.algebra.radicals import radical_prime
 from singcheck.budget import checkpoint
@@ -145,6 +146,9 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly, reduce=None) -> 
     w = red(a * a + b * b)
     delta = red(w - d * d)
 
+    def product(x, y):  # in slices that a time limit can stop
+        return multiply_in_pieces(x, y, red, PRODUCT_PAIRS)
+
     def mul(x, y):
         checkpoint()
         return red(x[0] * y[0] + red(delta * x[1]) * y[1]), red(x[0] * y[1] + x[1] * y[0])
@@ -165,35 +169,18 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly, reduce=None) -> 
     for (i, j), terms in groups.items():
         coefficient = red(ctx.from_dict(terms) * wpow[k - i - j])
         x = mul(cpow[i], spow[j])
-        g0 += _product(coefficient, x[0], red)
-        g1 += _product(coefficient, x[1], red)
-    return _product(g0, g0, red) - _product(delta, _product(g1, g1, red), red)
+        g0 += product(coefficient, x[0])
+        g1 += product(coefficient, x[1])
+    return product(g0, g0) - product(delta, product(g1, g1))
 
 
 #: The most pairs of terms one uninterrupted product may multiply: about 50 ms of FLINT
 #: on the rotary Delta's path-wise norms.  Their last squares multiply 5·10⁶ pairs, which
 #: took 0.25 s in one call and let a 0.2 s time limit overrun by that much (more on a
-#: slower machine).  Slicing costs a few per cent where it applies.
+#: slower machine).  Slicing costs a few per cent where it applies.  Sliced by the
+#: composition's :func:`~singcheck.algebra.composition.multiply_in_pieces`, whose own
+#: bound (:data:`~singcheck.algebra.composition.PIECE_PAIRS`) is twice this one.
 PRODUCT_PAIRS = 1_000_000
-
-
-def _product(x: fmpq_mpoly, y: fmpq_mpoly, reduce) -> fmpq_mpoly:
-    """``reduce(x·y)``, computed as the sum of ``reduce(x_i·y)`` over slices x_i of
-    ``x``'s terms small enough that each product multiplies at most
-    :data:`PRODUCT_PAIRS` pairs of terms, with a :func:`~singcheck.budget.checkpoint`
-    before each.  The same polynomial: ``reduce`` (a normal form modulo fixed
-    relations, or the identity) is linear."""
-    checkpoint()
-    if len(x) * len(y) <= PRODUCT_PAIRS:
-        return reduce(x * y)
-    terms = list(x.terms())
-    size = max(1, PRODUCT_PAIRS // len(y))
-    ctx = x.context()
-    total = ctx.from_dict({})
-    for start in range(0, len(terms), size):
-        checkpoint()
-        total += reduce(ctx.from_dict(dict(terms[start:start + size])) * y)
-    return total
 
 
 def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],

@@ -202,6 +202,24 @@ def to_json(doc: dict[str, Any]) -> str:
     return json.dumps(doc, indent=2, ensure_ascii=False) + "\n"
 
 
+def _modes_table(working_modes: list[dict[str, Any]], joints: list[str], verbose: bool):
+    """The working modes of one trajectory: status, joints at the start, singular times
+    and why (more than eight modes: the infeasible ones only with ``verbose``)."""
+    from rich.table import Table
+
+    modes = Table(title="working modes", title_justify="left")
+    for col in ("mode", "status", *[f"{j} at start" for j in joints], "singular at", "why"):
+        modes.add_column(col)
+    for m in working_modes:
+        if not verbose and m["status"] == "infeasible" and len(working_modes) > 8:
+            continue
+        modes.add_row(m["label"], m["status"],
+                      *[_num(m["joints_at_start"].get(j), 4) for j in joints],
+                      ", ".join(_num(x, 6) for x in m["singular_times"]) or "—",
+                      m["reason"] or "")
+    return modes
+
+
 def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, Any]],
                   verbose: bool = False) -> None:
     """Print one candidates table and one working-modes table per trajectory.
@@ -247,19 +265,8 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
         else:
             console.print(f"[bold]{title}[/bold]\n  no candidate: μ(t) = ξ(φ(t)) has no real "
                           "root on the range")
-        modes = Table(title="working modes", title_justify="left")
-        for col in ("mode", "status", *[f"{j} at start" for j in joints], "singular at",
-                    "why"):
-            modes.add_column(col)
-        for m in t["working_modes"]:
-            if not verbose and m["status"] == "infeasible" and len(t["working_modes"]) > 8:
-                continue
-            modes.add_row(m["label"], m["status"],
-                          *[_num(m["joints_at_start"].get(j), 4) for j in joints],
-                          ", ".join(_num(x, 6) for x in m["singular_times"]) or "—",
-                          m["reason"] or "")
-        if t["working_modes"]:
-            console.print(modes)
+        if t["working_modes"]:  # none when the check ended before the feasibility proofs
+            console.print(_modes_table(t["working_modes"], joints, verbose))
         if verbose:
             for i, c in enumerate(t["candidates"], 1):
                 lo, hi = c["t_interval"]

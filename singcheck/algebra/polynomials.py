@@ -55,8 +55,13 @@ def squarefree_part(p: fmpq_mpoly) -> fmpq_mpoly:
     """The product of the distinct irreducible factors of ``p``, made monic (exact).
 
     It has the same zero set as ``p`` and simple factors, so its roots along a path are
-    the candidates without multiplicity blow-up.
+    the candidates without multiplicity blow-up.  **The zero polynomial is returned as
+    it is**: it vanishes everywhere, and FLINT factors it into no factor at all, whose
+    product would be 1, a polynomial that vanishes nowhere (a path lying on the
+    singularity surface would lose every candidate).
     """
+    if p.is_zero():
+        return p
     _, factors = p.factor_squarefree()
     out = p.context().from_dict({(0,) * p.context().nvars(): 1})
     for f, _mult in factors:

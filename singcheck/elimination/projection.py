@@ -243,6 +243,11 @@ def degenerate_set(model: RobotModel) -> tuple[fmpq_mpoly, ...]:
 
 
 def _without_degenerate_factors(p: fmpq_mpoly, degenerate) -> fmpq_mpoly:
+    """``p``'s squarefree part without the factors that divide a degenerate W; the zero
+    polynomial stays zero (it has no factors to drop, and dropping "all of them" would
+    leave 1)."""
+    if p.is_zero():
+        return p
     if not degenerate:
         return squarefree_part(p)
     _, factors = squarefree_part(p).factor()

@@ -196,7 +196,15 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
     is kept), which keeps factored inputs (stacked stages) small.  ``reduce`` (optional)
     maps each intermediate to an equivalent one modulo relations of the ring (along a
     path: s² + c² = 1), which keeps the same zeros on the variety of those relations.
+
+    **Zero stays zero.**  The norm of the zero polynomial is zero, and so is the norm of g
+    once any step of its chain is identically zero (a path on the singularity: det A
+    vanishes in some mode all along it); FLINT factors zero into no factor, so without
+    this explicit case the product of "no factors" would make the result 1, a
+    polynomial that vanishes nowhere.
     """
+    if g.is_zero():
+        return g
     names = g.context().names()
     _, factors = g.factor()
     one = g.context().from_dict({(0,) * g.context().nvars(): 1})
@@ -213,6 +221,8 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
             acc = revolute_norm(acc, v[0], v[1], f, reduce) if isinstance(v, tuple) else \
                 acc.resultant(f, v)
             acc, reduced = reduce(acc) if reduce else acc, True
+            if acc.is_zero():
+                return acc  # this factor's norm is zero, so the whole norm is zero
             checkpoint()
             if later[i]:
                 acc, free = _split_free(acc, later[i])
@@ -232,9 +242,12 @@ def _split_free(p: fmpq_mpoly, variables: set[int]) -> tuple[fmpq_mpoly, fmpq_mp
     that involve one of ``variables`` (monic) and those that do not.  The norm is
     multiplicative, and a factor free of a leg's joint only comes out of that leg's
     resultant or revolute norm as a power of itself: set aside, it keeps its zeros
-    without being squared at every later leg (the rotary Delta's W = a² + b² factors)."""
-    _, parts = p.factor_squarefree()
+    without being squared at every later leg (the rotary Delta's W = a² + b² factors).
+    The zero polynomial is kept whole: ``(0, 1)`` (it has no factors to split)."""
     one = p.context().from_dict({(0,) * p.context().nvars(): 1})
+    if p.is_zero():
+        return p, one
+    _, parts = p.factor_squarefree()
     keep, free = one, one
     for part, _mult in parts:
         if any(part.degrees()[i] > 0 for i in variables):

@@ -1,0 +1,148 @@
+"""Zero is not "no factor": every step from F to μ keeps a polynomial that vanishes
+everywhere as zero (issue 26).
+
+A 6-RUS hexapod at its home pose lay on its singularity in 44 of its 64 working modes,
+yet was proven free: the path-wise elimination's intermediate norm was identically zero
+(the constant path is on ξ = 0) and FLINT's squarefree factorization of 0 is the empty
+product, so μ became 1.  These tests hold each normalising step to the zero polynomial,
+and whole paths lying on the singularity to an exact oracle written here (rational
+inverse kinematics and det A in ``fractions.Fraction``)."""
+
+from __future__ import annotations
+
+import itertools
+from fractions import Fraction as Q
+
+import pytest
+from flint import fmpq, fmpq_mpoly_ctx
+
+from singcheck import api
+from singcheck.algebra.polynomials import squarefree_part
+from singcheck.elimination.projection import _without_degenerate_factors
+from singcheck.elimination.requests import _split_free, norm_chain, revolute_norm
+from tests.conftest import ROBOTS
+
+RING = fmpq_mpoly_ctx.get(("r", "cr", "sr", "t", "s", "c"), "lex")
+r, cr, sr, t, s, c = RING.gens()
+ZERO = RING.from_dict({})
+
+
+def test_the_squarefree_part_of_zero_is_zero():
+    assert squarefree_part(ZERO).is_zero()
+    assert squarefree_part(4 * (t - 1) ** 2 * (s + 1)) == (t - 1) * (s + 1)
+
+
+def test_splitting_zero_keeps_it_whole():
+    keep, free = _split_free(ZERO, {0})
+    assert keep.is_zero() and free == 1
+
+
+def test_dropping_degenerate_factors_of_zero_leaves_zero():
+    assert _without_degenerate_factors(ZERO, (t ** 2 + 1,)).is_zero()
+    assert _without_degenerate_factors(ZERO, ()).is_zero()
+
+
+def test_the_norm_of_zero_is_zero():
+    assert norm_chain(ZERO, [("r", r ** 2 - t)]).is_zero()
+
+
+def test_a_chain_step_that_vanishes_identically_makes_the_norm_zero():
+    """det A = r - 1/2 on a leg r² - 1/4 = 0 (a constant pose): Res_r = 1/4 - 1/4 = 0.  The
+    mode r = 1/2 is singular all along; the other (r = -1/2) is not."""
+    assert norm_chain(r - fmpq(1, 2), [("r", r ** 2 - fmpq(1, 4))]).is_zero()
+    # and the same with a later leg still to come, whose step must not turn 0 into 1
+    g = (r - fmpq(1, 2)) * (cr + 2)
+    assert norm_chain(g, [("r", r ** 2 - fmpq(1, 4)), (("cr", "sr"), cr + sr - 1)]).is_zero()
+
+
+def test_a_revolute_norm_that_vanishes_identically_stays_zero():
+    """g = cos θ on the leg cos θ = 0 (θ = ±π/2): g is zero on both branches."""
+    assert revolute_norm(cr, "cr", "sr", cr).is_zero()
+    assert norm_chain(cr * (t + 3), [(("cr", "sr"), cr)]).is_zero()
+
+
+def test_a_non_zero_norm_is_unchanged():
+    """The explicit zero cases leave ordinary norms alone: Res_r(r - t, r² - 1) = t² - 1."""
+    assert norm_chain(r - t, [("r", r ** 2 - 1)]) == t ** 2 - 1
+
+
+# -- whole paths on the singularity, against an exact oracle -----------------------------
+
+#: A pose of the Orthoglide (legs of length 2) whose inverse kinematics is rational:
+#: 4 - y² - z², 4 - x² - z², 4 - x² - y² are squares of rationals (1444 = 38²).
+POSE = (Q(2, 19), Q(12, 19), Q(36, 19))
+
+
+def _isqrt(q: Q) -> Q:
+    from math import isqrt
+
+    a, b = isqrt(q.numerator), isqrt(q.denominator)
+    assert a * a == q.numerator and b * b == q.denominator
+    return Q(a, b)
+
+
+def _det3(m) -> Q:
+    return (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]))
+
+
+def orthoglide_singular_modes(pose) -> tuple[set[str], set[str]]:
+    """(modes inside [0, 4]ᶟ, those singular there), exactly: ρᵢ = Xᵢ ± √(4 - |X|² + Xᵢ²),
+    A's rows the leg vectors X - ρᵢ·eᵢ (up to the factor 2 of the gradient)."""
+    x = list(pose)
+    w = [_isqrt(4 - sum(v * v for j, v in enumerate(x) if j != i)) for i in range(3)]
+    inside, singular = set(), set()
+    for signs in itertools.product("+-", repeat=3):
+        rho = [x[i] + (w[i] if signs[i] == "+" else -w[i]) for i in range(3)]
+        if not all(0 <= v <= 4 for v in rho):
+            continue
+        label = "".join(signs)
+        inside.add(label)
+        rows = [[x[j] - (rho[i] if j == i else 0) for j in range(3)] for i in range(3)]
+        if _det3(rows) == 0:
+            singular.add(label)
+    return inside, singular
+
+
+def _constant_path(tmp_path, pose, name="on-surface"):
+    x, y, z = pose
+    f = tmp_path / f"{name}.yaml"
+    f.write_text(f"name: {name}\nparameter: t\nrange: [0, 1]\n"
+                 f"pose: {{x: {x}, y: {y}, z: {z}}}\n")
+    return f
+
+
+def test_the_oracle_pose_is_singular_in_some_modes_only():
+    inside, singular = orthoglide_singular_modes(POSE)
+    assert singular and inside - singular
+
+
+@pytest.mark.parametrize("max_surface_terms", [None, 0], ids=["xi-expanded", "path-wise"])
+def test_a_constant_path_on_the_singularity_is_singular_in_exactly_those_modes(
+        tmp_path, max_surface_terms):
+    """Both ways of computing μ (ξ(φ(t)) and the path-wise chain) give μ ≡ 0 here; the
+    verdict is `singular`, and the modes reported singular all along are the oracle's."""
+    kwargs = {} if max_surface_terms is None else {"max_surface_terms": max_surface_terms}
+    robot = api.load_robot(ROBOTS / "orthoglide.yaml", backend="flint", cache=False, **kwargs)
+    report = api.check(robot, api.load_trajectory(_constant_path(tmp_path, POSE), robot),
+                       regions=False)
+    inside, singular = orthoglide_singular_modes(POSE)
+    assert report.verdict == "singular"
+    feasible = {m.label for m in report.working_modes if m.feasible}
+    assert feasible == inside
+    found = {label for c in report.candidates for label in c.singular_modes}
+    assert found == singular
+    regular = {m.label for m in report.working_modes if m.feasible and not m.singular_times}
+    assert regular == inside - singular
+
+
+def test_a_constant_path_off_the_singularity_is_free(tmp_path):
+    """A nearby rational pose where no mode is singular (oracle): free, both ways."""
+    pose = (Q(1, 2), Q(1, 2), Q(1, 2))
+    for kwargs in ({}, {"max_surface_terms": 0}):
+        robot = api.load_robot(ROBOTS / "orthoglide.yaml", backend="flint", cache=False,
+                               **kwargs)
+        report = api.check(robot, api.load_trajectory(_constant_path(tmp_path, pose), robot),
+                           regions=False)
+        assert report.verdict == "singularity-free"

@@ -187,21 +187,24 @@ class Report:
 
 def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAULT_TOLERANCE,
           regions: bool = True, time_limit: float | None = None,
-          notify: Notify = _quiet) -> Report:
+          notify: Notify = _quiet, engine: str = "auto") -> Report:
     """Certify one trajectory of ``robot``: candidate singular times, their classification
     per working mode, the verdict, and (``regions``) where the path lies in the workspace.
 
     ``time_limit`` (seconds) bounds the whole certification; past it the report's verdict
     is ``unknown`` with the reason (the region statement alone past it is left out, with
-    the reason).  Prints nothing; ``notify`` hears of long steps.
+    the reason).  Prints nothing; ``notify`` hears of long steps.  ``engine``: ``auto``
+    (both engines: the exact one where it can run, always held against the interval
+    one; the interval engine alone on a path the exact one refuses), ``exact`` (refuse
+    such a path) or ``interval`` (the interval engine alone).
     """
     with deadline(time_limit):
         try:
-            certificate = certify_trajectory(robot.projection, trajectory, tolerance)
+            certificate = certify_trajectory(robot.projection, trajectory, tolerance, engine)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions:
-            return Report(trajectory, certificate)
+        if not regions or any(r.path.mu is None for r in certificate.pieces or [certificate]):
+            return Report(trajectory, certificate)  # no region statement without ξ along it
         from singcheck.spaces.path_regions import path_in_workspace, pieces_in_workspace
 
         mu_roots = ([c.t for c in certificate.candidates]
@@ -355,7 +358,8 @@ def shared_regions(robot: Robot, head: list, options: dict, notify: Notify = _qu
 def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document], *,
                 tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
                 time_limit: float | None = DEFAULT_TIME_LIMIT, jobs: int = 1,
-                ordered: bool = True, notify: Notify = _quiet) -> Iterator[dict]:
+                ordered: bool = True, notify: Notify = _quiet,
+                engine: str = "auto") -> Iterator[dict]:
     """Certify many trajectories, in ``jobs`` forked processes when there are more than 4;
     yields each one's JSON trajectory object as soon as it is known: in input order, or
     (``ordered=False``) in the order they finish.
@@ -369,7 +373,7 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
     from itertools import chain, islice
 
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
-                   notify=notify)
+                   notify=notify, engine=engine)
     items = iter(trajectories)
     head = list(islice(items, LOOKAHEAD))
     if jobs > 1 and len(head) > 4:

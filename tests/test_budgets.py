@@ -92,8 +92,8 @@ def test_a_composition_beyond_the_work_bound_is_refused_up_front(stacked, tmp_pa
             for v, k in zip(stacked.model.pose, (20, 19, 18, 17, 16, 15), strict=True)}
     spec = api.load_trajectory(trajectory(tmp_path, pose), stacked)
     start = time.monotonic()
-    with pytest.raises(SpecError) as refused:
-        api.check(stacked, spec, time_limit=60, regions=False)
+    with pytest.raises(SpecError) as refused:  # the exact engine's refusal (auto: intervals)
+        api.check(stacked, spec, time_limit=60, regions=False, engine="exact")
     assert time.monotonic() - start < 2
     message = str(refused.value)
     assert "too costly" in message and "\n" not in message
@@ -162,8 +162,8 @@ def test_a_hostile_path_wise_elimination_is_refused_up_front(rotary, tmp_path):
     pose = {"x": "cos(6*t)/2", "y": "sin(5*t)/2", "z": "-2 + t/10"}
     spec = api.load_trajectory(trajectory(tmp_path, pose), rotary)
     start = time.monotonic()
-    with pytest.raises(SpecError) as refused:
-        api.check(rotary, spec, time_limit=60, regions=False)
+    with pytest.raises(SpecError) as refused:  # the exact engine's refusal (auto: intervals)
+        api.check(rotary, spec, time_limit=60, regions=False, engine="exact")
     assert time.monotonic() - start < 2
     message = str(refused.value)
     assert "too costly" in message and "eliminating the joints along the path" in message
@@ -192,7 +192,7 @@ def test_a_path_stopped_before_its_roots_claims_no_candidate_list(
     once."""
     pose = {"x": "cos(12*t)/2", "y": "sin(11*t)/2", "z": "-2"}
     status, out, _ = run_cli(monkeypatch, capsys, "run", str(ROTARY), trajectory(tmp_path, pose),
-                             "--backend", "flint", "--time-limit", limit)
+                             "--backend", "flint", "--time-limit", limit, "--engine", "exact")
     assert status == code
     assert "not certified: the check ended before the real roots of μ(t) were isolated" in out
     assert verdict in out and "error: error" not in out and "unknown: unknown" not in out

@@ -928,7 +928,7 @@ def test_a_path_whose_mu_would_explode_is_refused_up_front(tmp_path, monkeypatch
     start = time.monotonic()
     code, out, err = run_cli(monkeypatch, capsys, "run", ORTHO, spec,
                              str(TRAJECTORIES / "heart2.yaml"), "-q", "--backend", "flint",
-                             "--format", "json")
+                             "--format", "json", "--engine", "exact")
     assert code == 2 and "Traceback" not in err, err
     costly, heart2 = json.loads(out)["trajectories"]
     assert costly["verdict"] == "error" and costly["error"]["kind"] == "spec"

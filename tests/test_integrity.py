@@ -146,3 +146,27 @@ def test_a_constant_path_off_the_singularity_is_free(tmp_path):
         report = api.check(robot, api.load_trajectory(_constant_path(tmp_path, pose), robot),
                            regions=False)
         assert report.verdict == "singularity-free"
+
+
+def test_a_whole_range_singularity_is_reported_on_surface_in_json_and_table(tmp_path):
+    """The modes singular all along carry on_surface: [t0, t1] (JSON, working modes and
+    candidates) and the table says "all of [t0, t1]"; the others carry null."""
+    import io
+
+    from rich.console import Console
+
+    from singcheck.report.trajectory import render_tables, robot_json
+
+    robot = api.load_robot(ROBOTS / "orthoglide.yaml", backend="flint", cache=False)
+    report = api.check(robot, api.load_trajectory(_constant_path(tmp_path, POSE), robot),
+                       regions=False)
+    doc = report.to_dict()
+    _, singular = orthoglide_singular_modes(POSE)
+    on = {m["label"]: m["on_surface"] for m in doc["working_modes"]}
+    assert {label for label, v in on.items() if v} == singular
+    assert all(on[label] == [0.0, 1.0] for label in singular)
+    assert all(c["on_surface"] == [0.0, 1.0] for c in doc["candidates"])
+    out = io.StringIO()
+    render_tables(Console(file=out, width=200), robot_json(robot.projection), [doc])
+    assert "all of [0, 1] (det A ≡ 0)" in out.getvalue()
+    assert "singular along the whole path" in out.getvalue()

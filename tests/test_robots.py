@@ -324,8 +324,8 @@ def test_a_pose_angle_too_high_a_multiple_of_t_is_refused_up_front(tmp_path, rob
     path = trajectory(tmp_path, {"x": "3/2 + sin(t)/2", "y": "2 - cos(t)/2", "phi": "30*t"})
     robot = robots("3-prr")
     start = time.monotonic()
-    with pytest.raises(SpecError) as refused:
-        api.check(robot, api.load_trajectory(path, robot), regions=False)
+    with pytest.raises(SpecError) as refused:  # the exact engine's refusal (auto: intervals)
+        api.check(robot, api.load_trajectory(path, robot), regions=False, engine="exact")
     assert time.monotonic() - start < 5
     message = str(refused.value)
     assert "\n" not in message
@@ -334,7 +334,7 @@ def test_a_pose_angle_too_high_a_multiple_of_t_is_refused_up_front(tmp_path, rob
     assert "in tan(t/2) (at most 800: the cost grows as its fourth power)" in message
     monkeypatch.setenv("SINGCHECK_CACHE_DIR", str(tmp_path / "cache"))
     code, out, _ = run_cli(monkeypatch, capsys, "run", str(ROBOTS / "3-prr.yaml"), path,
-                           "--backend", "flint", "-q", "--format", "json")
+                           "--backend", "flint", "-q", "--format", "json", "--engine", "exact")
     assert code == 2
 
 

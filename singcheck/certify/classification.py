@@ -48,11 +48,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
 
-from flint import acb, arb
+from flint import arb
 
 from singcheck.algebra.intervals import excludes_zero, sign, working_precision
 from singcheck.algebra.radicals import evaluate_path
 from singcheck.budget import checkpoint
+from singcheck.certify.engines import (
+    EXACT_NOT_RUN,
+    Corroboration,
+    corroborate,
+    corroborated_verdict,
+)
+from singcheck.certify.interval_engine import mode_values as _mode_values
+from singcheck.certify.interval_engine import search_det_a
 from singcheck.certify.path import PathModel, joint_float
 from singcheck.certify.working_modes import (
     FEASIBLE,
@@ -102,6 +110,7 @@ class Candidate:
     modes: list[ModeAtCandidate]
     status: str = UNKNOWN  # real | spurious | unknown
     segment: int = 1  # the piece of a multi-piece path it lies on (1 = the first)
+    on_surface: tuple[arb, arb] | None = None  # (t0, t1): its modes are singular all along
 
     @property
     def t(self) -> arb:
@@ -124,6 +133,7 @@ class TrajectoryReport:
     mu_roots_complete: bool = False  # every root of μ isolated (the candidates are all)
     spec: TrajectorySpec | None = None  # the whole path (None: path.trajectory)
     pieces: list[TrajectoryReport] = field(default_factory=list)  # per segment, if several
+    corroboration: Corroboration | None = None  # the interval engine's check (per piece)
 
     @property
     def trajectory(self) -> TrajectorySpec:
@@ -133,27 +143,6 @@ class TrajectoryReport:
     @property
     def name(self) -> str:
         return self.trajectory.name
-
-
-def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
-    pose, variables = path.pose_and_variables_at(t)
-    per_leg = path.leg_branches_at(t, variables)
-    values: dict[str, arb | acb | None] = {}
-    joints: dict[str, list] = {}
-    complete = {}
-    for mode in modes:  # (plain loops: this runs for every mode at every candidate)
-        js = []
-        real = True
-        for leg, b in zip(per_leg, mode.branches, strict=True):
-            j = leg[b.label]
-            real = real and j is not None
-            js.append(j)
-        joints[mode.label] = js
-        values[mode.label] = None
-        if real:
-            complete[mode.label] = js
-    values.update(path.det_A_modes(complete, variables))  # the pose part once for all
-    return pose, joints, values
 
 
 def _conjugate_values(path: PathModel, modes: list[WorkingMode], t: arb) -> list:
@@ -377,6 +366,8 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
     if all(m.status == INFEASIBLE for m in modes):
         verdict, reason = verdict_of(modes, [], [])
         return TrajectoryReport(path, verdict, reason, [], modes, NOT_NEEDED)
+    if path.mu is None:
+        return _certify_by_intervals(path, modes)
     try:
         isolation = isolate_real_roots(path.mu, path.trajectory.range, tolerance)
     except IdenticallyZeroError:
@@ -388,8 +379,62 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
     undecided = [(b.t, b.reason) for b in isolation.undecided
                  if not _clear_undecided(path, modes, b)]
     verdict, reason = verdict_of(modes, candidates, undecided)
-    return TrajectoryReport(path, verdict, reason, candidates, modes, isolation.method,
-                            undecided, not isolation.undecided)
+    return _corroborated(TrajectoryReport(path, verdict, reason, candidates, modes,
+                                          isolation.method, undecided,
+                                          not isolation.undecided))
+
+
+def _corroborated(report: TrajectoryReport) -> TrajectoryReport:
+    """The report with the interval engine's check of its verdict
+    (:func:`.engines.corroborate`), and the verdict that follows from both engines."""
+    check = corroborate(report.path, report.modes, report.candidates, report.undecided,
+                        report.verdict, BY_IDENTICALLY_ZERO)
+    report.corroboration = check
+    report.verdict, report.reason = corroborated_verdict(report.verdict, report.reason, check)
+    return report
+
+
+#: ``root_method`` of a path certified by the interval engine alone (no μ)
+BY_INTERVALS_ONLY = "none: interval engine (det A along each feasible mode)"
+BY_INTERVAL_CROSSING = "sign change of det A along the mode (ball arithmetic)"
+
+
+def _certify_by_intervals(path: PathModel, modes: list[WorkingMode]) -> TrajectoryReport:
+    """The verdict of the interval engine alone, when the exact engine did not run
+    (``path.exact_refused`` says why): a proven crossing along a feasible mode is
+    ``singular`` (its window is the candidate), every feasible mode proven ≠ 0 on the
+    whole range is ``singularity-free``, and windows left open are ``unknown`` with their
+    bound.  A touch without a sign change cannot be proven by intervals: it stays a
+    window."""
+    feasible = [m for m in modes if m.status == FEASIBLE]
+    searches = search_det_a(path, feasible) if feasible else {}
+    candidates = []
+    for mode in feasible:
+        for w in searches[mode.label].crossings:
+            candidates.append(_window_candidate(path, mode, w))
+    candidates.sort(key=lambda c: float(c.t.mid()))
+    for mode in modes:
+        mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
+    undecided = [(arb(w.lo).union(arb(w.hi)),
+                  f"the interval engine could not prove det A ≠ 0 along mode {m.label} "
+                  f"there (|det A| ≤ {w.bound:.3g}), and {path.exact_refused}")
+                 for m in feasible for w in searches[m.label].windows if not w.crossing]
+    verdict, reason = verdict_of(modes, candidates, undecided)
+    if verdict == VERDICT_FREE:
+        reason += f", by the interval engine alone ({path.exact_refused})"
+    check = Corroboration(EXACT_NOT_RUN, path.exact_refused, searches)
+    return TrajectoryReport(path, verdict, reason, candidates, modes, BY_INTERVALS_ONLY,
+                            undecided, False, corroboration=check)
+
+
+def _window_candidate(path: PathModel, mode: WorkingMode, w) -> Candidate:
+    """A crossing the interval engine proved along ``mode`` in the window ``w``."""
+    t = arb(w.lo).union(arb(w.hi))
+    pose, joints, _ = _mode_values(path, [mode], t)
+    shown = {mode.label: {leg.leg.joint: joint_float(v)
+                          for leg, v in zip(path.legs, joints[mode.label], strict=True)}}
+    return Candidate(RealRoot(t, None), pose, shown,
+                     [ModeAtCandidate(mode.label, SINGULAR, BY_INTERVAL_CROSSING)], "real")
 
 
 def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
@@ -430,8 +475,8 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
     if verdict == VERDICT_FREE:
         reason += " (the path lies on ξ(X) = 0: each mode was decided on its own)"
     # the candidates are the modes' own zeros, not roots of μ (which is ≡ 0)
-    return TrajectoryReport(path, verdict, reason, candidates, modes, method, undecided,
-                            mu_roots_complete=False)
+    return _corroborated(TrajectoryReport(path, verdict, reason, candidates, modes, method,
+                                          undecided, mu_roots_complete=False))
 
 
 def _mode_zeros(path: PathModel, mode: WorkingMode, samples: list):
@@ -459,8 +504,9 @@ def _on_surface_candidate(path, mode, status, proof) -> Candidate:
     shown = {mode.label: {leg.leg.joint: joint_float(v)
                           for leg, v in zip(path.legs, joints[mode.label], strict=True)}}
     state = "real" if status == SINGULAR else UNKNOWN
+    end = path.trajectory.range.end.ball()
     return Candidate(RealRoot(t, None), pose, shown, [ModeAtCandidate(mode.label, status, proof)],
-                     state)
+                     state, on_surface=(t, end) if status == SINGULAR else None)
 
 
 def verdict_of(modes, candidates, undecided) -> tuple[str, str]:

@@ -23,7 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 
-from flint import acb, arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
+from flint import acb, acb_mat, arb, arb_mat, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.composition import (
     MAX_COMPOSE_WORK,
@@ -447,10 +447,11 @@ class PathModel:
     projection: RobotProjection
     trajectory: TrajectorySpec
     phi: tuple[fmpq_mpoly, ...]  # pose coordinates in the robot's pose order (display)
-    mu: fmpq_mpoly  # ξ(φ(t))
+    mu: fmpq_mpoly | None  # ξ(φ(t)); None: the exact engine did not run (exact_refused)
     legs: tuple[LegAlongPath, ...]
     coordinates: tuple[fmpq_mpoly, ...] = ()  # the pose variables' (cos φ, sin φ for angles)
     degenerate: tuple[fmpq_mpoly, ...] = ()  # W of each revolute leg along the path
+    exact_refused: str = ""  # why μ was not computed ("" when it was)
 
     def pose_at(self, t: arb) -> list[arb]:
         """The pose coordinates (an angle in radians, its π offset included)."""
@@ -496,6 +497,8 @@ class PathModel:
         the pose, and each mode only sums its few joint monomials.  The same polynomial,
         grouped differently: every enclosure is as rigorous as :meth:`det_A`'s."""
         model = self.projection.model
+        if len(model.det_A) > MATRIX_FORM_ABOVE:
+            return _det_a_by_matrix(model, joints_by_mode, pose, signs)
         split = _det_a_by_joints(model)
         n_joint = len(model.joint_variables)
         point = [arb(0)] * n_joint + list(pose)
@@ -546,6 +549,29 @@ class PathModel:
         as ``signs`` says), by ball evaluation of the leg's coefficients at the pose."""
         model = self.projection.model
         return [branches_at_pose(model, leg.leg, pose, signs) for leg in self.legs]
+
+
+#: det A with more terms than this (a hexapod's: 10⁵) is enclosed per mode as the
+#: determinant of the ball matrix A(φ(T), ρ_mode(T)) instead of term by term
+MATRIX_FORM_ABOVE = 5000
+
+
+def _det_a_by_matrix(model: RobotModel, joints_by_mode: dict, pose: list[arb],
+                     signs: dict[int, int] | None = None) -> dict:
+    """det A per mode as the determinant of the ball matrix A = ∂F/∂X enclosed at the
+    mode's joints and the pose (FLINT's ``arb_mat.det``, rigorous): the same value as
+    the expanded det A wherever the (cos, sin) pairs lie on their circles and the
+    square roots square to their radicands — true of every point the balls stand for —
+    at a few hundred terms instead of det A's many thousands."""
+    radicals = [b for _, b in sorted(radical_balls(model.context, signs).items())]
+    out = {}
+    for label, joints in joints_by_mode.items():
+        point = _flat_joints(joints) + list(pose) + radicals
+        powers: dict = {}
+        rows = [[evaluate(e, point, powers) for e in row] for row in model.A]
+        real = all(isinstance(e, arb) for row in rows for e in row)
+        out[label] = (arb_mat(rows) if real else acb_mat(rows)).det()
+    return out
 
 
 def _flat_joints(joints: list) -> list:
@@ -799,8 +825,20 @@ def _leg_coefficients(leg: Leg) -> tuple[fmpq_mpoly, ...]:
     return memo_per_object(_LEG_COEFFICIENTS, leg, leg_coefficients)
 
 
-def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathModel:
-    """The model along one piece (a multi-piece path: one per ``trajectory.pieces``)."""
+#: which engines certify a path: both (the interval engine first, the exact one where
+#: it can run), the exact one (μ required: refused when too costly), the interval one
+AUTO, EXACT, INTERVAL = "auto", "exact", "interval"
+ENGINES = (AUTO, EXACT, INTERVAL)
+
+
+def build_path(projection: RobotProjection, trajectory: TrajectorySpec,
+               engine: str = AUTO) -> PathModel:
+    """The model along one piece (a multi-piece path: one per ``trajectory.pieces``).
+
+    μ is left out (None, with the reason in ``exact_refused``) when ``engine`` is
+    ``interval``, or when it is ``auto`` and the exact engine refuses the path (μ or its
+    isolation too costly, a path-wise elimination not supported): the interval engine
+    then certifies the path alone."""
     if trajectory.segments:
         raise ValueError("build_path takes one piece: use trajectory.pieces")
     model = projection.model
@@ -852,9 +890,33 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
             coordinates.append(x)
     coordinates = tuple(coordinates)
     pose_vars = model.pose_variables
+    mu, refused = None, "the interval engine alone was asked for (--engine interval)"
+    if engine != INTERVAL:
+        try:
+            mu = _mu(projection, trajectory, coordinates, where)
+        except (SpecError, UnsupportedRobotError) as e:
+            if engine == EXACT:
+                raise
+            refused = f"the exact engine refused this path: {e.message}"
+    try:
+        legs = _legs_along(model, coordinates)
+        degenerate = tuple(compose_pose(w, coordinates, pose_vars)
+                           for w in memo_per_object(_DEGENERATE, model, degenerate_set))
+    except TooCostly as e:
+        raise _too_costly(f"a leg's constraint along the path: {e}", trajectory) from None
+    return PathModel(projection, trajectory, phi, mu, legs, coordinates, degenerate,
+                     "" if mu is not None else refused)
+
+
+def _mu(projection: RobotProjection, trajectory: TrajectorySpec,
+        coordinates: tuple[fmpq_mpoly, ...], where: dict) -> fmpq_mpoly:
+    """μ(t): ξ(φ(t)) when ξ was expanded, else eliminated along the path; refused (a
+    :class:`SpecError` naming the pose) when it, or isolating its roots, is too costly."""
+    model = projection.model
     if projection.expanded:
         # ξ modulo the pose angles' circles: μ is the same (φ's cos, sin lie on them)
-        mu = _compose_mu(projection.surface_on_circles, coordinates, pose_vars, trajectory)
+        mu = _compose_mu(projection.surface_on_circles, coordinates, model.pose_variables,
+                         trajectory)
     else:
         try:
             mu = eliminate_along_path(model, coordinates, where)
@@ -865,13 +927,7 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec) -> PathM
         raise _too_costly(f"isolating the real roots of μ(t) would take a polynomial of degree "
                           f"{degree} in tan(t/2) (at most {MAX_HALF_ANGLE_DEGREE}: the cost "
                           "grows as its fourth power)", trajectory)
-    try:
-        legs = _legs_along(model, coordinates)
-        degenerate = tuple(compose_pose(w, coordinates, pose_vars)
-                           for w in memo_per_object(_DEGENERATE, model, degenerate_set))
-    except TooCostly as e:
-        raise _too_costly(f"a leg's constraint along the path: {e}", trajectory) from None
-    return PathModel(projection, trajectory, phi, mu, legs, coordinates, degenerate)
+    return mu
 
 
 #: W of each revolute leg (:func:`~singcheck.elimination.projection.degenerate_set`),

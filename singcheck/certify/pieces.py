@@ -39,7 +39,8 @@ from singcheck.certify.classification import (
     certify_path,
     verdict_of,
 )
-from singcheck.certify.path import build_path
+from singcheck.certify.engines import combined, corroborated_verdict
+from singcheck.certify.path import AUTO, build_path
 from singcheck.certify.working_modes import FEASIBLE, INFEASIBLE, UNKNOWN, WorkingMode
 from singcheck.elimination.projection import RobotProjection
 from singcheck.roots.enclosures import RealRoot
@@ -47,14 +48,15 @@ from singcheck.spec.files import TrajectorySpec
 
 
 def certify_trajectory(projection: RobotProjection, spec: TrajectorySpec,
-                       tolerance: float = 1e-9) -> TrajectoryReport:
-    """The verdict for a whole path, one piece or many (see the module docstring)."""
+                       tolerance: float = 1e-9, engine: str = AUTO) -> TrajectoryReport:
+    """The verdict for a whole path, one piece or many (see the module docstring);
+    ``engine``: :data:`~singcheck.certify.path.ENGINES`."""
     if not spec.segments and spec.time_scale is None:
-        return certify_path(build_path(projection, spec), tolerance)
+        return certify_path(build_path(projection, spec, engine), tolerance)
     reports = []
     for piece in spec.pieces:
         checkpoint()
-        reports.append(certify_path(build_path(projection, piece), tolerance))
+        reports.append(certify_path(build_path(projection, piece, engine), tolerance))
     return compose(spec, reports)
 
 
@@ -65,7 +67,9 @@ def joins(spec: TrajectorySpec) -> list:
 
 def _global_candidate(c: Candidate, piece: TrajectorySpec, segment: int) -> Candidate:
     root = RealRoot(piece.to_global(c.t), c.root.multiplicity)
-    return Candidate(root, c.pose, c.joints, c.modes, c.status, segment)
+    on_surface = None if c.on_surface is None else tuple(piece.to_global(t)
+                                                         for t in c.on_surface)
+    return Candidate(root, c.pose, c.joints, c.modes, c.status, segment, on_surface)
 
 
 def _same_root_at_join(report: TrajectoryReport, left: Candidate, right: Candidate,
@@ -149,11 +153,13 @@ def compose(spec: TrajectorySpec, reports: list[TrajectoryReport]) -> Trajectory
     verdict, reason = verdict_of(modes, candidates, undecided)
     if verdict == VERDICT_INFEASIBLE:
         reason = _mode_change(spec, reports) or reason
+    check = combined([r.corroboration for r in reports])
+    verdict, reason = corroborated_verdict(verdict, reason, check)
     methods = list(dict.fromkeys(r.root_method for r in reports))
     return TrajectoryReport(reports[0].path, verdict, reason, candidates, modes,
                             methods[0] if len(methods) == 1 else " + ".join(methods),
                             undecided, all(r.mu_roots_complete for r in reports), spec,
-                            reports)
+                            reports, check)
 
 
 def _mode_change(spec, reports) -> str | None:

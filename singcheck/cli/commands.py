@@ -118,11 +118,18 @@ def cli() -> None:
               show_default=True,
               help="How a CSV table of poses (TRAJECTORY ending in .csv) is joined: straight "
                    "lines, or the natural cubic spline through its rows.")
+@click.option("--engine", type=click.Choice(["auto", "exact", "interval"]), default="auto",
+              show_default=True,
+              help="auto: the exact engine (μ and its certified roots) held against the "
+                   "interval engine (det A enclosed along each feasible mode), the interval "
+                   "engine alone on a path the exact one refuses; exact: refuse such a path; "
+                   "interval: the interval engine alone (a tangency stays unknown).")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
 def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs,
-        time_limit, no_regions, scheduler, plot_dir, interpolation, quiet, verbose) -> None:
+        time_limit, no_regions, scheduler, plot_dir, interpolation, engine, quiet,
+        verbose) -> None:  # engine: which certifies (the elimination backend is --backend)
     """Certify each TRAJECTORY of ROBOT (YAML spec files; - reads standard input; a
     trajectory may also be a CSV table of poses).  A YAML file may hold several
     trajectories as documents separated by ---; their names must be unique in a run.
@@ -152,7 +159,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
                     verbose, progress, jobs, plot_dir, interpolation, time_limit=time_limit,
-                    regions=not no_regions, scheduler=scheduler)
+                    regions=not no_regions, scheduler=scheduler, certify_with=engine)
     sys.exit(int(code))
 
 
@@ -180,7 +187,7 @@ def _worst(codes) -> ExitCode:
 
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
          progress, jobs, plot_dir=None, interpolation="cubic", *, time_limit=300.0,
-         regions=True, scheduler=None):
+         regions=True, scheduler=None, certify_with="auto"):
     from contextlib import closing
     from itertools import chain, islice
 
@@ -208,7 +215,7 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     else:
         progress.note(f"singularity surface: not expanded: {projection.not_expanded}")
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
-                   ordered=fmt != "jsonl", notify=progress.note)
+                   ordered=fmt != "jsonl", notify=progress.note, engine=certify_with)
     if scheduler:
         from singcheck.cluster import check_on_cluster
 

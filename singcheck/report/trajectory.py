@@ -44,7 +44,16 @@ def candidate_json(report: TrajectoryReport, c) -> dict[str, Any]:
         "status": c.status,
         "modes": [{"mode": m.mode, "status": m.status, "proof": m.proof} for m in c.modes],
         "segment": c.segment,
+        "on_surface": _on_surface(c),
     }
+
+
+def _on_surface(c) -> list[float] | None:
+    """[t0, t1] of a candidate whose singular modes are singular all along it (det A ≡ 0
+    on the piece), else None."""
+    if c.on_surface is None:
+        return None
+    return [float(c.on_surface[0].mid()), float(c.on_surface[1].mid())]
 
 
 def _range(spec) -> list[str]:
@@ -92,7 +101,7 @@ def error_json(spec, kind: str, message: str) -> dict[str, Any]:
 
 
 def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
-    return {
+    doc = {
         **_trajectory_head(report.trajectory),
         "verdict": report.verdict,
         "reason": report.reason,
@@ -107,12 +116,19 @@ def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
                 "joints_at_start": m.joints_at_start,
                 "proof": m.proof,
                 "singular_times": [float(c.t.mid()) for c in m.singular_times],
+                "on_surface": next((_on_surface(c) for c in m.singular_times
+                                    if c.on_surface is not None), None),
             }
             for m in report.modes
         ],
         "undecided": [{"t_interval": _interval(t), "reason": r} for t, r in report.undecided],
         "segments": segments_json(report),
+        "corroboration": None if report.corroboration is None
+        else report.corroboration.to_json(),
     }
+    if report.verdict == "error":  # the two engines disagree
+        doc["error"] = {"kind": "inconsistent", "message": report.reason}
+    return doc
 
 
 def workspace_json(w) -> dict[str, Any]:
@@ -215,9 +231,17 @@ def _modes_table(working_modes: list[dict[str, Any]], joints: list[str], verbose
             continue
         modes.add_row(m["label"], m["status"],
                       *[_num(m["joints_at_start"].get(j), 4) for j in joints],
-                      ", ".join(_num(x, 6) for x in m["singular_times"]) or "—",
+                      _singular_at(m),
                       m["reason"] or "")
     return modes
+
+
+def _singular_at(m: dict[str, Any]) -> str:
+    """The table's "singular at" cell: the times, or the whole stretch on the surface."""
+    if m.get("on_surface"):
+        lo, hi = m["on_surface"]
+        return f"all of [{_num(lo, 6)}, {_num(hi, 6)}] (det A ≡ 0)"
+    return ", ".join(_num(x, 6) for x in m["singular_times"]) or "—"
 
 
 def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, Any]],

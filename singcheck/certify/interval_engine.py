@@ -1,0 +1,182 @@
+"""The interval engine: det A along each working mode, enclosed by ball arithmetic.
+
+It reads what the path model evaluates — the pose φ(T), each leg's closed-form branch
+(quadratic for a prismatic leg, the (cos, sin) pair for a revolute one) and det A of
+the robot — on balls T of the parameter, and never μ or anything the elimination made.
+That makes it the second, independent computation behind every verdict
+(:mod:`.engines` compares the two).
+
+What it proves, per working mode given as *feasible* (its branches real, separated and
+inside the limits on the whole closed range, so det A along it is continuous):
+
+* **det A ≠ 0 on a piece T**: the ball enclosure of det A(φ(T), ρ_mode(T)) excludes 0
+  (FLINT's comparisons are certain; every operation rounds outward).  Its sign there
+  is proven too.
+* **A crossing in a window W**: the pieces just left and right of W carry proven,
+  opposite signs; det A is continuous, so it vanishes in W (intermediate values).
+
+Pieces that are not proven are halved (the enclosures tighten as balls shrink) until
+they are narrower than :data:`MIN_WIDTH` of the range or the evaluation budget is
+spent; what is left are *windows*, each with the proven bound |det A| ≤ ε on it.  A
+window whose two sides have the same sign (or touch a range end) may hold a tangency,
+an even number of crossings, or nothing: the interval engine does not guess.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+
+from flint import arb
+
+from singcheck.algebra.intervals import excludes_zero, sign
+from singcheck.budget import checkpoint
+from singcheck.certify.covers import halves, pieces
+
+#: the narrowest piece that is halved again, relative to the range's length
+MIN_WIDTH = 2.0 ** -26
+#: ... for a piece holding a time the caller expects det A to vanish at (a hint: the
+#: window left there only has to be narrow enough to tell that zero from others)
+HINT_WIDTH = 2.0 ** -14
+#: ball evaluations (all the modes at once) per 2π of range, at least BUDGET
+BUDGET = 20000
+
+
+@dataclass(frozen=True)
+class Window:
+    """A stretch [lo, hi] on which det A along the mode was not proven ≠ 0."""
+
+    lo: float
+    hi: float
+    bound: float  # proven: |det A| ≤ bound on the whole window (inf when not enclosed)
+    left: int | None  # the proven sign just before the window (None: a range end)
+    right: int | None  # ... and just after it
+
+    @property
+    def crossing(self) -> bool:
+        """Proven: det A vanishes in the window (opposite signs around it)."""
+        return self.left is not None and self.right is not None and self.left != self.right
+
+    def overlaps(self, t: arb) -> bool:
+        return not (t.upper() < self.lo or t.lower() > self.hi)
+
+
+@dataclass
+class ModeSearch:
+    """What the interval engine proved about det A along one working mode."""
+
+    label: str
+    proven: list[tuple[float, float, int]] = field(default_factory=list)  # (lo, hi, sign)
+    windows: list[Window] = field(default_factory=list)
+
+    @property
+    def free(self) -> bool:
+        """Proven: det A ≠ 0 along the mode on the whole range."""
+        return not self.windows
+
+    @property
+    def crossings(self) -> list[Window]:
+        return [w for w in self.windows if w.crossing]
+
+    def nonzero_on(self, t: arb) -> bool:
+        """Proven: det A ≠ 0 on all of the ball t (it lies in one proven piece)."""
+        lo, hi = t.lower(), t.upper()
+        return any(a <= lo and hi <= b for a, b, _ in self.proven)
+
+
+def _bound(value) -> float:
+    """An upper bound of |value| over its ball (inf when there is none)."""
+    if not isinstance(value, arb) or not value.is_finite():
+        return math.inf
+    return float(abs(value).upper())
+
+
+def mode_values(path, modes: list, t: arb):
+    """(pose, joints per mode, det A per mode) enclosed over the ball ``t``: the pose and
+    the legs' branches once for all the modes, det A's pose part once (a mode whose
+    branches are not all real there gets None)."""
+    pose, variables = path.pose_and_variables_at(t)
+    per_leg = path.leg_branches_at(t, variables)
+    values: dict = {}
+    joints: dict[str, list] = {}
+    complete = {}
+    for mode in modes:  # (plain loops: this runs for every mode at every candidate)
+        js = []
+        real = True
+        for leg, b in zip(per_leg, mode.branches, strict=True):
+            j = leg[b.label]
+            real = real and j is not None
+            js.append(j)
+        joints[mode.label] = js
+        values[mode.label] = None
+        if real:
+            complete[mode.label] = js
+    values.update(path.det_A_modes(complete, variables))  # the pose part once for all
+    return pose, joints, values
+
+
+def search_det_a(path, modes: list, refine: set[str] | None = None,
+                 budget: int | None = None, hints: dict | None = None
+                 ) -> dict[str, ModeSearch]:
+    """Branch-and-bound of det A along each of ``modes`` (given as feasible) over the
+    path's closed range.  Only the modes in ``refine`` (default: all) are refined past the
+    first cover; the others are enclosed once on each of its pieces (a mode said to be
+    singular all along: every piece stays a window, and refining it would cost
+    everything).  All the modes open on a piece share one enclosure of the pose and the
+    legs there.  ``hints`` (per mode, balls of t where det A is expected to vanish) only
+    stop the halving early around them (:data:`HINT_WIDTH`): they change no proof."""
+    interval = path.trajectory.range
+    width = float(interval.end) - float(interval.start)
+    smallest = max(width * MIN_WIDTH, 1e-300)
+    near = max(width * HINT_WIDTH, smallest)
+    hints = hints or {}
+    periods = max(1.0, width / (2 * math.pi))
+    left = budget if budget is not None else int(BUDGET * periods)
+    refine = {m.label for m in modes} if refine is None else refine
+    found: dict[str, dict[tuple[float, float], tuple[int | None, float]]] = {
+        m.label: {} for m in modes}
+    todo = deque((piece, list(modes)) for piece in pieces(interval))
+    while todo:  # breadth first: a spent budget leaves the whole range equally refined
+        checkpoint()
+        piece, open_modes = todo.popleft()
+        _, _, values = mode_values(path, open_modes, piece)
+        left -= 1
+        lo, hi = float(piece.lower()), float(piece.upper())
+        again = []
+        for mode in open_modes:
+            v = values[mode.label]
+            if isinstance(v, arb) and excludes_zero(v):
+                found[mode.label][lo, hi] = (sign(v), _bound(v))
+            elif mode.label in refine and left > 0 and hi - lo > smallest and not (
+                    hi - lo <= near and any(h.overlaps(piece) for h in
+                                            hints.get(mode.label, ()))):
+                again.append(mode)
+            else:
+                found[mode.label][lo, hi] = (None, _bound(v))
+        if again:
+            a, b = halves(piece)
+            todo += [(a, again), (b, again)]
+    return {label: _summarise(label, pieces_found) for label, pieces_found in found.items()}
+
+
+def _summarise(label: str, found: dict) -> ModeSearch:
+    """The proven pieces and the windows (maximal runs of unproven pieces, with the
+    signs on either side) of one mode."""
+    out = ModeSearch(label)
+    run: list = []
+    before: int | None = None
+    for (lo, hi), (s, bound) in sorted(found.items()):
+        if s is None:
+            run.append((lo, hi, bound))
+            continue
+        out.proven.append((lo, hi, s))
+        if run:
+            out.windows.append(Window(run[0][0], run[-1][1], max(r[2] for r in run),
+                                      before, s))
+            run = []
+        before = s
+    if run:
+        out.windows.append(Window(run[0][0], run[-1][1], max(r[2] for r in run), before,
+                                  None))
+    return out

@@ -1,0 +1,164 @@
+"""Two engines, one verdict (issue 26): the exact engine's answer is held against the
+interval engine's enclosures of det A along each feasible mode, and a disagreement is
+the verdict ``error`` (``error.kind`` ``inconsistent``), never a silent answer.
+
+The disagreements are made by breaking one engine on purpose (monkeypatching its
+result), since two correct engines never disagree; the interval engine's own findings
+are checked against 50-digit mpmath values of det A along the Orthoglide's branches."""
+
+from __future__ import annotations
+
+import itertools
+
+import mpmath as mp
+import pytest
+
+from singcheck import api
+from singcheck.certify import classification, interval_engine
+from singcheck.certify.interval_engine import search_det_a
+from singcheck.roots.enclosures import RootIsolation
+from tests import robot_oracles as oracles
+from tests.conftest import ROBOTS, TRAJECTORIES
+from tests.test_robots import _agrees, robots  # noqa: F401 (the fixture)
+
+
+@pytest.fixture(scope="module")
+def orthoglide():
+    return api.load_robot(ROBOTS / "orthoglide.yaml", backend="flint", cache=False)
+
+
+def _check(robot, name):
+    return api.check(robot, api.load_trajectory(TRAJECTORIES / f"{name}.yaml", robot),
+                     regions=False)
+
+
+def _det_a_plus(t) -> mp.mpf:
+    """det A of the Orthoglide's +++ mode on heart 1 at t, at 50 digits, from the
+    geometry: ρᵢ = Xᵢ + √(4 - |X|² + Xᵢ²), rows X - ρᵢ·eᵢ."""
+    mp.mp.dps = 50
+    x = 8 * mp.sin(t) ** 3 / 7
+    y = 13 * mp.cos(t) / 14 - 5 * mp.cos(2 * t) / 14 - mp.cos(3 * t) / 10 - mp.cos(4 * t) / 14
+    z = mp.mpf(1)
+    X = [x, y, z]
+    rows = []
+    for i in range(3):
+        rho = X[i] + mp.sqrt(4 - sum(v * v for j, v in enumerate(X) if j != i))
+        rows.append([X[j] - (rho if j == i else 0) for j in range(3)])
+    return mp.det(mp.matrix(rows))
+
+
+def test_the_interval_engine_proves_heart_1_crossings_where_det_a_changes_sign(orthoglide):
+    report = _check(orthoglide, "heart1")
+    search = search_det_a(report.path, [m for m in report.working_modes if m.feasible])
+    crossings = search["+++"].crossings
+    assert len(crossings) == 2
+    for w in crossings:  # the oracle: det A at 50 digits has opposite signs at the ends
+        assert mp.sign(_det_a_plus(mp.mpf(w.lo))) * mp.sign(_det_a_plus(mp.mpf(w.hi))) < 0
+    for lo, hi, s in search["+++"].proven[::7]:  # a proven sign is the true sign
+        assert mp.sign(_det_a_plus((mp.mpf(lo) + mp.mpf(hi)) / 2)) == s
+
+
+def test_agreeing_engines_are_reported_confirmed(orthoglide):
+    free, singular = _check(orthoglide, "heart2"), _check(orthoglide, "heart1")
+    assert free.verdict == "singularity-free" and singular.verdict == "singular"
+    for report in (free, singular):
+        doc = report.to_dict()
+        assert doc["corroboration"]["engine"] == "interval"
+        assert doc["corroboration"]["status"] == "confirmed"
+        assert "error" not in doc
+
+
+def test_an_exact_engine_that_misses_the_roots_is_caught(orthoglide, monkeypatch):
+    """μ's isolation made to find nothing (what μ = 1 did on the 6-RUS): the exact engine
+    alone would say free; the intervals prove det A changes sign along +++."""
+    monkeypatch.setattr(classification, "isolate_real_roots",
+                        lambda *a, **k: RootIsolation((), (), "broken on purpose"))
+    report = _check(orthoglide, "heart1")
+    doc = report.to_dict()
+    assert report.verdict == "error"
+    assert doc["error"]["kind"] == "inconsistent"
+    assert "exact engine: singularity-free" in doc["reason"]
+    assert "changes sign along mode +++" in doc["reason"]
+    assert doc["corroboration"]["status"] == "inconsistent"
+
+
+def test_a_singular_time_where_det_a_is_proven_nonzero_is_caught(orthoglide, monkeypatch):
+    """The classification made to call every mode singular at every root: at heart 1's
+    negative roots +++ is proven regular by the intervals."""
+    real = classification.classify_candidate
+
+    def everything_singular(path, modes, root, tolerance, by_elimination=True):
+        c = real(path, modes, root, tolerance, by_elimination)
+        c.modes = [classification.ModeAtCandidate(m.mode, classification.SINGULAR, "broken")
+                   for m in c.modes]
+        return c
+
+    monkeypatch.setattr(classification, "classify_candidate", everything_singular)
+    doc = _check(orthoglide, "heart1").to_dict()
+    assert doc["verdict"] == "error" and doc["error"]["kind"] == "inconsistent"
+    assert "ball arithmetic proves det A ≠ 0 there" in doc["reason"]
+
+
+def test_a_free_verdict_the_intervals_cannot_confirm_is_unknown(orthoglide, monkeypatch):
+    """No refinement at all (a budget of nothing): the first cover of heart 2 does not
+    prove det A ≠ 0 everywhere, so the exact engine's `free` stands alone: unknown,
+    with the window and its bound."""
+    monkeypatch.setattr(interval_engine, "BUDGET", 0)
+    monkeypatch.setattr(interval_engine, "pieces", lambda interval: [
+        interval.start.ball().union(interval.end.ball())])
+    report = _check(orthoglide, "heart2")
+    assert report.verdict == "unknown"
+    assert "could not confirm det A ≠ 0 in mode +++" in report.reason
+    assert "|det A| ≤" in report.reason
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in oracles.PATHS))
+def test_the_interval_engine_alone_agrees_with_the_independent_oracle(name, robots):  # noqa: F811
+    """Each bundled robot path that has a 50-digit oracle (tests/robot_oracles.py),
+    certified with ``engine="interval"`` (no μ at all): the same verdict, feasible modes
+    and singular times as the oracle's."""
+    path = {p.name: p for p in oracles.PATHS}[name]
+    truth = oracles.solve(path)
+    oracle = path.oracle()
+    robot = robots(oracle.robot)
+    traj = api.load_trajectory(TRAJECTORIES / f"{name}.yaml", robot)
+    report = api.check(robot, traj, regions=False, engine="interval")
+    assert report.path.mu is None
+    assert report.to_dict()["corroboration"]["status"] == "exact engine not run"
+    _agrees(report, oracle, truth)
+
+
+def test_auto_answers_a_path_the_exact_engine_refuses(robots, tmp_path):  # noqa: F811
+    """3-PRR with φ = 30t: the exact engine refuses (μ's half-angle degree over its
+    bound); ``auto`` still answers, without μ: infeasible, and the oracle agrees (at
+    t = 1/10, 50 digits, no working mode has every leg real and inside its limits)."""
+    from singcheck.errors import SpecError
+
+    robot = robots("3-prr")
+    f = tmp_path / "spin.yaml"
+    f.write_text("name: spin\nparameter: t\nrange: [0, 1]\n"
+                 "pose: {x: 3/2 + sin(t)/2, y: 2 - cos(t)/2, phi: 30*t}\n")
+    traj = api.load_trajectory(f, robot)
+    with pytest.raises(SpecError):
+        api.check(robot, traj, regions=False, engine="exact")
+    report = api.check(robot, traj, regions=False)
+    assert report.path.mu is None and "refused" in report.path.exact_refused
+    assert report.verdict == "infeasible"
+    oracle = oracles.three_prr()
+    t = mp.mpf(1) / 10
+    X = [mp.mpf(3) / 2 + mp.sin(t) / 2, 2 - mp.cos(t) / 2, 30 * t]
+    for mode in itertools.product((0, 1), repeat=3):
+        q = oracle.joints(mode, X)
+        assert q is None or any(not (leg.lo <= v <= leg.hi)
+                                for leg, v in zip(oracle.legs, q, strict=True))
+
+
+def _oracle_det(oracle, start: list, pose, t, steps: int = 2000):
+    """det A at t along the mode whose joints at t = 0 are ``start``: each leg's branch
+    followed from 0 to t in small steps (the nearest of the two closed-form roots)."""
+    q = [mp.mpf(v) for v in start]
+    for k in range(1, steps + 1):
+        X = pose(t * k / steps)
+        q = [min(leg.branches(X), key=lambda v, old=old: abs(v - old))
+             for leg, old in zip(oracle.legs, q, strict=True)]
+    return oracle.det_A(q, pose(t))

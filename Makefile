@@ -4,6 +4,8 @@ VENV   ?= .venv
 BIN    := $(VENV)/bin
 ROBOT  ?= robots/orthoglide.yaml
 TRAJ   ?= trajectories/heart1.yaml
+# wait (up to 10 min) for another apt (unattended upgrades) to release its lock, not fail
+APT    := apt-get -o DPkg::Lock::Timeout=600
 
 .PHONY: help setup cas browser test test-fast lint demo examples bench clean
 
@@ -23,16 +25,16 @@ cas:
 	@if command -v Singular >/dev/null && command -v M2 >/dev/null; then :; else \
 	  echo "installing Singular and Macaulay2 (Debian packages singular, macaulay2)"; \
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
-	  $$SUDO apt-get update -qq && \
-	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq singular macaulay2 >/dev/null; fi
+	  $$SUDO $(APT) update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO $(APT) install -y -qq singular macaulay2 >/dev/null; fi
 
 # Headless Chromium (Debian package chromium): the tests open the HTML figures page in it.
 browser:
 	@if command -v chromium >/dev/null; then :; else \
 	  echo "installing Chromium (Debian package chromium)"; \
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
-	  $$SUDO apt-get update -qq && \
-	  DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium >/dev/null; fi
+	  $$SUDO $(APT) update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $$SUDO $(APT) install -y -qq chromium >/dev/null; fi
 
 # Debian's python3 lacks ensurepip until python3-venv is installed: install it when we can.
 $(VENV)/.installed: pyproject.toml
@@ -41,7 +43,7 @@ $(VENV)/.installed: pyproject.toml
 	  echo "python3 -m venv failed: installing Debian's python3-venv"; \
 	  rm -rf $(VENV); \
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
-	  $$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq python3-venv && \
+	  $$SUDO $(APT) update -qq && $$SUDO $(APT) install -y -qq python3-venv && \
 	  $(PYTHON) -m venv $(VENV); }
 	$(BIN)/python -m pip install -q --upgrade pip
 	$(BIN)/python -m pip install -q -e '.[test,bench,plot,html,dask]'

@@ -74,11 +74,22 @@ class Robot:
     def backend(self) -> str:
         return self.projection.backend
 
+    def __repr__(self) -> str:  # short: the model's polynomials run to kilobytes
+        return (f"<Robot {self.name}: joints {', '.join(self.spec.joints)}; pose "
+                f"{', '.join(self.spec.pose)}; {_surface_summary(self.projection)}>")
+
     @property
     def singularity_surface(self):
         """ξ(X), squarefree, exact (an ``fmpq_mpoly`` in the pose variables); None when it
         was too big to expand (``projection.not_expanded`` says why)."""
         return self.projection.singularity_surface
+
+
+def _surface_summary(projection) -> str:
+    if not projection.expanded:
+        return "ξ(X) not expanded"
+    return (f"ξ(X) of degree {projection.singularity_surface.total_degree()} "
+            f"({projection.backend})")
 
 
 def robot_from_spec(spec: RobotSpec, backend: str = "auto", *, timeout: float = 600.0,
@@ -138,6 +149,9 @@ class Report:
     @property
     def name(self) -> str:
         return self.trajectory.name
+
+    def __repr__(self) -> str:  # short: the certificate holds the whole path model
+        return f"<Report {self.name}: {self.verdict}: {self.reason}>"
 
     @property
     def verdict(self) -> str:

@@ -134,6 +134,10 @@ class TrajectoryReport:
     def name(self) -> str:
         return self.trajectory.name
 
+    def __repr__(self) -> str:  # short: the path model runs to kilobytes
+        return (f"<TrajectoryReport {self.name}: {self.verdict}, "
+                f"{len(self.candidates)} candidate(s)>")
+
 
 def _mode_values(path: PathModel, modes: list[WorkingMode], t: arb):
     pose, variables = path.pose_and_variables_at(t)

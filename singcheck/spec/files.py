@@ -86,6 +86,10 @@ class RobotSpec:
     angles: frozenset[str] = frozenset()  # joints and pose variables used inside sin/cos
     radicals: tuple[int, ...] = ()  # primes p whose sqrt(p) is a variable of the context
 
+    def __repr__(self) -> str:  # short: the constraints can run to kilobytes
+        return (f"<RobotSpec {self.name}: joints {', '.join(self.joints)}; pose "
+                f"{', '.join(self.pose)}>")
+
     def variables(self, name: str) -> tuple[str, ...]:
         """The context's variables of a joint or pose variable: itself, or
         ``(cos(v), sin(v))`` for an angle."""

@@ -8,8 +8,6 @@ import json
 import subprocess
 from fractions import Fraction
 
-import pytest
-
 from tests.conftest import ROBOTS, ROOT, TRAJECTORIES
 from tests.test_cli import singcheck
 

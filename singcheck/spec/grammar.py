@@ -9,11 +9,11 @@ unary minus, so ``-x^2`` is ``-(x^2)``)::
     power   := atom (("^" | "**") unary)?
     atom    := NUMBER ["deg"] | NAME | NAME "(" expr ")" | "(" expr ")"
 
-Numbers are exact: ``0.1`` is 1/10, ``1e-3`` is 1/1000; ``30 deg`` is 30·π/180 = π/6.  Implicit multiplication
-(``2x``) is refused.  The parser builds a small tree; the compilers turn it into exact
-objects: a polynomial over Q (:func:`compile_polynomial`), a trig polynomial in
-``Q[t, s, c]`` (:func:`compile_trajectory_coordinate`), or a constant ``a + b·π``
-(:func:`compile_constant`).  Errors are :class:`ExprError` with a column.
+Numbers are exact: ``0.1`` is 1/10, ``1e-3`` is 1/1000; ``30 deg`` is 30·π/180 = π/6.
+Implicit multiplication (``2x``) is refused.  The parser builds a small tree; the
+compilers turn it into exact objects: a polynomial over Q (:func:`compile_polynomial`),
+a trig polynomial in ``Q[t, s, c]`` (:func:`compile_trajectory_coordinate`), or a
+constant ``a + b·π`` (:func:`compile_constant`).  Errors are :class:`ExprError` with a column.
 
 >>> str(compile_constant(parse("-pi/2 + 0.5")))
 '1/2-1/2*pi'

@@ -8,6 +8,8 @@ import json
 import subprocess
 from fractions import Fraction
 
+import pytest
+
 from tests.conftest import ROBOTS, ROOT, TRAJECTORIES
 from tests.test_cli import singcheck
 
@@ -88,3 +90,105 @@ def test_reprs_are_one_short_line():
     assert repr(report) == ("<Report heart1: singular: working mode +++ is singular at "
                             "t ≈ 0.977817>")
     assert repr(report.certificate) == "<TrajectoryReport heart1: singular, 4 candidate(s)>"
+
+
+# --- CSV on stdin, column maps and units -----------------------------------------------
+
+PLAIN = "t,x,y,z\n0,0.25,0.6,1\n1,0.9,1.1,1\n2,1.2,0.3,1\n"
+MILLIMETRES = ("time,X_mm,Y_mm,Z_mm,speed\n0,250,600,1000,3\n1,900,1100,1000,4\n"
+               "2,1200,300,1000,5\n")
+
+
+def run_stdin(text: str, *args: str) -> subprocess.CompletedProcess:
+    import os
+    import sys
+
+    return subprocess.run([sys.executable, "-m", "singcheck", "run", ORTHO, *args,
+                           "--no-regions", "-q", "--backend", "flint"], input=text,
+                          capture_output=True, text=True, cwd=ROOT, timeout=300,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+
+
+def test_a_csv_on_stdin_without_csv_says_how_to_read_it():
+    out = run_stdin(PLAIN, "-")
+    assert out.returncode == 2 and out.stdout == ""
+    assert out.stderr.strip().splitlines() == [
+        "singcheck: error: <stdin>:1: expected a mapping (key: value), got a single value "
+        "(is it a CSV table of poses? name it *.csv or run with --csv)"]
+
+
+def test_csv_on_stdin_gives_the_same_answer_as_the_file(tmp_path):
+    path = tmp_path / "plain.csv"
+    path.write_text(PLAIN)
+    from_file = singcheck("run", ORTHO, str(path), "--format", "jsonl", "--no-regions", "-q",
+                          "--backend", "flint")
+    from_stdin = run_stdin(PLAIN, "-", "--csv", "--format", "jsonl")
+    assert from_file.returncode == from_stdin.returncode == 1, from_stdin.stderr
+    a, b = json.loads(from_file.stdout), json.loads(from_stdin.stdout)
+    assert (a["name"], b["name"], b["path"]) == ("plain", "stdin", "<stdin>")
+    assert a["verdict"] == b["verdict"] == "singular"
+    assert a["candidates"] == b["candidates"] and a["working_modes"] == b["working_modes"]
+
+
+def test_a_column_map_with_units_reads_a_foreign_table_exactly(tmp_path):
+    from singcheck.spec.files import load_robot
+    from singcheck.spec.paths import CsvFormat, parse_csv
+
+    robot = load_robot(ORTHO)
+    table = CsvFormat("linear", (("t", "time"), ("x", "X_mm"), ("y", "Y_mm"), ("z", "Z_mm")),
+                      (("x", Fraction(1, 1000)), ("y", Fraction(1, 1000)),
+                       ("z", Fraction(1, 1000))))
+    mapped = parse_csv(MILLIMETRES, "mm.csv", robot, table)
+    plain = parse_csv(PLAIN, "plain.csv", robot, "linear")
+    assert [p.pose for p in mapped.pieces] == [p.pose for p in plain.pieces]
+    assert mapped.parameter == "t" and mapped.global_range == plain.global_range
+    # the same through the command line, stdin and a file alike
+    out = run_stdin(MILLIMETRES, "-", "--csv", "--columns", "t=time,x=X_mm,y=Y_mm,z=Z_mm",
+                    "--scale", "x=1/1000,y=0.001,z=1e-3", "--format", "jsonl")
+    assert out.returncode == 1, out.stderr
+    line = json.loads(out.stdout)
+    assert line["verdict"] == "singular" and line["parameter"] == "t"
+
+
+def test_without_a_map_a_foreign_table_is_refused_with_the_column():
+    out = run_stdin(MILLIMETRES, "-", "--csv")
+    assert out.returncode == 2
+    assert out.stderr.strip() == (
+        "singcheck: error: <stdin>:1: column 'X_mm' is not a pose variable of robot "
+        "orthoglide (pose: x, y, z; to pick and rename columns: --columns x=X_mm,...)")
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--columns", "time"], "--columns: expected NAME=VALUE, got 'time'"),
+    (["--columns", "x=X_mm,x=Y_mm"], "--columns: x is given twice"),
+    (["--scale", "x=pi"], "'pi' is not a non-zero rational number"),
+    (["--scale", "x=0"], "'0' is not a non-zero rational number"),
+    (["--scale", "x=1/"], "--scale: x: "),
+    (["--columns", "t=time,x=X,y=Y_mm,z=Z_mm"], "<stdin>:1: no column 'X' for x"),
+    (["--columns", "t=time,u=speed"], "only one of them, the parameter"),
+    (["--columns", "t=time,x=X_mm,y=Y_mm,z=Z_mm", "--scale", "w=2"], "the scale names 'w'"),
+])
+def test_bad_column_maps_are_one_line_and_exit_2(args, words):
+    out = run_stdin(MILLIMETRES, "-", "--csv", *args)
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert words in out.stderr, out.stderr
+
+
+# --- messages a first run prints -------------------------------------------------------
+
+@pytest.mark.parametrize("pose, straight", [
+    ("{x: t, y: 1/2, z: 1 - t/3}", True),
+    ("{x: sin(t), y: 1/2, z: 1}", False),
+    ("{x: t^2, y: 1/2, z: 1}", False),
+])
+def test_too_costly_says_what_is_too_costly(tmp_path, pose, straight):
+    from singcheck.certify.path import _too_costly
+    from singcheck.spec.files import load_robot, load_trajectory
+
+    path = tmp_path / "p.yaml"
+    path.write_text(f"name: p\nparameter: t\nrange: [0, 1]\npose: {pose}\n")
+    message = str(_too_costly("μ(t) would have 10^9 terms", load_trajectory(
+        path, load_robot(ORTHO))))
+    assert message.startswith(f"{path}:4: pose: too costly: μ(t) would have 10^9 terms: ")
+    assert ("the cost is the robot's" in message) is straight
+    assert ("lower the degrees" in message) is not straight

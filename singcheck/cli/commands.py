@@ -116,13 +116,24 @@ def cli() -> None:
               help="Also write the figures (see `singcheck plot`) to this directory.")
 @click.option("--interpolation", type=click.Choice(["linear", "cubic"]), default="cubic",
               show_default=True,
-              help="How a CSV table of poses (TRAJECTORY ending in .csv) is joined: straight "
-                   "lines, or the natural cubic spline through its rows.")
+              help="How a CSV table of poses (TRAJECTORY ending in .csv, or any with --csv) "
+                   "is joined: straight lines, or the natural cubic spline through its rows.")
+@click.option("--csv", "as_csv", is_flag=True,
+              help="Read every TRAJECTORY, - (standard input) included, as a CSV table of "
+                   "poses, whatever its name.")
+@click.option("--columns", metavar="VAR=COLUMN,...",
+              help="CSV column map: read each pose variable (or the parameter) from the "
+                   "column with that header, e.g. t=time,x=X_mm,y=Y_mm; columns it does not "
+                   "name are ignored.")
+@click.option("--scale", metavar="VAR=FACTOR,...",
+              help="Multiply a CSV column by an exact factor, e.g. x=1/1000,y=1/1000 for "
+                   "millimetres (or 0.001).")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
 def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs,
-        time_limit, no_regions, scheduler, plot_dir, interpolation, quiet, verbose) -> None:
+        time_limit, no_regions, scheduler, plot_dir, interpolation, as_csv, columns, scale,
+        quiet, verbose) -> None:
     """Certify each TRAJECTORY of ROBOT (YAML spec files; - reads standard input; a
     trajectory may also be a CSV table of poses).  A YAML file may hold several
     trajectories as documents separated by ---; their names must be unique in a run.
@@ -149,10 +160,11 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     if plot_dir:
         require_extra("plot")
     progress = Progress(quiet)
+    table = csv_format(interpolation, as_csv, columns, scale)
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
                     verbose, progress, jobs, plot_dir, interpolation, time_limit=time_limit,
-                    regions=not no_regions, scheduler=scheduler)
+                    regions=not no_regions, scheduler=scheduler, table=table)
     sys.exit(int(code))
 
 
@@ -178,9 +190,54 @@ def _worst(codes) -> ExitCode:
     return max(codes, key=_SEVERITY.index, default=ExitCode.SINGULARITY_FREE)
 
 
+def csv_format(interpolation: str, as_csv: bool, columns: str | None, scale: str | None):
+    """The --csv, --columns and --scale options as a
+    :class:`~singcheck.spec.paths.CsvFormat` (None when none is given); a malformed one
+    is a usage error (exit 2)."""
+    from singcheck.spec.paths import CsvFormat
+
+    if not (as_csv or columns or scale):
+        return None
+    mapped = _pairs(columns, "--columns", lambda text: text)
+    return CsvFormat(interpolation, tuple(mapped), tuple(_pairs(scale, "--scale", _factor)))
+
+
+def _pairs(text: str | None, option: str, value) -> list[tuple[str, object]]:
+    out: dict[str, object] = {}
+    for item in (text or "").split(","):
+        name, eq, rest = item.partition("=")
+        name, rest = name.strip(), rest.strip()
+        if not item.strip():
+            continue
+        if not eq or not name or not rest:
+            raise click.BadParameter(f"expected NAME=VALUE, got {item.strip()!r}",
+                                     param_hint=option)
+        if name in out:
+            raise click.BadParameter(f"{name} is given twice", param_hint=option)
+        try:
+            out[name] = value(rest)
+        except ValueError as e:
+            raise click.BadParameter(f"{name}: {e}", param_hint=option) from None
+    return list(out.items())
+
+
+def _factor(text: str):
+    """An exact, non-zero rational factor (singcheck's grammar: 1/1000, 0.001, 1e-3)."""
+    from singcheck.spec.grammar import ExprError, compile_constant, parse
+
+    try:
+        value = compile_constant(parse(text))
+    except ExprError as e:
+        raise ValueError(f"{e} in {text!r}") from None
+    if value.pi_coefficient or not value.rational:
+        raise ValueError(f"{text!r} is not a non-zero rational number (a CSV stays "
+                         "rational: give angles in radians)")
+    return value.rational
+
+
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
          progress, jobs, plot_dir=None, interpolation="cubic", *, time_limit=300.0,
-         regions=True, scheduler=None):
+         regions=True, scheduler=None, table=None):
     from contextlib import closing
     from itertools import chain, islice
 
@@ -188,7 +245,7 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     from singcheck.spec.files import load_robot, read_documents
 
     spec = load_robot(robot)
-    documents = read_documents(trajectories, interpolation)
+    documents = read_documents(trajectories, interpolation, csv=table)
     # the first documents (all of a small batch) are parsed here, before any work: a bad
     # one stops the run at once (exit 2, one line); past them, the documents are parsed
     # by the workers, and a bad one is that trajectory's result

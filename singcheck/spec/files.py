@@ -29,7 +29,7 @@ from singcheck.spec.grammar import (
     compile_value,
     parse,
 )
-from singcheck.spec.paths import csv_name, multi_piece, parse_csv
+from singcheck.spec.paths import CsvFormat, csv_name, multi_piece, parse_csv
 from singcheck.spec.plainyaml import compose_all as compose_plain
 from singcheck.spec.plainyaml import kind
 from singcheck.spec.trajectory import (
@@ -559,7 +559,7 @@ class Document:
     text: str
     name: str | None = None  # its name key, when the YAML could be read
     name_line: int | None = None
-    csv: str | None = None  # a CSV table: its interpolation (linear or cubic)
+    csv: CsvFormat | str | None = None  # a CSV table: how to read it (or its interpolation)
     error: SpecError | None = None
 
     @property
@@ -573,10 +573,13 @@ class Document:
         if self.error is not None:
             raise self.error
         if self.csv is not None:
-            return parse_csv(self.text, self.path, robot, self.csv)
+            return parse_csv(self.text, self.path, robot, self.csv, self.name)
         try:
             return _trajectory(_compose(self.text, self.path, self.line), self.path, robot)
         except SpecError as e:
+            if _looks_like_csv(self.text):
+                e = SpecError(f"{e.message} (is it a CSV table of poses? name it *.csv or "
+                              "run with --csv)", path=e.path, line=e.line, key=e.key)
             raise self.located(e) from None
 
     def located(self, e: SpecError) -> SpecError:
@@ -584,6 +587,14 @@ class Document:
             return e
         return SpecError(f"{e.message} (document {self.number})", path=e.path, line=e.line,
                          key=e.key)
+
+
+def _looks_like_csv(text: str) -> bool:
+    """A header line of comma-separated names (t,x,y,z) and no YAML key on it."""
+    first = next((line for line in text.splitlines() if line.strip()
+                  and not line.lstrip().startswith("#")), "")
+    return "," in first and ":" not in first and \
+        all(_IDENTIFIER.match(c.strip()) for c in first.split(","))
 
 
 def _is_marker(line: bytes, marker: bytes) -> bool:
@@ -678,12 +689,13 @@ def _name(node) -> dict:
 
 
 def read_documents(paths: Iterable[str | os.PathLike], interpolation: str | None = None,
-                   ) -> Iterator[Document]:
+                   *, csv: CsvFormat | None = None) -> Iterator[Document]:
     """Every trajectory of the files, lazily, as :class:`Document` (a YAML file, or
     ``-``, standard input, holds one or more documents; a CSV file one table), read one
     at a time: memory does not grow with the number of trajectories but for their
     names, which must be unique in a run (a repeated one is that document's error).
-    A file that cannot be opened, or ``-`` given twice, is refused here, at once."""
+    A file that cannot be opened, or ``-`` given twice, is refused here, at once.
+    ``csv``: every input is a CSV table read so (standard input too), not only ``*.csv``."""
     paths = [os.fspath(p) for p in paths]
     if paths.count(STDIN) > 1:
         raise SpecError("standard input (-) is given twice", path=STDIN)
@@ -694,14 +706,17 @@ def read_documents(paths: Iterable[str | os.PathLike], interpolation: str | None
                     pass
             except OSError as e:
                 raise SpecError(f"cannot read the file: {e.strerror or e}", path=path) from None
-    return _unique(_all_documents(paths, interpolation))
+    return _unique(_all_documents(paths, interpolation, csv))
 
 
-def _all_documents(paths: list[str], interpolation: str | None) -> Iterator[Document]:
+def _all_documents(paths: list[str], interpolation: str | None,
+                   table: CsvFormat | None = None) -> Iterator[Document]:
     for path in paths:
-        if path.lower().endswith(".csv"):
-            document = Document(path, 1, 1, "", name=csv_name(path),
-                                csv=interpolation or "cubic")
+        if table is not None or path.lower().endswith(".csv"):
+            stdin = path == STDIN
+            document = Document(STDIN_NAME if stdin else path, 1, 1, "",
+                                name="stdin" if stdin else csv_name(path),
+                                csv=table or CsvFormat(interpolation or "cubic"))
             try:
                 yield replace(document, text=_read(path))
             except SpecError as e:

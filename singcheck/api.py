@@ -161,7 +161,7 @@ class Report:
     @property
     def reason(self) -> str:
         if self.certificate is None:
-            return f"unknown: {self.time_limited}"
+            return self.time_limited.removeprefix("unknown: ")  # the verdict says unknown
         return self.certificate.reason
 
     @property
@@ -253,7 +253,7 @@ def check_safely(robot: Robot, trajectory: TrajectorySpec, **options) -> dict[st
         with hard_time_limit(options.get("time_limit")):
             doc = check(robot, trajectory, **options).to_dict()
     except TimeLimitExceeded as e:
-        doc = time_limited_json(trajectory, f"unknown: {e}")
+        doc = time_limited_json(trajectory, str(e))
     except BackendError as e:
         doc = error_json(trajectory, "backend", str(e))
     except SpecError as e:  # refused up front (a path too costly to certify)

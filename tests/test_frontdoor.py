@@ -192,3 +192,93 @@ def test_too_costly_says_what_is_too_costly(tmp_path, pose, straight):
     assert message.startswith(f"{path}:4: pose: too costly: μ(t) would have 10^9 terms: ")
     assert ("the cost is the robot's" in message) is straight
     assert ("lower the degrees" in message) is not straight
+
+
+def test_a_one_piece_path_names_no_segment(tmp_path):
+    """A k·π·t path is certified as one rescaled piece: its reasons and proofs say
+    nothing of 'segment 1' (they did, 7 times, in this JSON)."""
+    path = tmp_path / "pit.yaml"
+    path.write_text("name: pit\nparameter: t\nrange: [0, 1]\n"
+                    "pose: {x: 1/2 + cos(2*pi*t)/4, y: 1, z: 1}\n")
+    out = singcheck("run", ORTHO, str(path), "--backend", "flint", "--no-regions", "-q",
+                    "--format", "json")
+    assert out.returncode in (0, 1), out.stderr
+    (doc,) = json.loads(out.stdout)["trajectories"]
+    assert len(doc["segments"]) == 1 and doc["segments"][0]["time_scale"]
+    assert "segment 1" not in out.stdout
+    assert any(m["reason"] for m in doc["working_modes"])  # reasons are still there
+
+
+def test_a_fifty_row_csv_is_summarised_not_listed(tmp_path):
+    path = tmp_path / "fifty.csv"
+    path.write_text("t,x,y,z\n" + "".join(f"{i},{0.3 + i / 100:.2f},1,1\n"
+                                          for i in range(50)))
+    out = singcheck("run", ORTHO, str(path), "--backend", "flint", "--no-regions", "-q",
+                    "--interpolation", "linear")
+    assert out.returncode in (0, 1), out.stderr
+    lines = [line for line in out.stdout.splitlines() if "segments:" in line]
+    assert lines == ["  segments: 49 pieces (1: [0, 1]; …; 49: [48, 49]), roots by exact "
+                     "univariate"]
+
+
+def test_reasons_do_not_repeat_the_verdict(tmp_path):
+    from singcheck.report.trajectory import error_json, time_limited_json
+    from singcheck.spec.files import load_robot, load_trajectory
+
+    spec = load_trajectory(TRAJECTORIES / "heart1.yaml", load_robot(ORTHO))
+    stopped = time_limited_json(spec, "unknown: time limit (2 s) reached")
+    assert (stopped["verdict"], stopped["reason"]) == ("unknown", "time limit (2 s) reached")
+    failed = error_json(spec, "backend", "Singular failed")
+    assert (failed["verdict"], failed["reason"]) == ("error", "Singular failed")
+    # and through the command line: the JSON reason, the table's verdict line
+    path = tmp_path / "slow.yaml"
+    path.write_text("name: slow\nparameter: t\nrange: [0, 1]\n"
+                    "pose: {x: cos(12*t)/2, y: sin(11*t)/2, z: -2}\n")
+    rotary = str(ROBOTS / "rotary-delta.yaml")
+    out = singcheck("run", rotary, str(path), "--backend", "flint", "--time-limit", "0.2",
+                    "--format", "json", "-q")
+    assert out.returncode == 3, out.stderr
+    (doc,) = json.loads(out.stdout)["trajectories"]
+    assert doc["reason"] == "time limit (0.2 s) reached"
+    table = singcheck("run", rotary, str(path), "--backend", "flint", "--time-limit", "0.2",
+                      "-q")
+    assert "verdict unknown: time limit (0.2 s) reached" in table.stdout
+    assert "unknown: unknown" not in table.stdout
+
+
+def test_jsonl_lines_carry_their_time():
+    out = singcheck("run", ORTHO, str(TRAJECTORIES / "heart1.yaml"),
+                    str(TRAJECTORIES / "heart2.yaml"), "--format", "jsonl", "--no-regions",
+                    "-q", "--backend", "flint")
+    assert out.returncode == 1, out.stderr
+    lines = [json.loads(line) for line in out.stdout.splitlines()]
+    assert sorted(d["name"] for d in lines) == ["heart1", "heart2"]
+    for d in lines:
+        assert isinstance(d["time_s"], float) and 0 < d["time_s"] < 60
+    whole = singcheck("run", ORTHO, str(TRAJECTORIES / "heart1.yaml"), "--format", "json",
+                      "--no-regions", "-q", "--backend", "flint")
+    assert "time_s" not in json.loads(whole.stdout)["trajectories"][0]
+
+
+def test_run_help_explains_the_mode_labels():
+    out = singcheck("run", "--help")
+    assert out.returncode == 0
+    text = " ".join(out.stdout.split())
+    assert "Working modes (+++, +-, ooo, ...): one character per leg" in text
+    assert "o the only branch of a leg linear in its joint" in text
+    assert "+ the branch with +√D" in text and "- the other branch" in text
+
+
+def test_html_with_plotly_from_its_cdn_is_smaller(tmp_path):
+    pytest.importorskip("plotly")
+    common = ["plot", ORTHO, str(TRAJECTORIES / "heart1.yaml"), "--format", "html", "-q",
+              "--backend", "flint"]
+    inline = singcheck(*common, "--out", str(tmp_path / "inline"))
+    cdn = singcheck(*common, "--plotly", "cdn", "--out", str(tmp_path / "cdn"))
+    assert inline.returncode == cdn.returncode == 0, cdn.stderr
+    big = (tmp_path / "inline" / "singcheck.html").read_text()
+    small = (tmp_path / "cdn" / "singcheck.html").read_text()
+    assert 'src="https://cdn.plot.ly/plotly-' in small
+    assert "cdn.plot.ly/plotly" not in big.split("<body>")[0]
+    assert len(small) < len(big) - 4_000_000  # plotly.js is about 4.8 MB
+    assert small.count("Plotly.newPlot") == big.count("Plotly.newPlot") > 0

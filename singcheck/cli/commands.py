@@ -26,6 +26,15 @@ Examples:
   singcheck run robots/orthoglide.yaml paths.yaml --scheduler tcp://10.0.0.5:8786
 
 \b
+Working modes (+++, +-, ooo, ...): one character per leg, in the order of the joints:
+  +  the branch with +√D: ρ = (-b + √D)/(2a) for a leg quadratic in its joint ρ;
+     for a revolute joint θ, the branch with +√Δ in (cos θ, sin θ) (one elbow posture)
+  -  the other branch: -√D (the other elbow posture)
+  o  the only branch of a leg linear in its joint (ρ = -c/b): nothing to choose
+A mode is feasible when each of its branches stays real, apart from the other branch
+and inside the joint limits along the whole path.
+
+\b
 Exit status:
   0  every trajectory is proven singularity-free
   1  some trajectory is singular or infeasible
@@ -319,8 +328,8 @@ class _Sink:
         self.results: list[dict] = []
 
     def add(self, doc: dict) -> None:
-        seconds = doc.pop("time_s", None)  # not in the JSON schema: JUnit's time only
-        if self.fmt == "junit":
+        seconds = doc.pop("time_s", None)  # JUnit's time, and each jsonl line's
+        if self.fmt in ("junit", "jsonl"):
             doc["time_s"] = seconds
         if self.fmt != "jsonl":
             self.results.append(doc)
@@ -473,7 +482,7 @@ def _plot_all(certificates, out_dir: str, progress) -> list:
     return written
 
 
-def _plot_html(certificates, out_dir: str):
+def _plot_html(certificates, out_dir: str, plotly_js: str = "inline"):
     try:
         import plotly  # noqa: F401
 
@@ -481,7 +490,7 @@ def _plot_html(certificates, out_dir: str):
     except ImportError as e:
         raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
                         "pip install 'singcheck[html]'") from None
-    return write_html(certificates, os.path.join(out_dir, "singcheck.html"))
+    return write_html(certificates, os.path.join(out_dir, "singcheck.html"), plotly_js)
 
 
 @cli.command(epilog="""\b
@@ -499,6 +508,10 @@ Examples:
 @click.option("--format", "fmt", type=click.Choice(["files", "html"]), default="files",
               show_default=True, help="files: PNG and SVG per figure; html: one "
               "self-contained interactive page (needs singcheck[html]).")
+@click.option("--plotly", "plotly_js", type=click.Choice(["inline", "cdn"]), default="inline",
+              show_default=True, help="For --format html: inline plotly's JavaScript (a "
+              "page that works offline: heart 1's is 6.0 MB) or load it from plotly's CDN "
+              "(a page that needs the network: heart 1's is 1.1 MB).")
 @click.option("--regions", "spaces", multiple=True,
               type=click.Choice(["workspace", "jointspace"]),
               help="Also draw the regions of that space coloured by their number of "
@@ -512,7 +525,7 @@ Examples:
               "analysis; past it that figure is not drawn and the command ends with exit "
               "3, unknown: time limit.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
-def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, time_limit,
+def plot(robot, trajectories, out_dir, backend, fmt, plotly_js, spaces, slices, time_limit,
          quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
@@ -541,7 +554,7 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, time_limit,
             certificates = _certificates(machine, specs, time_limit)
             complete &= len(certificates) == len(specs)
             if fmt == "html":
-                click.echo(str(_plot_html(certificates, out_dir)))
+                click.echo(str(_plot_html(certificates, out_dir, plotly_js)))
             else:
                 for path in _plot_all(certificates, out_dir, progress):
                     click.echo(str(path))

@@ -11,7 +11,8 @@ PACKAGE = Path(__file__).resolve().parent.parent / "singcheck"
 # the pipeline, bottom to top; a module may import its own stage and those below it
 STAGES = ["algebra", "spec", "model", "elimination", "roots", "certify", "spaces", "report",
           "api", "cli"]
-FOUNDATION = {"errors", "budget", "atomic", "version"}  # importable by every stage
+FOUNDATION = {"errors", "budget", "atomic", "version",  # importable by every stage
+              "schemas"}  # data files (the JSON Schemas) and a reader
 ONLY_IN = {"click": {"cli"}, "rich": {"report"}, "matplotlib": {"report"}}
 
 

@@ -684,6 +684,22 @@ def cache_clear() -> None:
     click.echo(f"removed {EliminationCache().clear()} entries")
 
 
+@cli.command(epilog="""\b
+Examples:
+  singcheck schema robot > robot.schema.json
+  singcheck schema report | check-jsonschema --schemafile /dev/stdin report.json
+""")
+@click.argument("name", type=click.Choice(["robot", "trajectory", "report"]))
+def schema(name) -> None:
+    """Print the JSON Schema (Draft 2020-12) of a robot spec, a trajectory document or
+    the JSON report (each jsonl line: the report's $defs/jsonl_line).  Editors with the
+    YAML language server check a spec whose first line is
+    # yaml-language-server: $schema=PATH/TO/robot.schema.json"""
+    from singcheck.schemas import schema_text
+
+    click.echo(schema_text(name), nl=False)
+
+
 def _register_space_commands() -> None:
     from singcheck.cli.spaces import jointspace, workspace
 

@@ -19,7 +19,8 @@ jsonschema = pytest.importorskip("jsonschema")
 
 SCHEMAS = ROOT / "singcheck" / "schemas"
 BUNDLED = [*sorted(ROBOTS.glob("*.yaml")), *sorted(TRAJECTORIES.glob("*.yaml")),
-           *sorted((ROOT / "tests" / "data").glob("*/*.yaml"))]
+           *sorted((ROOT / "tests" / "data").glob("*/*.yaml")),
+           *sorted((ROOT / "docs" / "tutorial").glob("*.yaml"))]
 ROBOT_FILES = [p for p in BUNDLED if re.search(r"^joints:", p.read_text(), re.M)]
 TRAJECTORY_FILES = [p for p in BUNDLED if p not in ROBOT_FILES]
 MODELINE = re.compile(r"# yaml-language-server: \$schema=(\S+)\n")

@@ -178,7 +178,7 @@ class Report:
         return self.certificate.path if self.certificate else None
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON schema's trajectory object (README, "JSON output")."""
+        """The JSON report's trajectory object (``singcheck schema report``)."""
         from singcheck.report.trajectory import (
             time_limited_json,
             trajectory_json,

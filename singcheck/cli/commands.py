@@ -100,9 +100,9 @@ def cli() -> None:
               show_default=True, help="Width of the certified enclosure of each root in t.")
 @click.option("--format", "fmt", type=click.Choice(["table", "json", "jsonl", "junit"]),
               default="table", show_default=True,
-              help="table for people; json for programs (schema in README); jsonl: one "
-                   "JSON object per trajectory, written as each one finishes; junit: JUnit "
-                   "XML for CI test reports.")
+              help="table for people; json for programs (its JSON Schema: singcheck schema "
+                   "report); jsonl: one JSON object per trajectory, with time_s, written as "
+                   "each one finishes; junit: JUnit XML for CI test reports.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, writable=True),
               help="Write the result to this file (atomically: nothing if interrupted) "
                    "instead of stdout.")
@@ -510,8 +510,8 @@ Examples:
               "self-contained interactive page (needs singcheck[html]).")
 @click.option("--plotly", "plotly_js", type=click.Choice(["inline", "cdn"]), default="inline",
               show_default=True, help="For --format html: inline plotly's JavaScript (a "
-              "page that works offline: heart 1's is 6.0 MB) or load it from plotly's CDN "
-              "(a page that needs the network: heart 1's is 1.1 MB).")
+              "page that works offline, several MB) or load it from plotly's CDN (a much "
+              "smaller page that needs the network).")
 @click.option("--regions", "spaces", multiple=True,
               type=click.Choice(["workspace", "jointspace"]),
               help="Also draw the regions of that space coloured by their number of "

@@ -1,6 +1,7 @@
 """Rendering of certification reports: a rich table for people, JSON for programs.
 
-The JSON document is described in the README ("JSON output"); bump
+The JSON document is described in docs/outputs.md ("JSON output") and by its JSON
+Schema, singcheck/schemas/report.schema.json (``singcheck schema report``); bump
 ``SCHEMA_VERSION`` on any incompatible change.
 """
 

@@ -282,3 +282,16 @@ def test_html_with_plotly_from_its_cdn_is_smaller(tmp_path):
     assert "cdn.plot.ly/plotly" not in big.split("<body>")[0]
     assert len(small) < len(big) - 4_000_000  # plotly.js is about 4.8 MB
     assert small.count("Plotly.newPlot") == big.count("Plotly.newPlot") > 0
+
+
+def test_plot_names_the_verdict_once_when_a_path_runs_out_of_time(tmp_path):
+    pytest.importorskip("matplotlib")
+    path = tmp_path / "slow.yaml"
+    path.write_text("name: slow\nparameter: t\nrange: [0, 1]\n"
+                    "pose: {x: cos(12*t)/2, y: sin(11*t)/2, z: -2}\n")
+    out = singcheck("plot", str(ROBOTS / "rotary-delta.yaml"), str(path), "--out",
+                    str(tmp_path / "figures"), "--backend", "flint", "--time-limit", "0.2",
+                    "-q")
+    assert out.returncode == 3
+    assert out.stderr.strip().splitlines() == [
+        "singcheck: slow: unknown: time limit (0.2 s) reached (--time-limit): no figure"]

@@ -462,8 +462,8 @@ def _certificates(machine, specs, time_limit: float, tolerance: float = 1e-9) ->
         report = api.check(machine, spec, tolerance=tolerance, regions=False,
                            time_limit=time_limit)
         if report.certificate is None:
-            click.echo(f"singcheck: {spec.name}: {report.reason} (--time-limit): no "
-                       "figure", err=True)
+            click.echo(f"singcheck: {spec.name}: {report.verdict}: {report.reason} "
+                       "(--time-limit): no figure", err=True)
         else:
             out.append(report.certificate)
     return out

@@ -427,6 +427,7 @@ def test_the_dask_run_gives_the_local_verdicts(local_cluster, tmp_path, orthogli
     assert sorted(d["name"] for d in streamed) == sorted(local)
     for d in streamed:
         del d["robot"]
+        assert isinstance(d.pop("time_s"), float)  # each line's own seconds
         assert d == {k: v for k, v in local[d["name"]].items() if k != "time_s"}
     doc = singcheck("run", ORTHO, *paths, "--format", "json", "--backend", "flint", "-q",
                     env=env)

@@ -295,3 +295,15 @@ def test_plot_names_the_verdict_once_when_a_path_runs_out_of_time(tmp_path):
     assert out.returncode == 3
     assert out.stderr.strip().splitlines() == [
         "singcheck: slow: unknown: time limit (0.2 s) reached (--time-limit): no figure"]
+
+
+def test_a_column_map_applies_to_the_csv_tables_of_a_run_not_to_its_yaml(tmp_path):
+    table = tmp_path / "mm.csv"
+    table.write_text(MILLIMETRES)
+    out = singcheck("run", ORTHO, str(TRAJECTORIES / "heart2.yaml"), str(table),
+                    "--columns", "t=time,x=X_mm,y=Y_mm,z=Z_mm", "--scale",
+                    "x=1/1000,y=1/1000,z=1/1000", "--format", "jsonl", "--no-regions", "-q",
+                    "--backend", "flint")
+    assert out.returncode == 1, out.stderr
+    verdicts = {d["name"]: d["verdict"] for d in map(json.loads, out.stdout.splitlines())}
+    assert verdicts == {"heart2": "singularity-free", "mm": "singular"}

@@ -169,11 +169,12 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     if plot_dir:
         require_extra("plot")
     progress = Progress(quiet)
-    table = csv_format(interpolation, as_csv, columns, scale)
+    table = csv_format(interpolation, columns, scale)
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
                     verbose, progress, jobs, plot_dir, interpolation, time_limit=time_limit,
-                    regions=not no_regions, scheduler=scheduler, table=table)
+                    regions=not no_regions, scheduler=scheduler, table=table,
+                    all_csv=as_csv)
     sys.exit(int(code))
 
 
@@ -199,13 +200,13 @@ def _worst(codes) -> ExitCode:
     return max(codes, key=_SEVERITY.index, default=ExitCode.SINGULARITY_FREE)
 
 
-def csv_format(interpolation: str, as_csv: bool, columns: str | None, scale: str | None):
-    """The --csv, --columns and --scale options as a
-    :class:`~singcheck.spec.paths.CsvFormat` (None when none is given); a malformed one
-    is a usage error (exit 2)."""
+def csv_format(interpolation: str, columns: str | None, scale: str | None):
+    """The --columns and --scale options as a :class:`~singcheck.spec.paths.CsvFormat`
+    for the CSV tables of a run (None when neither is given); a malformed one is a usage
+    error (exit 2)."""
     from singcheck.spec.paths import CsvFormat
 
-    if not (as_csv or columns or scale):
+    if not (columns or scale):
         return None
     mapped = _pairs(columns, "--columns", lambda text: text)
     return CsvFormat(interpolation, tuple(mapped), tuple(_pairs(scale, "--scale", _factor)))
@@ -246,7 +247,7 @@ def _factor(text: str):
 
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
          progress, jobs, plot_dir=None, interpolation="cubic", *, time_limit=300.0,
-         regions=True, scheduler=None, table=None):
+         regions=True, scheduler=None, table=None, all_csv=False):
     from contextlib import closing
     from itertools import chain, islice
 
@@ -254,7 +255,7 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     from singcheck.spec.files import load_robot, read_documents
 
     spec = load_robot(robot)
-    documents = read_documents(trajectories, interpolation, csv=table)
+    documents = read_documents(trajectories, interpolation, csv=table, all_csv=all_csv)
     # the first documents (all of a small batch) are parsed here, before any work: a bad
     # one stops the run at once (exit 2, one line); past them, the documents are parsed
     # by the workers, and a bad one is that trajectory's result

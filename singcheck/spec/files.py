@@ -689,13 +689,15 @@ def _name(node) -> dict:
 
 
 def read_documents(paths: Iterable[str | os.PathLike], interpolation: str | None = None,
-                   *, csv: CsvFormat | None = None) -> Iterator[Document]:
+                   *, csv: CsvFormat | None = None, all_csv: bool = False
+                   ) -> Iterator[Document]:
     """Every trajectory of the files, lazily, as :class:`Document` (a YAML file, or
     ``-``, standard input, holds one or more documents; a CSV file one table), read one
     at a time: memory does not grow with the number of trajectories but for their
     names, which must be unique in a run (a repeated one is that document's error).
     A file that cannot be opened, or ``-`` given twice, is refused here, at once.
-    ``csv``: every input is a CSV table read so (standard input too), not only ``*.csv``."""
+    ``csv``: how CSV tables are read (``*.csv`` files; with ``all_csv``, every input,
+    standard input too)."""
     paths = [os.fspath(p) for p in paths]
     if paths.count(STDIN) > 1:
         raise SpecError("standard input (-) is given twice", path=STDIN)
@@ -706,13 +708,14 @@ def read_documents(paths: Iterable[str | os.PathLike], interpolation: str | None
                     pass
             except OSError as e:
                 raise SpecError(f"cannot read the file: {e.strerror or e}", path=path) from None
-    return _unique(_all_documents(paths, interpolation, csv))
+    return _unique(_all_documents(paths, interpolation, csv, all_csv))
 
 
 def _all_documents(paths: list[str], interpolation: str | None,
-                   table: CsvFormat | None = None) -> Iterator[Document]:
+                   table: CsvFormat | None = None, all_csv: bool = False
+                   ) -> Iterator[Document]:
     for path in paths:
-        if table is not None or path.lower().endswith(".csv"):
+        if all_csv or path.lower().endswith(".csv"):
             stdin = path == STDIN
             document = Document(STDIN_NAME if stdin else path, 1, 1, "",
                                 name="stdin" if stdin else csv_name(path),

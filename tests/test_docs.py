@@ -138,3 +138,19 @@ def test_the_tutorial_verbose_lines_and_figures_are_real(tutorial_dir):
     assert out.stdout.splitlines() == listed
     for name in listed:
         assert (tutorial_dir / name).stat().st_size > 0
+
+
+def test_the_readme_first_run_is_what_singcheck_prints(tmp_path):
+    command, body = _console_blocks(README)[0]
+    assert command == "singcheck run robots/orthoglide.yaml trajectories/heart1.yaml"
+    out = subprocess.run([sys.executable, "-m", "singcheck", *command.split()[1:]], cwd=ROOT,
+                         capture_output=True, text=True, timeout=600,
+                         env={**os.environ, "PYTHONPATH": str(ROOT),
+                              "SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 1, out.stderr
+    printed = [line.rstrip() for line in out.stdout.rstrip("\n").splitlines()]
+    shown = [line for line in body if not line.startswith("…")]
+    assert len(shown) == 12
+    for line in shown:
+        assert line in printed, line
+    assert printed[:10] == shown[:10] and printed[-2:] == shown[-2:]

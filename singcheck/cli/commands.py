@@ -24,6 +24,8 @@ Examples:
   cat paths/*.yaml | singcheck run robots/orthoglide.yaml - --format jsonl
   singcheck run robots/orthoglide.yaml paths.yaml --format junit -o report.xml
   singcheck run robots/orthoglide.yaml paths.yaml --scheduler tcp://10.0.0.5:8786
+  singcheck run robots/orthoglide.yaml - --csv --columns t=time,x=X_mm,y=Y_mm,z=Z_mm \\
+    --scale x=1/1000,y=1/1000,z=1/1000 < log.csv
 
 \b
 Working modes (+++, +-, ooo, ...): one character per leg, in the order of the joints:

@@ -93,7 +93,7 @@ def interleaved(fns: list, repeat: int = REPEAT) -> list[list[tuple[float, float
     scan, the same code on the same polynomials, which warmed it, and singcheck always
     right after the 10⁵-point scan, whose arrays evicted its code and data from the
     caches: on heart 1 that order made the scan's median 6-10 % lower and singcheck's
-    a few % higher than in varied orders (README, Speed)."""
+    a few % higher than in varied orders (docs/speed.md)."""
     out: list[list[tuple[float, float]]] = [[] for _ in fns]
     orders = random.Random(ROUND_ORDER_SEED)
     for _ in range(repeat):

@@ -74,11 +74,22 @@ class Robot:
     def backend(self) -> str:
         return self.projection.backend
 
+    def __repr__(self) -> str:  # short: the model's polynomials run to kilobytes
+        return (f"<Robot {self.name}: joints {', '.join(self.spec.joints)}; pose "
+                f"{', '.join(self.spec.pose)}; {_surface_summary(self.projection)}>")
+
     @property
     def singularity_surface(self):
         """ξ(X), squarefree, exact (an ``fmpq_mpoly`` in the pose variables); None when it
         was too big to expand (``projection.not_expanded`` says why)."""
         return self.projection.singularity_surface
+
+
+def _surface_summary(projection) -> str:
+    if not projection.expanded:
+        return "ξ(X) not expanded"
+    return (f"ξ(X) of degree {projection.singularity_surface.total_degree()} "
+            f"({projection.backend})")
 
 
 def robot_from_spec(spec: RobotSpec, backend: str = "auto", *, timeout: float = 600.0,
@@ -139,6 +150,9 @@ class Report:
     def name(self) -> str:
         return self.trajectory.name
 
+    def __repr__(self) -> str:  # short: the certificate holds the whole path model
+        return f"<Report {self.name}: {self.verdict}: {self.reason}>"
+
     @property
     def verdict(self) -> str:
         """singularity-free, singular, infeasible or unknown."""
@@ -147,7 +161,7 @@ class Report:
     @property
     def reason(self) -> str:
         if self.certificate is None:
-            return f"unknown: {self.time_limited}"
+            return self.time_limited.removeprefix("unknown: ")  # the verdict says unknown
         return self.certificate.reason
 
     @property
@@ -164,7 +178,7 @@ class Report:
         return self.certificate.path if self.certificate else None
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON schema's trajectory object (README, "JSON output")."""
+        """The JSON report's trajectory object (``singcheck schema report``)."""
         from singcheck.report.trajectory import (
             time_limited_json,
             trajectory_json,
@@ -242,7 +256,7 @@ def check_safely(robot: Robot, trajectory: TrajectorySpec, **options) -> dict[st
         with hard_time_limit(options.get("time_limit")):
             doc = check(robot, trajectory, **options).to_dict()
     except TimeLimitExceeded as e:
-        doc = time_limited_json(trajectory, f"unknown: {e}")
+        doc = time_limited_json(trajectory, str(e))
     except BackendError as e:
         doc = error_json(trajectory, "backend", str(e))
     except SpecError as e:  # refused up front (a path too costly to certify)

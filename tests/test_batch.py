@@ -104,7 +104,7 @@ def test_a_multi_document_stream_on_stdin_in_jsonl(tmp_path):
     for d in docs:
         assert d["robot"]["name"] == "orthoglide" and d["path"] == "<stdin>"
         assert "workspace" not in d  # --no-regions
-        assert "time_s" not in d  # the schema's object, unchanged
+        assert isinstance(d["time_s"], float)  # the seconds it took (issue #30)
     heart1 = next(d for d in docs if d["name"] == "heart1")
     assert [round(c["t"], 2) for c in heart1["candidates"]] == [-1.51, -0.98, 0.98, 1.51]
 
@@ -427,6 +427,7 @@ def test_the_dask_run_gives_the_local_verdicts(local_cluster, tmp_path, orthogli
     assert sorted(d["name"] for d in streamed) == sorted(local)
     for d in streamed:
         del d["robot"]
+        assert isinstance(d.pop("time_s"), float)  # each line's own seconds
         assert d == {k: v for k, v in local[d["name"]].items() if k != "time_s"}
     doc = singcheck("run", ORTHO, *paths, "--format", "json", "--backend", "flint", "-q",
                     env=env)

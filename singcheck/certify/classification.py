@@ -144,6 +144,10 @@ class TrajectoryReport:
     def name(self) -> str:
         return self.trajectory.name
 
+    def __repr__(self) -> str:  # short: the path model runs to kilobytes
+        return (f"<TrajectoryReport {self.name}: {self.verdict}, "
+                f"{len(self.candidates)} candidate(s)>")
+
 
 def _conjugate_values(path: PathModel, modes: list[WorkingMode], t: arb) -> list:
     """det A of every mode of every conjugate robot (square roots' signs flipped)."""

@@ -230,8 +230,20 @@ def isolation_degree(mu: fmpq_mpoly) -> int:
 
 
 def _too_costly(what: str, trajectory: TrajectorySpec) -> SpecError:
-    return SpecError(f"too costly: {what}: lower the degrees or the coefficients of the "
-                     "coordinates, or the multiples of t in sin/cos", path=trajectory.path,
+    """The refusal of a path whose certification would cost too much, saying what to
+    change: the path's degrees, or, for a path already of degree 1 in t without sin/cos
+    (a straight line), nothing in the path: the cost is the robot's."""
+    straight = all(p.degrees()[0] <= 1 and max(p.degrees()[1:], default=0) <= 0
+                   for piece in trajectory.pieces for p in piece.pose.values()
+                   if not p.is_zero())  # degrees in t, then in sin t, cos t (and others)
+    if straight:
+        advice = ("the path is already a straight line (degree 1 in t, no sin/cos): the "
+                  "cost is the robot's (its singularity surface ξ(X) and its legs), not "
+                  "the path's; a robot with fewer pose variables or simpler legs is needed")
+    else:
+        advice = ("lower the degrees or the coefficients of the coordinates, or the "
+                  "multiples of t in sin/cos (or cut the path into shorter, simpler pieces)")
+    return SpecError(f"too costly: {what}: {advice}", path=trajectory.path,
                      line=trajectory.lines.get("pose"), key="pose")
 
 

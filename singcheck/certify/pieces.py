@@ -97,6 +97,11 @@ def _continuous(label: str, left: list[dict], right: list[dict]) -> bool:
     return True
 
 
+def _piece(i: int, count: int) -> str:
+    """How a reason names the piece ``i`` (0-based): nothing for a path of one piece."""
+    return f"segment {i + 1}: " if count > 1 else ""
+
+
 def _compose_modes(spec, reports) -> list[WorkingMode]:
     at_joins = [(_branch_values(reports[i], j), _branch_values(reports[i + 1], j))
                 for i, j in enumerate(joins(spec))]
@@ -107,7 +112,7 @@ def _compose_modes(spec, reports) -> list[WorkingMode]:
         for state in (INFEASIBLE, UNKNOWN):
             hit = next(((i, m) for i, m in enumerate(per_piece) if m.status == state), None)
             if hit:
-                status, reason = state, f"segment {hit[0] + 1}: {hit[1].reason}"
+                status, reason = state, _piece(hit[0], len(reports)) + hit[1].reason
                 break
         if status == FEASIBLE:
             for i, (left, right) in enumerate(at_joins):
@@ -116,8 +121,8 @@ def _compose_modes(spec, reports) -> list[WorkingMode]:
                     reason = (f"its IK branch is not the same on both sides of the join of "
                               f"segments {i + 1} and {i + 2}")
                     break
-        proof = "; ".join(f"segment {i + 1}: {m.proof}" for i, m in enumerate(per_piece)
-                          if m.proof)
+        proof = "; ".join(_piece(i, len(reports)) + m.proof
+                          for i, m in enumerate(per_piece) if m.proof)
         out.append(WorkingMode(first.label, first.branches, status, reason,
                                first.joints_at_start, proof=proof))
     return out
@@ -147,7 +152,7 @@ def compose(spec: TrajectorySpec, reports: list[TrajectoryReport]) -> Trajectory
             candidates.append(_restatus(g, feasible))
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
-    undecided = [(piece.to_global(t), f"segment {i + 1}: {why}")
+    undecided = [(piece.to_global(t), _piece(i, len(reports)) + why)
                  for i, (piece, report) in enumerate(zip(spec.pieces, reports, strict=True))
                  for t, why in report.undecided]
     verdict, reason = verdict_of(modes, candidates, undecided)

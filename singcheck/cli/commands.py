@@ -24,6 +24,17 @@ Examples:
   cat paths/*.yaml | singcheck run robots/orthoglide.yaml - --format jsonl
   singcheck run robots/orthoglide.yaml paths.yaml --format junit -o report.xml
   singcheck run robots/orthoglide.yaml paths.yaml --scheduler tcp://10.0.0.5:8786
+  singcheck run robots/orthoglide.yaml - --csv --columns t=time,x=X_mm,y=Y_mm,z=Z_mm \\
+    --scale x=1/1000,y=1/1000,z=1/1000 < log.csv
+
+\b
+Working modes (+++, +-, ooo, ...): one character per leg, in the order of the joints:
+  +  the branch with +√D: ρ = (-b + √D)/(2a) for a leg quadratic in its joint ρ;
+     for a revolute joint θ, the branch with +√Δ in (cos θ, sin θ) (one elbow posture)
+  -  the other branch: -√D (the other elbow posture)
+  o  the only branch of a leg linear in its joint (ρ = -c/b): nothing to choose
+A mode is feasible when each of its branches stays real, apart from the other branch
+and inside the joint limits along the whole path.
 
 \b
 Exit status:
@@ -91,9 +102,9 @@ def cli() -> None:
               show_default=True, help="Width of the certified enclosure of each root in t.")
 @click.option("--format", "fmt", type=click.Choice(["table", "json", "jsonl", "junit"]),
               default="table", show_default=True,
-              help="table for people; json for programs (schema in README); jsonl: one "
-                   "JSON object per trajectory, written as each one finishes; junit: JUnit "
-                   "XML for CI test reports.")
+              help="table for people; json for programs (its JSON Schema: singcheck schema "
+                   "report); jsonl: one JSON object per trajectory, with time_s, written as "
+                   "each one finishes; junit: JUnit XML for CI test reports.")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, writable=True),
               help="Write the result to this file (atomically: nothing if interrupted) "
                    "instead of stdout.")
@@ -116,8 +127,18 @@ def cli() -> None:
               help="Also write the figures (see `singcheck plot`) to this directory.")
 @click.option("--interpolation", type=click.Choice(["linear", "cubic"]), default="cubic",
               show_default=True,
-              help="How a CSV table of poses (TRAJECTORY ending in .csv) is joined: straight "
-                   "lines, or the natural cubic spline through its rows.")
+              help="How a CSV table of poses (TRAJECTORY ending in .csv, or any with --csv) "
+                   "is joined: straight lines, or the natural cubic spline through its rows.")
+@click.option("--csv", "as_csv", is_flag=True,
+              help="Read every TRAJECTORY, - (standard input) included, as a CSV table of "
+                   "poses, whatever its name.")
+@click.option("--columns", metavar="VAR=COLUMN,...",
+              help="CSV column map: read each pose variable (or the parameter) from the "
+                   "column with that header, e.g. t=time,x=X_mm,y=Y_mm; columns it does not "
+                   "name are ignored.")
+@click.option("--scale", metavar="VAR=FACTOR,...",
+              help="Multiply a CSV column by an exact factor, e.g. x=1/1000,y=1/1000 for "
+                   "millimetres (or 0.001).")
 @click.option("--engine", type=click.Choice(["auto", "exact", "interval"]), default="auto",
               show_default=True,
               help="auto: the exact engine (μ and its certified roots) held against the "
@@ -128,8 +149,8 @@ def cli() -> None:
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
 def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs,
-        time_limit, no_regions, scheduler, plot_dir, interpolation, engine, quiet,
-        verbose) -> None:  # engine: which certifies (the elimination backend is --backend)
+        time_limit, no_regions, scheduler, plot_dir, interpolation, as_csv, columns, scale,
+        engine, quiet, verbose) -> None:  # engine: which certifies (--backend eliminates)
     """Certify each TRAJECTORY of ROBOT (YAML spec files; - reads standard input; a
     trajectory may also be a CSV table of poses).  A YAML file may hold several
     trajectories as documents separated by ---; their names must be unique in a run.
@@ -156,10 +177,12 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     if plot_dir:
         require_extra("plot")
     progress = Progress(quiet)
+    table = csv_format(interpolation, columns, scale)
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
                     verbose, progress, jobs, plot_dir, interpolation, time_limit=time_limit,
-                    regions=not no_regions, scheduler=scheduler, certify_with=engine)
+                    regions=not no_regions, scheduler=scheduler, table=table,
+                    all_csv=as_csv, certify_with=engine)
     sys.exit(int(code))
 
 
@@ -185,9 +208,54 @@ def _worst(codes) -> ExitCode:
     return max(codes, key=_SEVERITY.index, default=ExitCode.SINGULARITY_FREE)
 
 
+def csv_format(interpolation: str, columns: str | None, scale: str | None):
+    """The --columns and --scale options as a :class:`~singcheck.spec.paths.CsvFormat`
+    for the CSV tables of a run (None when neither is given); a malformed one is a usage
+    error (exit 2)."""
+    from singcheck.spec.paths import CsvFormat
+
+    if not (columns or scale):
+        return None
+    mapped = _pairs(columns, "--columns", lambda text: text)
+    return CsvFormat(interpolation, tuple(mapped), tuple(_pairs(scale, "--scale", _factor)))
+
+
+def _pairs(text: str | None, option: str, value) -> list[tuple[str, object]]:
+    out: dict[str, object] = {}
+    for item in (text or "").split(","):
+        name, eq, rest = item.partition("=")
+        name, rest = name.strip(), rest.strip()
+        if not item.strip():
+            continue
+        if not eq or not name or not rest:
+            raise click.BadParameter(f"expected NAME=VALUE, got {item.strip()!r}",
+                                     param_hint=option)
+        if name in out:
+            raise click.BadParameter(f"{name} is given twice", param_hint=option)
+        try:
+            out[name] = value(rest)
+        except ValueError as e:
+            raise click.BadParameter(f"{name}: {e}", param_hint=option) from None
+    return list(out.items())
+
+
+def _factor(text: str):
+    """An exact, non-zero rational factor (singcheck's grammar: 1/1000, 0.001, 1e-3)."""
+    from singcheck.spec.grammar import ExprError, compile_constant, parse
+
+    try:
+        value = compile_constant(parse(text))
+    except ExprError as e:
+        raise ValueError(f"{e} in {text!r}") from None
+    if value.pi_coefficient or not value.rational:
+        raise ValueError(f"{text!r} is not a non-zero rational number (a CSV stays "
+                         "rational: give angles in radians)")
+    return value.rational
+
+
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
          progress, jobs, plot_dir=None, interpolation="cubic", *, time_limit=300.0,
-         regions=True, scheduler=None, certify_with="auto"):
+         regions=True, scheduler=None, table=None, all_csv=False, certify_with="auto"):
     from contextlib import closing
     from itertools import chain, islice
 
@@ -195,7 +263,7 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     from singcheck.spec.files import load_robot, read_documents
 
     spec = load_robot(robot)
-    documents = read_documents(trajectories, interpolation)
+    documents = read_documents(trajectories, interpolation, csv=table, all_csv=all_csv)
     # the first documents (all of a small batch) are parsed here, before any work: a bad
     # one stops the run at once (exit 2, one line); past them, the documents are parsed
     # by the workers, and a bad one is that trajectory's result
@@ -269,8 +337,8 @@ class _Sink:
         self.results: list[dict] = []
 
     def add(self, doc: dict) -> None:
-        seconds = doc.pop("time_s", None)  # not in the JSON schema: JUnit's time only
-        if self.fmt == "junit":
+        seconds = doc.pop("time_s", None)  # JUnit's time, and each jsonl line's
+        if self.fmt in ("junit", "jsonl"):
             doc["time_s"] = seconds
         if self.fmt != "jsonl":
             self.results.append(doc)
@@ -403,8 +471,8 @@ def _certificates(machine, specs, time_limit: float, tolerance: float = 1e-9) ->
         report = api.check(machine, spec, tolerance=tolerance, regions=False,
                            time_limit=time_limit)
         if report.certificate is None:
-            click.echo(f"singcheck: {spec.name}: {report.reason} (--time-limit): no "
-                       "figure", err=True)
+            click.echo(f"singcheck: {spec.name}: {report.verdict}: {report.reason} "
+                       "(--time-limit): no figure", err=True)
         else:
             out.append(report.certificate)
     return out
@@ -423,7 +491,7 @@ def _plot_all(certificates, out_dir: str, progress) -> list:
     return written
 
 
-def _plot_html(certificates, out_dir: str):
+def _plot_html(certificates, out_dir: str, plotly_js: str = "inline"):
     try:
         import plotly  # noqa: F401
 
@@ -431,7 +499,7 @@ def _plot_html(certificates, out_dir: str):
     except ImportError as e:
         raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
                         "pip install 'singcheck[html]'") from None
-    return write_html(certificates, os.path.join(out_dir, "singcheck.html"))
+    return write_html(certificates, os.path.join(out_dir, "singcheck.html"), plotly_js)
 
 
 @cli.command(epilog="""\b
@@ -449,6 +517,10 @@ Examples:
 @click.option("--format", "fmt", type=click.Choice(["files", "html"]), default="files",
               show_default=True, help="files: PNG and SVG per figure; html: one "
               "self-contained interactive page (needs singcheck[html]).")
+@click.option("--plotly", "plotly_js", type=click.Choice(["inline", "cdn"]), default="inline",
+              show_default=True, help="For --format html: inline plotly's JavaScript (a "
+              "page that works offline, several MB) or load it from plotly's CDN (a much "
+              "smaller page that needs the network).")
 @click.option("--regions", "spaces", multiple=True,
               type=click.Choice(["workspace", "jointspace"]),
               help="Also draw the regions of that space coloured by their number of "
@@ -462,7 +534,7 @@ Examples:
               "analysis; past it that figure is not drawn and the command ends with exit "
               "3, unknown: time limit.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
-def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, time_limit,
+def plot(robot, trajectories, out_dir, backend, fmt, plotly_js, spaces, slices, time_limit,
          quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
@@ -491,7 +563,7 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, time_limit,
             certificates = _certificates(machine, specs, time_limit)
             complete &= len(certificates) == len(specs)
             if fmt == "html":
-                click.echo(str(_plot_html(certificates, out_dir)))
+                click.echo(str(_plot_html(certificates, out_dir, plotly_js)))
             else:
                 for path in _plot_all(certificates, out_dir, progress):
                     click.echo(str(path))
@@ -619,6 +691,22 @@ def cache_clear() -> None:
     from singcheck.elimination.cache import EliminationCache
 
     click.echo(f"removed {EliminationCache().clear()} entries")
+
+
+@cli.command(epilog="""\b
+Examples:
+  singcheck schema robot > robot.schema.json
+  singcheck schema report | check-jsonschema --schemafile /dev/stdin report.json
+""")
+@click.argument("name", type=click.Choice(["robot", "trajectory", "report"]))
+def schema(name) -> None:
+    """Print the JSON Schema (Draft 2020-12) of a robot spec, a trajectory document or
+    the JSON report (each jsonl line: the report's $defs/jsonl_line).  Editors with the
+    YAML language server check a spec whose first line is
+    # yaml-language-server: $schema=PATH/TO/robot.schema.json"""
+    from singcheck.schemas import schema_text
+
+    click.echo(schema_text(name), nl=False)
 
 
 def _register_space_commands() -> None:

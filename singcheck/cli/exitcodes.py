@@ -1,4 +1,4 @@
-"""The one exit-status enum of the command line (documented in the README), and the one
+"""The one exit-status enum of the command line (documented in docs/outputs.md), and the one
 place where library errors become exit codes."""
 
 from __future__ import annotations

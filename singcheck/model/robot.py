@@ -105,6 +105,10 @@ class RobotModel:
     def name(self) -> str:
         return self.spec.name
 
+    def __repr__(self) -> str:  # short: F, A, B, det A and det B run to kilobytes
+        return (f"<RobotModel {self.name}: {len(self.legs)} legs, det A of degree "
+                f"{self.det_A.total_degree()}, det B of degree {self.det_B.total_degree()}>")
+
     @property
     def angles(self) -> frozenset[str]:
         return self.spec.angles

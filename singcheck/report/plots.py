@@ -373,10 +373,13 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
     return written
 
 
-def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
+def write_html(reports: list[TrajectoryReport], target: str | Path,
+               plotly_js: str = "inline") -> Path:
     """One self-contained interactive page (plotly, its JavaScript inlined once) with
     the same four figures for every trajectory, and the robot moving along it
-    (:mod:`singcheck.report.animation`) when its spec has a drawing."""
+    (:mod:`singcheck.report.animation`) when its spec has a drawing.  ``plotly_js="cdn"``:
+    the page loads plotly's JavaScript from its CDN instead (a few MB smaller; needs the
+    network to be viewed)."""
     import plotly.graph_objects as go
 
     from singcheck.atomic import write_atomically
@@ -448,7 +451,9 @@ def write_html(reports: list[TrajectoryReport], target: str | Path) -> Path:
         moving = animation_figure(report, d, f"{robot} · {report.name}: the robot along "
                                   "the path")
         for fig in figs + ([moving] if moving is not None else []):
-            parts.append(fig.to_html(full_html=False, include_plotlyjs=first, auto_play=False))
+            script = "cdn" if plotly_js == "cdn" else True  # cdn: a <script src=...>
+            parts.append(fig.to_html(full_html=False, auto_play=False,
+                                     include_plotlyjs=first and script))
             first = False
     page = ("<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>singcheck figures"
             "</title></head><body>\n" + "\n".join(parts) + "\n</body></html>\n")

@@ -1,4 +1,4 @@
-"""Rendering of workspace / joint-space analyses: a rich table, or JSON (README schema)."""
+"""Rendering of workspace / joint-space analyses: a rich table, or JSON (docs/spaces.md)."""
 
 from __future__ import annotations
 

@@ -1,6 +1,7 @@
 """Rendering of certification reports: a rich table for people, JSON for programs.
 
-The JSON document is described in the README ("JSON output"); bump
+The JSON document is described in docs/outputs.md ("JSON output") and by its JSON
+Schema, singcheck/schemas/report.schema.json (``singcheck schema report``); bump
 ``SCHEMA_VERSION`` on any incompatible change.
 """
 
@@ -86,8 +87,30 @@ def segments_json(report: TrajectoryReport) -> list[dict[str, Any]]:
                                                   strict=True), 1)]
 
 
+#: a path of more pieces than this has its pieces summarised, not listed, in the table
+MAX_LISTED_SEGMENTS = 6
+
+
+def segments_line(segments: list[dict[str, Any]]) -> str:
+    """The table's line on a path's pieces: each piece listed for a few, else summarised
+    (a 50-row CSV is 49 pieces: their count, the whole range, the isolation methods)."""
+    def one(s):
+        return f"{s['segment']}: [{s['range'][0]}, {s['range'][1]}] ({s['root_isolation']})"
+
+    if len(segments) <= MAX_LISTED_SEGMENTS:
+        return "  segments: " + "; ".join(one(s) for s in segments)
+    methods = list(dict.fromkeys(str(s["root_isolation"]) for s in segments))
+    first, last = segments[0], segments[-1]
+    return (f"  segments: {len(segments)} pieces (1: [{first['range'][0]}, "
+            f"{first['range'][1]}]; …; {last['segment']}: [{last['range'][0]}, "
+            f"{last['range'][1]}]), roots by {' and '.join(methods)}")
+
+
 def time_limited_json(spec, reason: str) -> dict[str, Any]:
-    """The trajectory object of a certification stopped by its time limit: unknown."""
+    """The trajectory object of a certification stopped by its time limit: unknown.  The
+    reason says why, without repeating the verdict (``time limit (2 s) reached``)."""
+    while reason.startswith("unknown: "):
+        reason = reason.removeprefix("unknown: ")
     return {**_trajectory_head(spec), "verdict": "unknown", "reason": reason,
             "root_isolation": None, "candidates": [], "working_modes": [], "undecided": []}
 
@@ -96,7 +119,7 @@ def error_json(spec, kind: str, message: str) -> dict[str, Any]:
     """The trajectory object of a trajectory whose check failed (``kind``: backend, spec
     — a document that is no valid trajectory, or a path refused as too costly — or
     internal): verdict ``error``, the reason, and nothing certified."""
-    return {**time_limited_json(spec, f"error: {message}"), "verdict": "error",
+    return {**time_limited_json(spec, message), "verdict": "error",
             "error": {"kind": kind, "message": message}}
 
 
@@ -302,9 +325,7 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
             console.print(f"  undecided for {t['parameter']} in [{lo:.9g}, {hi:.9g}]: "
                           f"{u['reason']}")
         if pieces:
-            console.print("  segments: " + "; ".join(
-                f"{s['segment']}: [{s['range'][0]}, {s['range'][1]}] ({s['root_isolation']})"
-                for s in segments))
+            console.print(segments_line(segments))
         if t.get("workspace"):
             console.print(workspace_line(t["workspace"]))
         style = _VERDICT_STYLE.get(t["verdict"], "bold")

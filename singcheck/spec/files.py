@@ -29,7 +29,7 @@ from singcheck.spec.grammar import (
     compile_value,
     parse,
 )
-from singcheck.spec.paths import csv_name, multi_piece, parse_csv
+from singcheck.spec.paths import CsvFormat, csv_name, multi_piece, parse_csv
 from singcheck.spec.plainyaml import compose_all as compose_plain
 from singcheck.spec.plainyaml import kind
 from singcheck.spec.trajectory import (
@@ -85,6 +85,10 @@ class RobotSpec:
     lines: dict[str, int] = field(default_factory=dict)
     angles: frozenset[str] = frozenset()  # joints and pose variables used inside sin/cos
     radicals: tuple[int, ...] = ()  # primes p whose sqrt(p) is a variable of the context
+
+    def __repr__(self) -> str:  # short: the constraints can run to kilobytes
+        return (f"<RobotSpec {self.name}: joints {', '.join(self.joints)}; pose "
+                f"{', '.join(self.pose)}>")
 
     def variables(self, name: str) -> tuple[str, ...]:
         """The context's variables of a joint or pose variable: itself, or
@@ -555,7 +559,7 @@ class Document:
     text: str
     name: str | None = None  # its name key, when the YAML could be read
     name_line: int | None = None
-    csv: str | None = None  # a CSV table: its interpolation (linear or cubic)
+    csv: CsvFormat | str | None = None  # a CSV table: how to read it (or its interpolation)
     error: SpecError | None = None
 
     @property
@@ -569,10 +573,13 @@ class Document:
         if self.error is not None:
             raise self.error
         if self.csv is not None:
-            return parse_csv(self.text, self.path, robot, self.csv)
+            return parse_csv(self.text, self.path, robot, self.csv, self.name)
         try:
             return _trajectory(_compose(self.text, self.path, self.line), self.path, robot)
         except SpecError as e:
+            if _looks_like_csv(self.text):
+                e = SpecError(f"{e.message} (is it a CSV table of poses? name it *.csv or "
+                              "run with --csv)", path=e.path, line=e.line, key=e.key)
             raise self.located(e) from None
 
     def located(self, e: SpecError) -> SpecError:
@@ -580,6 +587,14 @@ class Document:
             return e
         return SpecError(f"{e.message} (document {self.number})", path=e.path, line=e.line,
                          key=e.key)
+
+
+def _looks_like_csv(text: str) -> bool:
+    """A header line of comma-separated names (t,x,y,z) and no YAML key on it."""
+    first = next((line for line in text.splitlines() if line.strip()
+                  and not line.lstrip().startswith("#")), "")
+    return "," in first and ":" not in first and \
+        all(_IDENTIFIER.match(c.strip()) for c in first.split(","))
 
 
 def _is_marker(line: bytes, marker: bytes) -> bool:
@@ -674,12 +689,15 @@ def _name(node) -> dict:
 
 
 def read_documents(paths: Iterable[str | os.PathLike], interpolation: str | None = None,
+                   *, csv: CsvFormat | None = None, all_csv: bool = False
                    ) -> Iterator[Document]:
     """Every trajectory of the files, lazily, as :class:`Document` (a YAML file, or
     ``-``, standard input, holds one or more documents; a CSV file one table), read one
     at a time: memory does not grow with the number of trajectories but for their
     names, which must be unique in a run (a repeated one is that document's error).
-    A file that cannot be opened, or ``-`` given twice, is refused here, at once."""
+    A file that cannot be opened, or ``-`` given twice, is refused here, at once.
+    ``csv``: how CSV tables are read (``*.csv`` files; with ``all_csv``, every input,
+    standard input too)."""
     paths = [os.fspath(p) for p in paths]
     if paths.count(STDIN) > 1:
         raise SpecError("standard input (-) is given twice", path=STDIN)
@@ -690,14 +708,18 @@ def read_documents(paths: Iterable[str | os.PathLike], interpolation: str | None
                     pass
             except OSError as e:
                 raise SpecError(f"cannot read the file: {e.strerror or e}", path=path) from None
-    return _unique(_all_documents(paths, interpolation))
+    return _unique(_all_documents(paths, interpolation, csv, all_csv))
 
 
-def _all_documents(paths: list[str], interpolation: str | None) -> Iterator[Document]:
+def _all_documents(paths: list[str], interpolation: str | None,
+                   table: CsvFormat | None = None, all_csv: bool = False
+                   ) -> Iterator[Document]:
     for path in paths:
-        if path.lower().endswith(".csv"):
-            document = Document(path, 1, 1, "", name=csv_name(path),
-                                csv=interpolation or "cubic")
+        if all_csv or path.lower().endswith(".csv"):
+            stdin = path == STDIN
+            document = Document(STDIN_NAME if stdin else path, 1, 1, "",
+                                name="stdin" if stdin else csv_name(path),
+                                csv=table or CsvFormat(interpolation or "cubic"))
             try:
                 yield replace(document, text=_read(path))
             except SpecError as e:

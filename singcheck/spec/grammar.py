@@ -7,16 +7,18 @@ unary minus, so ``-x^2`` is ``-(x^2)``)::
     term    := unary (("*" | "/") unary)*
     unary   := ("+" | "-") unary | power
     power   := atom (("^" | "**") unary)?
-    atom    := NUMBER | NAME | NAME "(" expr ")" | "(" expr ")"
+    atom    := NUMBER ["deg"] | NAME | NAME "(" expr ")" | "(" expr ")"
 
-Numbers are exact: ``0.1`` is 1/10, ``1e-3`` is 1/1000.  Implicit multiplication
-(``2x``) is refused.  The parser builds a small tree; the compilers turn it into exact
-objects: a polynomial over Q (:func:`compile_polynomial`), a trig polynomial in
-``Q[t, s, c]`` (:func:`compile_trajectory_coordinate`), or a constant ``a + b·π``
-(:func:`compile_constant`).  Errors are :class:`ExprError` with a column.
+Numbers are exact: ``0.1`` is 1/10, ``1e-3`` is 1/1000; ``30 deg`` is 30·π/180 = π/6.
+Implicit multiplication (``2x``) is refused.  The parser builds a small tree; the
+compilers turn it into exact objects: a polynomial over Q (:func:`compile_polynomial`),
+a trig polynomial in ``Q[t, s, c]`` (:func:`compile_trajectory_coordinate`), or a
+constant ``a + b·π`` (:func:`compile_constant`).  Errors are :class:`ExprError` with a column.
 
 >>> str(compile_constant(parse("-pi/2 + 0.5")))
 '1/2-1/2*pi'
+>>> str(compile_constant(parse("135 deg")))
+'3/4*pi'
 """
 
 from __future__ import annotations
@@ -46,6 +48,10 @@ MAX_BITS = 4096  # of any intermediate rational's numerator or denominator (1233
 MAX_LITERAL_BITS = 512  # of a number literal's numerator or denominator (1e154 is fine)
 MAX_NESTING = 64  # parentheses, calls and exponents inside one another
 FUNCTIONS = ("sin", "cos")  # sqrt is handled apart: it only takes constants
+
+
+#: the unit after a number that makes it an angle in degrees: ``30 deg`` is π/6, exactly
+DEGREE = "deg"
 
 
 class ExprError(ValueError):
@@ -88,6 +94,8 @@ def _tokens(text: str) -> list[tuple[str, str, int]]:
             out.append((kind, m.group(), pos + 1))
         pos = m.end()
     for (k1, v1, _), (k2, v2, c2) in zip(out, out[1:], strict=False):
+        if k1 == "num" and k2 == "name" and v2 == DEGREE:
+            continue  # 30 deg: a unit, not a missing operator
         if k1 == "num" and k2 in ("name", "num") or (k1 == "op" and v1 == ")" and
                                                      (k2 in ("name", "num") or v2 == "(")):
             raise ExprError(f"missing operator before {v2!r} (write 2*x, not 2x)", c2)
@@ -177,7 +185,12 @@ class _Parser:
     def atom(self) -> Node:
         kind, v, col = self.take()
         if kind == "num":
-            return Node("num", col, _exact_number(v, col))
+            value = _exact_number(v, col)
+            if self.peek()[0] == "name" and self.peek()[1] == DEGREE:
+                self.take()  # d deg is d·π/180 exactly: (d/180)*pi
+                return Node("mul", col, None, (Node("num", col, value / 180),
+                                               Node("name", col, "pi")))
+            return Node("num", col, value)
         if kind == "name":
             if self.peek()[1] == "(":
                 self.take()

@@ -22,6 +22,7 @@ refused with one line naming both segments.
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from fractions import Fraction
 
 from flint import fmpq, fmpq_mpoly
@@ -184,13 +185,30 @@ def _check_table(path: str, parameter: str, times, lines, where) -> None:
                             f"({times[i - 1]} then {times[i]})", path=path, line=lines[i])
 
 
+@dataclass(frozen=True)
+class CsvFormat:
+    """How a CSV table of poses is read: its ``interpolation`` (linear or cubic), a column
+    map ``columns`` ((variable, header) pairs: the pose variable, or the parameter, read
+    from the column with that header; other columns are then ignored) and exact factors
+    ``scale`` ((variable, factor) pairs: ``x`` in millimetres is scaled by 1/1000)."""
+
+    interpolation: str = "cubic"
+    columns: tuple[tuple[str, str], ...] = ()
+    scale: tuple[tuple[str, Fraction], ...] = ()
+
+
 def csv_name(path: str) -> str:
     """A CSV trajectory's name: its file's name without ``.csv``."""
     return re.sub(r"\.csv\Z", "", path.replace("\\", "/").rsplit("/", 1)[-1], flags=re.I)
 
 
-def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec:
-    """A CSV table of poses: header ``PARAMETER,POSE...`` then one exact row per waypoint."""
+def parse_csv(text: str, path: str, robot, interpolation: str | CsvFormat,
+              trajectory_name: str | None = None) -> TrajectorySpec:
+    """A CSV table of poses: header ``PARAMETER,POSE...`` then one exact row per waypoint;
+    with a column map (:class:`CsvFormat`), the header names the columns the map picks
+    and other columns are ignored.  ``trajectory_name``: default, the file's name."""
+    table = interpolation if isinstance(interpolation, CsvFormat) else \
+        CsvFormat(interpolation)
     text = text.removeprefix("\ufeff")  # a byte-order mark some spreadsheets write
     rows = [(n, line) for n, line in enumerate(text.splitlines(), 1)
             if line.strip() and not line.lstrip().startswith("#")]
@@ -198,6 +216,9 @@ def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec
         raise SpecError("the file is empty", path=path, line=1)
     header_line, header = rows[0]
     names = [c.strip() for c in header.split(",")]
+    picked = None
+    if table.columns or table.scale:
+        names, picked = _mapped(table, names, robot, path, header_line)
     parameter = names[0]
     if not re.fullmatch(r"[A-Za-z_][A-Za-z_0-9]*", parameter) or parameter in robot.pose:
         raise SpecError(f"the first column must name the parameter (e.g. t), not "
@@ -205,7 +226,9 @@ def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec
     for v in names[1:]:
         if v not in robot.pose:
             raise SpecError(f"column {v!r} is not a pose variable of robot {robot.name} "
-                            f"(pose: {', '.join(robot.pose)})", path=path, line=header_line)
+                            f"(pose: {', '.join(robot.pose)}; to pick and rename columns: "
+                            f"--columns {robot.pose[0]}={v},...)", path=path,
+                            line=header_line)
         if names.count(v) > 1:
             raise SpecError(f"column {v!r} appears twice", path=path, line=header_line)
     missing = [v for v in robot.pose if v not in names]
@@ -215,11 +238,15 @@ def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec
     times: list[Fraction] = []
     values: dict[str, list[Fraction]] = {v: [] for v in robot.pose}
     lines = []
+    factors = dict(table.scale)
     for n, line in rows[1:]:
         cells = [c.strip() for c in line.split(",")]
-        if len(cells) != len(names):
-            raise SpecError(f"{len(cells)} values for {len(names)} columns", path=path,
-                            line=n)
+        if len(cells) != (len(names) if picked is None else picked[1]):
+            raise SpecError(f"{len(cells)} values for "
+                            f"{len(names) if picked is None else picked[1]} columns",
+                            path=path, line=n)
+        if picked is not None:
+            cells = [cells[i] for i in picked[0]]
         exact = []
         for name, cell in zip(names, cells, strict=True):
             number = _NUMBER.match(cell)
@@ -233,14 +260,45 @@ def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec
             except ZeroDivisionError:
                 raise SpecError(f"{name}: {cell!r} divides by zero", path=path,
                                 line=n) from None
+        exact = [value * factors.get(name, 1) for name, value in zip(names, exact,
+                                                                      strict=True)]
         times.append(exact[0])
         for name, value in zip(names[1:], exact[1:], strict=True):
             values[name].append(value)
         lines.append(n)
     _check_table(path, parameter, times, lines, header_line)
-    stem = csv_name(path)
-    pieces = interpolated_pieces(path, stem, parameter, times, values, interpolation, lines)
-    return _whole(path, stem, parameter, pieces, {"interpolation": interpolation})
+    stem = trajectory_name or csv_name(path)
+    pieces = interpolated_pieces(path, stem, parameter, times, values, table.interpolation,
+                                 lines)
+    return _whole(path, stem, parameter, pieces, {"interpolation": table.interpolation})
+
+
+def _mapped(table: CsvFormat, header: list[str], robot, path: str, line: int):
+    """The variables a column map reads, parameter first then the pose in the robot's
+    order, and ((the column index of each), the number of columns in the header)."""
+    columns = dict(table.columns)
+    others = [v for v in columns if v not in robot.pose]
+    if len(others) > 1:
+        raise SpecError(f"the column map names {', '.join(others)}: only one of them, the "
+                        f"parameter, may be other than a pose variable of robot "
+                        f"{robot.name} (pose: {', '.join(robot.pose)})", path=path, line=line)
+    parameter = others[0] if others else header[0]
+    for v, _ in table.scale:
+        if v != parameter and v not in robot.pose:
+            raise SpecError(f"the scale names {v!r}, neither the parameter {parameter!r} "
+                            f"nor a pose variable of robot {robot.name} (pose: "
+                            f"{', '.join(robot.pose)})", path=path, line=line)
+    variables = [parameter, *robot.pose]
+    index = []
+    for v in variables:
+        column = columns.get(v, v if v != parameter or others else header[0])
+        if column not in header:
+            raise SpecError(f"no column {column!r} for {v} (header: {','.join(header)})",
+                            path=path, line=line)
+        if header.count(column) > 1:
+            raise SpecError(f"column {column!r} appears twice", path=path, line=line)
+        index.append(header.index(column))
+    return variables, (index, len(header))
 
 
 def interpolated_pieces(path: str, name: str, parameter: str, times: list[Fraction],

@@ -52,6 +52,12 @@ class TrajectorySpec:
     #: u keeps ball evaluations tight and coefficients small); ``range`` is then in u.
     time_offset: Fraction = Fraction(0)
 
+    def __repr__(self) -> str:  # short: the pose polynomials can run to kilobytes
+        pieces = f", {len(self.segments)} pieces" if self.segments else ""
+        rng = self.global_range
+        return (f"<TrajectorySpec {self.name}: {self.parameter} in [{rng.start}, "
+                f"{rng.end}]{pieces}>")
+
     @property
     def pieces(self) -> tuple[TrajectorySpec, ...]:
         """The one-piece specs to certify, in order (the spec itself for one piece)."""

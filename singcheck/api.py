@@ -219,17 +219,19 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
             certificate = certify_trajectory(robot.projection, trajectory, tolerance, engine)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions or any(r.path.mu is None for r in certificate.pieces or [certificate]):
+        if not regions or any(r.path.exact_refused for r in certificate.pieces or [certificate]):
             return Report(trajectory, certificate)  # no region statement without ξ along it
         from singcheck.spaces.path_regions import path_in_workspace, pieces_in_workspace
 
         mu_roots = ([c.t for c in certificate.candidates]
                     if certificate.mu_roots_complete else None)
-        budget = None if regions == "wait" else REGION_BUDGET
+        budget = None if regions == "wait" else region_budget()
         left = remaining()
         own = budget is not None and (left is None or left > budget)
         try:
             with deadline(budget):
+                if not _with_mu(certificate):
+                    return Report(trajectory, certificate)
                 if certificate.pieces:
                     where = pieces_in_workspace(certificate, tolerance, robot.region_cache,
                                                 notify)
@@ -243,9 +245,34 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
         return Report(trajectory, certificate, where)
 
 
+def _with_mu(certificate) -> bool:
+    """μ along every piece of a certified path, for the region statement (the interval
+    engine may have decided without it); False when the exact engine refuses a piece."""
+    from singcheck.certify.path import with_mu
+
+    for report in certificate.pieces or [certificate]:
+        report.path = with_mu(report.path)
+        if report.path.mu is None:
+            return False
+    return True
+
+
 #: seconds the region statement may take beside a verdict (``regions="wait"``: no budget
 #: of its own, only the trajectory's time limit): it never holds the verdict back
 REGION_BUDGET = 2.0
+
+
+def region_budget() -> float:
+    """:data:`REGION_BUDGET`, or the environment's ``SINGCHECK_REGION_BUDGET`` (seconds, a
+    positive number; anything else is ignored)."""
+    import math
+    import os
+
+    try:
+        value = float(os.environ.get("SINGCHECK_REGION_BUDGET", ""))
+    except ValueError:
+        return REGION_BUDGET
+    return value if value > 0 and math.isfinite(value) else REGION_BUDGET
 
 
 #: the default per-trajectory time limit of a batch (seconds): generous, but finite

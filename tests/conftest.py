@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -9,6 +10,11 @@ import pytest
 ROOT = Path(__file__).resolve().parent.parent
 ROBOTS = ROOT / "robots"
 TRAJECTORIES = ROOT / "trajectories"
+
+# The region statement's own budget (2 s beside the verdict) is for users; the tests
+# check what it says, on a machine that may be loaded, so they give it a minute (the
+# test of the budget itself sets its own).  Subprocesses inherit it.
+os.environ.setdefault("SINGCHECK_REGION_BUDGET", "60")
 
 
 @pytest.fixture(scope="session")

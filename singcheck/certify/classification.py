@@ -370,12 +370,85 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
     if all(m.status == INFEASIBLE for m in modes):
         verdict, reason = verdict_of(modes, [], [])
         return TrajectoryReport(path, verdict, reason, [], modes, NOT_NEEDED)
-    if path.mu is None:
+    if path.mu is not None:  # --engine exact
+        return _certify_exactly(path, modes, tolerance)
+    if path.exact_refused:  # --engine interval
         return _certify_by_intervals(path, modes)
+    return _interval_engine_first(path, modes, tolerance)
+
+
+#: seconds the exact engine may take to corroborate a verdict the interval engine
+#: proved on its own (past them the verdict stands on the interval engine alone, and the
+#: report says so); where the interval engine leaves windows, the exact engine has the
+#: trajectory's whole time limit
+EXACT_CORROBORATION_BUDGET = 5.0
+
+
+def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
+                           tolerance: float) -> TrajectoryReport:
+    """``--engine auto``: the interval engine first, then the exact one.
+
+    When the intervals decide the path on their own (every feasible mode proven ≠ 0, or
+    only proven crossings left), the exact engine corroborates within
+    :data:`EXACT_CORROBORATION_BUDGET`; when it cannot (refused, or out of budget) the
+    interval verdict stands, and the report says why the exact engine did not run.
+    When windows are left (a possible tangency, an enclosure too wide), the exact engine
+    decides the path, and the intervals' findings corroborate it."""
+    from singcheck.budget import TimeLimitExceeded, deadline, remaining
+    from singcheck.certify.path import with_mu
+
+    feasible = [m for m in modes if m.status == FEASIBLE]
+    searches = search_det_a(path, feasible, budget=first_pass_budget(path, feasible))
+    decided = all(w.crossing for s in searches.values() for w in s.windows)
+    if not decided:
+        exact = with_mu(path)
+        if exact.mu is None:
+            return _certify_by_intervals(exact, modes, searches)
+        return _certify_exactly(exact, modes, tolerance, searches)
+    left = remaining()
+    own = left is None or left > EXACT_CORROBORATION_BUDGET
+    try:
+        with deadline(EXACT_CORROBORATION_BUDGET):
+            exact = with_mu(path)
+            if exact.mu is not None:
+                return _certify_exactly(exact, modes, tolerance, searches)
+    except TimeLimitExceeded:
+        if not own:
+            raise
+        exact = replace_path(path, f"the exact engine did not finish within its "
+                                   f"{EXACT_CORROBORATION_BUDGET:g} s budget")
+    return _certify_by_intervals(exact, modes, searches)
+
+
+#: ball evaluations (of every feasible mode at once) the interval engine's first pass
+#: may spend per 2π of range, divided among the modes: what it leaves goes to the exact
+#: engine, which decides a path lying on the singularity (every piece a window) at once
+FIRST_PASS_EVALUATIONS = 20000
+
+
+def first_pass_budget(path: PathModel, feasible: list) -> int:
+    import math
+
+    interval = path.trajectory.range
+    periods = max(1.0, (float(interval.end) - float(interval.start)) / (2 * math.pi))
+    return max(200, int(FIRST_PASS_EVALUATIONS * periods) // max(1, len(feasible)))
+
+
+def replace_path(path: PathModel, why: str) -> PathModel:
+    """The path marked as one the exact engine did not certify, and why."""
+    from dataclasses import replace as _replace
+
+    return _replace(path, exact_refused=why)
+
+
+def _certify_exactly(path: PathModel, modes: list[WorkingMode], tolerance: float,
+                     searches: dict | None = None) -> TrajectoryReport:
+    """The exact engine's verdict (μ's certified roots, classified per mode), held against
+    the interval engine's (``searches`` when it has run already)."""
     try:
         isolation = isolate_real_roots(path.mu, path.trajectory.range, tolerance)
     except IdenticallyZeroError:
-        return _certify_on_surface(path, modes, tolerance)
+        return _certify_on_surface(path, modes, tolerance, searches)
     candidates = _classify_all(path, modes, isolation.roots, tolerance)
     singular = [(c, set(c.singular_modes)) for c in candidates]
     for mode in modes:
@@ -385,14 +458,15 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
     verdict, reason = verdict_of(modes, candidates, undecided)
     return _corroborated(TrajectoryReport(path, verdict, reason, candidates, modes,
                                           isolation.method, undecided,
-                                          not isolation.undecided))
+                                          not isolation.undecided), searches)
 
 
-def _corroborated(report: TrajectoryReport) -> TrajectoryReport:
+def _corroborated(report: TrajectoryReport, searches: dict | None = None) -> TrajectoryReport:
     """The report with the interval engine's check of its verdict
-    (:func:`.engines.corroborate`), and the verdict that follows from both engines."""
+    (:func:`.engines.corroborate`; ``searches``: its findings when it has run already),
+    and the verdict that follows from both engines."""
     check = corroborate(report.path, report.modes, report.candidates, report.undecided,
-                        report.verdict, BY_IDENTICALLY_ZERO)
+                        report.verdict, BY_IDENTICALLY_ZERO, searches)
     report.corroboration = check
     report.verdict, report.reason = corroborated_verdict(report.verdict, report.reason, check)
     return report
@@ -403,7 +477,8 @@ BY_INTERVALS_ONLY = "none: interval engine (det A along each feasible mode)"
 BY_INTERVAL_CROSSING = "sign change of det A along the mode (ball arithmetic)"
 
 
-def _certify_by_intervals(path: PathModel, modes: list[WorkingMode]) -> TrajectoryReport:
+def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
+                          searches: dict | None = None) -> TrajectoryReport:
     """The verdict of the interval engine alone, when the exact engine did not run
     (``path.exact_refused`` says why): a proven crossing along a feasible mode is
     ``singular`` (its window is the candidate), every feasible mode proven ≠ 0 on the
@@ -411,7 +486,8 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode]) -> Trajecto
     bound.  A touch without a sign change cannot be proven by intervals: it stays a
     window."""
     feasible = [m for m in modes if m.status == FEASIBLE]
-    searches = search_det_a(path, feasible) if feasible else {}
+    if searches is None:
+        searches = search_det_a(path, feasible) if feasible else {}
     candidates = []
     for mode in feasible:
         for w in searches[mode.label].crossings:
@@ -442,7 +518,7 @@ def _window_candidate(path: PathModel, mode: WorkingMode, w) -> Candidate:
 
 
 def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
-                        tolerance: float) -> TrajectoryReport:
+                        tolerance: float, searches: dict | None = None) -> TrajectoryReport:
     """μ ≡ 0: the path lies on ξ(X) = 0, so μ gives no candidates.  Each feasible mode is
     decided on its own (:func:`.exact.mode_zero_polynomial`): det A ≡ 0 along it (singular
     all along), or a non-zero trig polynomial whose roots hold its zeros, which are then
@@ -480,7 +556,7 @@ def _certify_on_surface(path: PathModel, modes: list[WorkingMode],
         reason += " (the path lies on ξ(X) = 0: each mode was decided on its own)"
     # the candidates are the modes' own zeros, not roots of μ (which is ≡ 0)
     return _corroborated(TrajectoryReport(path, verdict, reason, candidates, modes, method,
-                                          undecided, mu_roots_complete=False))
+                                          undecided, mu_roots_complete=False), searches)
 
 
 def _mode_zeros(path: PathModel, mode: WorkingMode, samples: list):

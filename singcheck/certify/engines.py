@@ -90,12 +90,13 @@ def _window_text(label: str, w) -> str:
     return f"mode {label} on t ∈ [{w.lo:.9g}, {w.hi:.9g}] (|det A| ≤ {w.bound:.3g} there)"
 
 
-def corroborate(path, modes, candidates, undecided, verdict: str, identically_zero: str
-                ) -> Corroboration:
+def corroborate(path, modes, candidates, undecided, verdict: str, identically_zero: str,
+                searches: dict | None = None) -> Corroboration:
     """The interval engine's check of one piece's verdict (see the module docstring).
     ``undecided``: the (t ball, reason) stretches the exact engine left open (a crossing
     there is no conflict: the verdict is already unknown); ``identically_zero``: the
-    proof name of a mode singular along the whole piece."""
+    proof name of a mode singular along the whole piece; ``searches``: the interval
+    engine's findings when it has run already (else it runs here)."""
     from singcheck.certify.working_modes import FEASIBLE
 
     feasible = [m for m in modes if m.status == FEASIBLE]
@@ -105,8 +106,11 @@ def corroborate(path, modes, candidates, undecided, verdict: str, identically_ze
              if pm.proof == identically_zero}
     hints = {m.label: [c.t for c in candidates if m.label in c.singular_modes]
              for m in feasible}
-    searches = search_det_a(path, feasible, refine={m.label for m in feasible} - whole,
-                            hints=hints)
+    if searches is None or any(m.label not in searches for m in feasible) or (
+            verdict == "singularity-free" and any(searches[m.label].windows for m in feasible)):
+        # (a first pass on a budget that left windows on a free path: search again, whole)
+        searches = search_det_a(path, feasible, refine={m.label for m in feasible} - whole,
+                                hints=hints)
     conflicts, confirmed = [], []
     for mode in feasible:
         s = searches[mode.label]

@@ -145,15 +145,26 @@ def search_det_a(path, modes: list, refine: set[str] | None = None,
         lo, hi = float(piece.lower()), float(piece.upper())
         unproven = [m for m in open_modes if not (isinstance(values[m.label], arb)
                                                  and excludes_zero(values[m.label]))]
+        monotone: dict[str, tuple[int, int]] = {}
         if unproven and mean_value_form:
-            for label, v in mean_value(path, unproven, piece, joints).items():
+            forms = mean_value(path, unproven, piece, joints)
+            for label, (v, _) in forms.items():
                 if excludes_zero(v) or not isinstance(values[label], arb):
                     values[label] = v
+            steep = [m for m in unproven if m.label in forms
+                     and not excludes_zero(values[m.label]) and excludes_zero(forms[m.label][1])]
+            if steep:
+                monotone = _end_signs(path, steep, piece)
         again = []
         for mode in open_modes:
             v = values[mode.label]
+            ends = monotone.get(mode.label)
             if isinstance(v, arb) and excludes_zero(v):
                 found[mode.label][lo, hi] = (sign(v), _bound(v))
+            elif ends is not None and ends[0] == ends[1]:  # monotone, one sign at both ends
+                found[mode.label][lo, hi] = (ends[0], _bound(v))
+            elif ends is not None:  # monotone between opposite signs: one simple crossing
+                found[mode.label][lo, hi] = (None, _bound(v), ends)
             elif mode.label in refine and left > 0 and hi - lo > smallest and not (
                     hi - lo <= near and any(h.overlaps(piece) for h in
                                             hints.get(mode.label, ()))):
@@ -166,25 +177,48 @@ def search_det_a(path, modes: list, refine: set[str] | None = None,
     return {label: _summarise(label, pieces_found) for label, pieces_found in found.items()}
 
 
+def _end_signs(path, modes: list, piece: arb) -> dict[str, tuple[int, int]]:
+    """The proven signs of det A at the two ends of the piece (exact points) for each
+    mode where both are proven."""
+    _, _, at_lo = mode_values(path, modes, arb(piece.lower()))
+    _, _, at_hi = mode_values(path, modes, arb(piece.upper()))
+    out = {}
+    for mode in modes:
+        a, b = at_lo[mode.label], at_hi[mode.label]
+        if isinstance(a, arb) and isinstance(b, arb) and excludes_zero(a) and excludes_zero(b):
+            out[mode.label] = (sign(a), sign(b))
+    return out
+
+
 def _summarise(label: str, found: dict) -> ModeSearch:
     """The proven pieces and the windows (maximal runs of unproven pieces, with the
-    signs on either side) of one mode."""
+    signs on either side) of one mode.  A piece on which det A is proven monotone
+    between opposite signs is a window of its own with those signs: one simple crossing,
+    whatever its neighbours."""
     out = ModeSearch(label)
     run: list = []
     before: int | None = None
-    for (lo, hi), (s, bound) in sorted(found.items()):
+
+    def close(after: int | None) -> None:
+        if run:
+            out.windows.append(Window(run[0][0], run[-1][1], max(r[2] for r in run),
+                                      before, after))
+            run.clear()
+
+    for (lo, hi), entry in sorted(found.items()):
+        s, bound = entry[0], entry[1]
+        if len(entry) == 3:  # a proven simple crossing
+            close(None)
+            out.windows.append(Window(lo, hi, bound, *entry[2]))
+            before = entry[2][1]
+            continue
         if s is None:
             run.append((lo, hi, bound))
             continue
         out.proven.append((lo, hi, s))
-        if run:
-            out.windows.append(Window(run[0][0], run[-1][1], max(r[2] for r in run),
-                                      before, s))
-            run = []
+        close(s)
         before = s
-    if run:
-        out.windows.append(Window(run[0][0], run[-1][1], max(r[2] for r in run), before,
-                                  None))
+    close(None)
     return out
 
 
@@ -239,9 +273,10 @@ def _pose_derivatives(path) -> list | None:
 
 
 def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
-    """det A per mode over the ball ``t`` in mean-value form (None for a mode where it
-    could not be formed): det A at the midpoint, plus the enclosure of its derivative
-    along the mode over ``t`` times (t − m).  The derivative: ∂det A/∂v · v' summed over
+    """(det A, its derivative along the mode) per mode over the ball ``t``, det A in
+    mean-value form (a mode where it could not be formed is left out): det A at the
+    midpoint, plus the enclosure of its derivative along the mode over ``t`` times
+    (t − m).  The derivative: ∂det A/∂v · v' summed over
     the pose variables (v' from d/dt of the path) and the joints (implicit
     differentiation of each leg f(ρ, X) = 0: ρ' = −(∇ₓf·X')/(∂f/∂ρ); a revolute joint's
     θ' = −(∇ₓf·X')/(b·cos θ − a·sin θ), then (cos θ)' = −sin θ·θ', (sin θ)' = cos θ·θ').
@@ -291,5 +326,5 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
             slope += evaluate(p, point, powers) * speed[i]
         value = mid + slope * (t - m)
         if value.is_finite():
-            out[mode.label] = value
+            out[mode.label] = (value, slope)
     return out

@@ -20,7 +20,7 @@ their norm (:mod:`singcheck.roots.isolation`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 from flint import acb, acb_mat, arb, arb_mat, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
@@ -844,13 +844,13 @@ ENGINES = (AUTO, EXACT, INTERVAL)
 
 
 def build_path(projection: RobotProjection, trajectory: TrajectorySpec,
-               engine: str = AUTO) -> PathModel:
+               engine: str = EXACT) -> PathModel:
     """The model along one piece (a multi-piece path: one per ``trajectory.pieces``).
 
-    μ is left out (None, with the reason in ``exact_refused``) when ``engine`` is
-    ``interval``, or when it is ``auto`` and the exact engine refuses the path (μ or its
-    isolation too costly, a path-wise elimination not supported): the interval engine
-    then certifies the path alone."""
+    μ is computed here only for ``engine="exact"``, the default (refused with a
+    :class:`SpecError` when too costly).  With ``auto`` it is left for later (None:
+    :func:`with_mu`, once the interval engine has run); with ``interval`` it is never
+    computed (``exact_refused`` says so)."""
     if trajectory.segments:
         raise ValueError("build_path takes one piece: use trajectory.pieces")
     model = projection.model
@@ -902,22 +902,33 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec,
             coordinates.append(x)
     coordinates = tuple(coordinates)
     pose_vars = model.pose_variables
-    mu, refused = None, "the interval engine alone was asked for (--engine interval)"
-    if engine != INTERVAL:
-        try:
-            mu = _mu(projection, trajectory, coordinates, where)
-        except (SpecError, UnsupportedRobotError) as e:
-            if engine == EXACT:
-                raise
-            refused = f"the exact engine refused this path: {e.message}"
+    mu, refused = None, ""
+    if engine == EXACT:
+        mu = _mu(projection, trajectory, coordinates, where)
+    elif engine == INTERVAL:
+        refused = "the interval engine alone was asked for (--engine interval)"
     try:
         legs = _legs_along(model, coordinates)
         degenerate = tuple(compose_pose(w, coordinates, pose_vars)
                            for w in memo_per_object(_DEGENERATE, model, degenerate_set))
     except TooCostly as e:
         raise _too_costly(f"a leg's constraint along the path: {e}", trajectory) from None
-    return PathModel(projection, trajectory, phi, mu, legs, coordinates, degenerate,
-                     "" if mu is not None else refused)
+    return PathModel(projection, trajectory, phi, mu, legs, coordinates, degenerate, refused)
+
+
+def with_mu(path: PathModel) -> PathModel:
+    """The path with μ computed (the exact engine's input), or with ``exact_refused``
+    saying why the exact engine refuses it (μ or its isolation too costly, a path-wise
+    elimination not supported)."""
+    if path.mu is not None or path.exact_refused:
+        return path
+    trajectory = path.trajectory
+    where = dict(path=trajectory.path, line=trajectory.lines.get("pose"), key="pose")
+    try:
+        mu = _mu(path.projection, trajectory, path.coordinates, where)
+    except SpecError as e:  # UnsupportedRobotError included
+        return replace(path, exact_refused=f"the exact engine refused this path: {e.message}")
+    return replace(path, mu=mu)
 
 
 def _mu(projection: RobotProjection, trajectory: TrajectorySpec,

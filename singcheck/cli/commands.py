@@ -145,10 +145,12 @@ def cli() -> None:
                    "millimetres (or 0.001).")
 @click.option("--engine", type=click.Choice(["auto", "exact", "interval"]), default="auto",
               show_default=True,
-              help="auto: the exact engine (μ and its certified roots) held against the "
-                   "interval engine (det A enclosed along each feasible mode), the interval "
-                   "engine alone on a path the exact one refuses; exact: refuse such a path; "
-                   "interval: the interval engine alone (a tangency stays unknown).")
+              help="auto: the interval engine (det A enclosed along each feasible mode) "
+                   "first, the exact engine (μ and its certified roots) to corroborate it "
+                   "(within 5 s) or to decide what the intervals leave, the intervals alone "
+                   "on a path the exact engine refuses; exact: the exact engine, held "
+                   "against the intervals, and such a path refused; interval: the interval "
+                   "engine alone (a tangency stays unknown).")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")

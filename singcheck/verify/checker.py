@@ -1,0 +1,250 @@
+"""The checks of a certificate (docs/certificate.md): the robot and the path read again
+from their texts, every enclosure recomputed on every piece of the proof's cover, and
+the claim derived from what is proven.  Nothing of the proof is trusted but the cover's
+cut points, the signs to check and the witnesses of infeasibility, each re-checked.
+
+A prismatic leg F(ρ, X) = a ρ² + b ρ + c (a, b, c polynomials of the pose X) has the
+branches ρ± = (−b ± √D)/(2a), D = b² − 4ac (the label '+' or '-', in joint order, of a
+working mode); a linear leg (a ≡ 0) the one branch −c/b (label 'o').  On a piece T the
+pose is enclosed from the path's expressions, D's enclosure must be > 0 (real, distinct
+branches: the branch is continuous on T), a ≠ 0, and the branch's enclosure inside the
+closed joint limits; det A = det(∂F/∂X) along a mode is enclosed from the branches.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from itertools import product
+
+from singcheck.verify import numbers as nb
+from singcheck.verify.numbers import Iv, NotDecided
+from singcheck.verify.reader import (
+    Refused,
+    coefficient,
+    constant,
+    derivative,
+    mul,
+    parse_expr,
+    parse_yaml,
+    poly,
+)
+
+ROBOT_KEYS = {"name", "description", "joints", "pose", "parameters", "constraints",
+              "joint_limits", "drawing"}
+PATH_KEYS = {"name", "parameter", "range", "pose"}
+
+
+class NotRecheckable(Exception):
+    """A robot or path this checker cannot re-check (the reason says which)."""
+
+
+def _names(value, what: str) -> list[str]:
+    if not isinstance(value, list) or not value or not all(
+            isinstance(v, str) and v.isidentifier() for v in value):
+        raise Refused(f"{what}: expected a list of names")
+    if len(set(value)) != len(value):
+        raise Refused(f"{what}: a name given twice")
+    return value
+
+
+class Robot:
+    """Joints, pose, each leg's a, b, c, the Jacobian ∂F/∂X and the limits."""
+
+    def __init__(self, text: str) -> None:
+        spec = parse_yaml(text)
+        if not isinstance(spec, dict) or not {"name", "joints", "pose", "constraints"} <= \
+                set(spec) or set(spec) - ROBOT_KEYS:
+            raise Refused("a robot spec needs name, joints, pose, constraints (and no "
+                          "other key than " + ", ".join(sorted(ROBOT_KEYS)) + ")")
+        self.name = spec["name"]
+        self.joints = _names(spec["joints"], "joints")
+        self.pose = _names(spec["pose"], "pose")
+        self.params: dict[str, Fraction] = {}
+        for key, text_ in (spec.get("parameters") or {}).items():
+            try:
+                self.params[key] = constant(parse_expr(text_), self.params)
+            except Refused as e:
+                raise NotRecheckable(f"parameter {key} is not rational ({e})") from None
+        vs = tuple(self.joints + self.pose)
+        cons = spec["constraints"]
+        if not isinstance(cons, list) or len(cons) != len(self.joints):
+            raise Refused("constraints: one per joint")
+        self.legs: list = [None] * len(self.joints)
+        n = len(self.joints)
+        for text_ in cons:
+            try:
+                f = poly(parse_expr(text_), vs, self.params)
+            except Refused as e:
+                if "only polynomial" in str(e):
+                    raise NotRecheckable(str(e)) from None
+                raise
+            used = [k for k in range(n) if any(e[k] for e in f)]
+            if len(used) != 1 or self.legs[used[0]] is not None:
+                raise Refused("each constraint must involve exactly one joint, its own")
+            k = used[0]
+            degree = max(e[k] for e in f)
+            if degree not in (1, 2):
+                raise NotRecheckable(f"{self.joints[k]} appears with degree {degree}")
+            a, b, c = (coefficient(f, k, d) for d in (2, 1, 0))
+            disc = _sub(mul(b, b), mul({e: 4 * v for e, v in a.items()}, c))
+            self.legs[k] = (k, a, b, c, disc, [derivative(f, n + j) for j in range(n)])
+        self.limits: dict[int, tuple[Fraction, Fraction]] = {}
+        for key, pair in (spec.get("joint_limits") or {}).items():
+            if key not in self.joints or not isinstance(pair, list) or len(pair) != 2:
+                raise Refused(f"joint_limits: {key}")
+            try:
+                lo, hi = (constant(parse_expr(x), self.params) for x in pair)
+            except Refused as e:
+                raise NotRecheckable(f"joint_limits of {key}: {e}") from None
+            self.limits[self.joints.index(key)] = (lo, hi)
+        self.labels = ["+-" if leg[1] else "o" for leg in self.legs]
+        self.modes = ["".join(m) for m in product(*self.labels)]
+        self._vs = vs
+
+
+def _sub(p: dict, q: dict) -> dict:
+    out = dict(p)
+    for e, v in q.items():
+        out[e] = out.get(e, 0) - v
+    return {e: v for e, v in out.items() if v}
+
+
+def evaluate(p: dict, values: list[Iv]) -> Iv:
+    """An enclosure of the polynomial p over the box ``values`` (one per variable)."""
+    total = Iv(0, 0)
+    powers: dict = {}
+    for e, c in p.items():
+        term = Iv.q(c)
+        for k, d in enumerate(e):
+            if d:
+                if (k, d) not in powers:
+                    powers[k, d] = values[k] ** d
+                term = term * powers[k, d]
+        total = total + term
+    return total
+
+
+class Path:
+    """The path's parameter, range and pose expressions (trees, evaluated on intervals)."""
+
+    def __init__(self, text: str, robot: Robot) -> None:
+        spec = parse_yaml(text)
+        if not isinstance(spec, dict):
+            raise Refused("a trajectory spec must be a mapping")
+        if set(spec) - PATH_KEYS and set(spec) & {"segments", "waypoints", "interpolation"}:
+            raise NotRecheckable("paths of segments or waypoints are not re-checked yet")
+        if set(spec) != PATH_KEYS:
+            raise Refused("a trajectory spec needs exactly " + ", ".join(sorted(PATH_KEYS)))
+        self.name, self.param = spec["name"], spec["parameter"]
+        if not isinstance(self.param, str) or not self.param.isidentifier() or \
+                self.param in robot.joints + robot.pose + list(robot.params) + ["pi"]:
+            raise Refused("parameter: a new name")
+        rng, pose = spec["range"], spec["pose"]
+        if not isinstance(rng, list) or len(rng) != 2 or not isinstance(pose, dict) or \
+                set(pose) != set(robot.pose):
+            raise Refused("range: [start, end]; pose: every pose variable of the robot")
+        self.known = {**{k: Iv.q(v) for k, v in robot.params.items()}}
+        self.start, self.end = (self._eval(parse_expr(x), {}) for x in rng)
+        self.trees = [parse_expr(pose[v]) for v in robot.pose]
+        for tree in self.trees:  # every name in a pose is known: refuse the others now
+            self._eval(tree, {self.param: Iv(0, 0)}, check_only=True)
+        if not self.start.hi < self.end.lo:
+            raise Refused("range: start must be below end")
+
+    def _eval(self, tree, env: dict, check_only: bool = False) -> Iv:
+        op = tree[0]
+        if op == "num":
+            return Iv.q(tree[1])
+        if op == "pi":
+            return nb.PI
+        if op == "var":
+            if tree[1] in env:
+                return env[tree[1]]
+            if tree[1] in self.known:
+                return self.known[tree[1]]
+            raise Refused(f"unknown name {tree[1]!r}")
+        args = [self._eval(t, env, check_only) for t in tree[1:] if isinstance(t, tuple)]
+        if check_only:
+            return Iv(0, 0)
+        if op == "neg":
+            return -args[0]
+        if op == "^":
+            return args[0] ** tree[2]
+        if op in ("sin", "cos"):
+            return (nb.sin if op == "sin" else nb.cos)(args[0])
+        if op == "sqrt":
+            return args[0].sqrt()
+        a, b = args
+        return a + b if op == "+" else a - b if op == "-" else a * b if op == "*" else a / b
+
+    def pose_on(self, t: Iv) -> list[Iv]:
+        return [self._eval(tree, {self.param: t}) for tree in self.trees]
+
+
+def branches_on(robot: Robot, pose: list[Iv]) -> list[dict]:
+    """Per leg, label → (enclosure of the branch, proven real, separated and inside the
+    limits?) over the pose box; enclosure None when it could not be enclosed."""
+    box = [Iv(0, 0)] * len(robot.joints) + pose
+    out = []
+    for k, a, b, c, disc, _ in robot.legs:
+        lim = robot.limits.get(k)
+        found = {}
+        try:
+            av, bv = evaluate(a, box), evaluate(b, box)
+            if a:
+                d = evaluate(disc, box)
+                root = d.sqrt() if d.positive() else None
+                two_a = av * 2
+                values = {"+": None if root is None else (root - bv) / two_a,
+                          "-": None if root is None else (-root - bv) / two_a}
+                real = d.positive() and av.sign() != 0
+            else:
+                values = {"o": -evaluate(c, box) / bv}
+                real = bv.sign() != 0
+        except NotDecided:
+            values, real = {label: None for label in ("+-" if a else "o")}, False
+        for label, v in values.items():
+            inside = v is not None and real and (lim is None or (
+                Iv.q(lim[0]).hi <= v.lo and v.hi <= Iv.q(lim[1]).lo))
+            found[label] = (v, inside)
+        out.append(found)
+    return out
+
+
+def det(m: list[list[Iv]]) -> Iv:
+    if len(m) == 1:
+        return m[0][0]
+    total = Iv(0, 0)
+    for j, head in enumerate(m[0]):
+        minor = det([row[:j] + row[j + 1:] for row in m[1:]])
+        total = total + head * minor if j % 2 == 0 else total - head * minor
+    return total
+
+
+def piece_values(robot: Robot, path: Path, t: Iv, modes: list[str]):
+    """(branches per leg, {mode: det A enclosure or None}) over the piece t."""
+    pose = path.pose_on(t)
+    legs = branches_on(robot, pose)
+    dets = {}
+    for mode in modes:
+        js = [legs[k][ch][0] for k, ch in enumerate(mode)]
+        if any(j is None for j in js):
+            dets[mode] = None
+            continue
+        box = js + pose
+        dets[mode] = det([[evaluate(p, box) for p in leg[5]] for leg in robot.legs])
+    return legs, dets
+
+
+def outside(robot: Robot, path: Path, t: Fraction, mode: str, leg: int) -> bool:
+    """Proven: at time t the branch of ``leg`` in ``mode`` is not real, or is outside the
+    closed joint limits."""
+    k, a, b, c, disc, _ = robot.legs[leg]
+    pose = path.pose_on(Iv.q(t))
+    box = [Iv(0, 0)] * len(robot.joints) + pose
+    if a and evaluate(disc, box).negative():
+        return True
+    v = branches_on(robot, pose)[leg][mode[leg]][0]
+    lim = robot.limits.get(k)
+    return v is not None and lim is not None and (
+        v.hi < Iv.q(lim[0]).lo or v.lo > Iv.q(lim[1]).hi)

@@ -19,6 +19,7 @@ from itertools import product
 from singcheck.verify import numbers as nb
 from singcheck.verify.numbers import Iv, NotDecided
 from singcheck.verify.reader import (
+    NotRational,
     Refused,
     coefficient,
     constant,
@@ -63,7 +64,7 @@ class Robot:
         for key, text_ in (spec.get("parameters") or {}).items():
             try:
                 self.params[key] = constant(parse_expr(text_), self.params)
-            except Refused as e:
+            except NotRational as e:
                 raise NotRecheckable(f"parameter {key} is not rational ({e})") from None
         vs = tuple(self.joints + self.pose)
         cons = spec["constraints"]
@@ -74,10 +75,8 @@ class Robot:
         for text_ in cons:
             try:
                 f = poly(parse_expr(text_), vs, self.params)
-            except Refused as e:
-                if "only polynomial" in str(e):
-                    raise NotRecheckable(str(e)) from None
-                raise
+            except NotRational as e:
+                raise NotRecheckable(str(e)) from None
             used = [k for k in range(n) if any(e[k] for e in f)]
             if len(used) != 1 or self.legs[used[0]] is not None:
                 raise Refused("each constraint must involve exactly one joint, its own")
@@ -94,7 +93,7 @@ class Robot:
                 raise Refused(f"joint_limits: {key}")
             try:
                 lo, hi = (constant(parse_expr(x), self.params) for x in pair)
-            except Refused as e:
+            except NotRational as e:
                 raise NotRecheckable(f"joint_limits of {key}: {e}") from None
             self.limits[self.joints.index(key)] = (lo, hi)
         self.labels = ["+-" if leg[1] else "o" for leg in self.legs]

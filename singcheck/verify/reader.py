@@ -21,6 +21,11 @@ class Refused(ValueError):
     """Something odd in a spec: the checker reads no further."""
 
 
+class NotRational(Refused):
+    """A well-formed value that is not rational (π, a square root, sin): a robot the
+    checker cannot re-check, not an odd spec."""
+
+
 # --- YAML subset -------------------------------------------------------------------
 
 def _strip_comment(line: str) -> str:
@@ -263,7 +268,9 @@ def constant(tree, names: dict | None = None) -> Fraction:
     op = tree[0]
     if op == "num":
         return tree[1]
-    if op == "var" and tree[1] in names:
+    if op == "var":
+        if tree[1] not in names:
+            raise Refused(f"unknown name {tree[1]!r}")
         return names[tree[1]]
     if op == "neg":
         return -constant(tree[1], names)
@@ -274,7 +281,7 @@ def constant(tree, names: dict | None = None) -> Fraction:
         if op == "/" and b == 0:
             raise Refused("division by zero")
         return a + b if op == "+" else a - b if op == "-" else a * b if op == "*" else a / b
-    raise Refused(f"not a rational constant: {op}")
+    raise NotRational(f"not a rational constant: {op}")
 
 
 # --- polynomials: {exponents: Fraction} over a fixed tuple of variables -------------
@@ -309,7 +316,8 @@ def poly(tree, variables: tuple, names: dict) -> dict:
         for _ in range(tree[2]):
             out = mul(out, base)
         return out
-    raise Refused(f"{op} in a constraint: only polynomial (prismatic) robots are re-checked")
+    raise NotRational(f"{op} in a constraint: only polynomial (prismatic) robots are "
+                      "re-checked")
 
 
 def mul(p: dict, q: dict) -> dict:

@@ -1,0 +1,325 @@
+"""Certificates (docs/certificate.md): written by ``run --certificate``, re-checked by
+``singcheck.verify`` with flint, sympy and mpmath unimportable; tampering is caught; the
+claimed singular times are checked against det A computed independently (mpmath, 50
+digits, the Orthoglide's closed-form legs)."""
+
+from __future__ import annotations
+
+import ast
+import copy
+import json
+import subprocess
+import sys
+import time
+from fractions import Fraction
+
+import mpmath
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from singcheck.verify import check, main
+from singcheck.verify.numbers import ONE, Iv, cos, sin
+from tests.conftest import ROBOTS, ROOT, TRAJECTORIES
+from tests.test_cli import singcheck
+
+ORTHO = str(ROBOTS / "orthoglide.yaml")
+BLOCKER = """\
+import sys
+class _Blocker:
+    def find_spec(self, name, path=None, target=None):
+        if name.split('.')[0] in ('flint', 'sympy', 'mpmath', 'numpy'):
+            raise ImportError('blocked for the test: ' + name)
+sys.meta_path.insert(0, _Blocker())
+"""
+
+
+@pytest.fixture(scope="module")
+def certs(tmp_path_factory):
+    """Certificates of heart1 and the helix, written by the command line."""
+    folder = tmp_path_factory.mktemp("certs")
+    out = singcheck("run", ORTHO, str(TRAJECTORIES / "heart1.yaml"),
+                    str(TRAJECTORIES / "helix.yaml"), "--no-regions", "-q", "-j", "1",
+                    "--format", "json", "--certificate", str(folder))
+    assert out.returncode == 1, out.stderr  # heart1 is singular
+    return {name: json.loads((folder / f"{name}.cert.json").read_text())
+            for name in ("heart1", "helix")}
+
+
+def verify_subprocess(tmp_path, cert, blocked: bool = True) -> subprocess.CompletedProcess:
+    path = tmp_path / "c.cert.json"
+    path.write_text(json.dumps(cert) if isinstance(cert, dict) else cert)
+    site = tmp_path / "site"
+    site.mkdir(exist_ok=True)
+    (site / "sitecustomize.py").write_text(BLOCKER if blocked else "")
+    env = {"PYTHONPATH": f"{site}:{ROOT}", "PATH": "/usr/bin:/bin"}
+    return subprocess.run([sys.executable, "-m", "singcheck.verify", str(path)],
+                          capture_output=True, text=True, env=env, cwd=tmp_path, timeout=120)
+
+
+def failures(cert: dict) -> list[str]:
+    try:
+        return check(cert)[0]
+    except ValueError as e:  # malformed: exit 2
+        return [f"unreadable: {e}"]
+
+
+@pytest.mark.parametrize("name", ["heart1", "helix"])
+def test_verify_passes_with_the_cas_libraries_unimportable(certs, name, tmp_path):
+    size = len(json.dumps(certs[name]))
+    assert size < 1_000_000
+    start = time.perf_counter()
+    out = verify_subprocess(tmp_path, certs[name])
+    seconds = time.perf_counter() - start
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert f"proven: {name}: " in out.stdout
+    assert seconds < 2.0, seconds
+
+
+def test_the_blocker_blocks(tmp_path):
+    """The import blocker the tests rely on does stop flint and mpmath."""
+    site = tmp_path / "site"
+    site.mkdir()
+    (site / "sitecustomize.py").write_text(BLOCKER)
+    out = subprocess.run([sys.executable, "-c", "import mpmath"], capture_output=True,
+                         text=True, env={"PYTHONPATH": str(site)}, timeout=60)
+    assert out.returncode == 1 and "blocked for the test" in out.stderr
+
+
+def test_the_checker_imports_nothing_of_singcheck_but_itself(certs, tmp_path):
+    path = tmp_path / "h.cert.json"
+    path.write_text(json.dumps(certs["helix"]))
+    script = ("import sys; from singcheck.verify import main; rc = main([sys.argv[1]]); "
+              "print(sorted(m for m in sys.modules if m.startswith('singcheck')))")
+    out = subprocess.run([sys.executable, "-c", script, str(path)], capture_output=True,
+                         text=True, env={"PYTHONPATH": str(ROOT)}, timeout=60)
+    modules = ast.literal_eval(out.stdout.strip().splitlines()[-1])
+    assert "singcheck.verify" in modules
+    assert {m for m in modules if not m.startswith("singcheck.verify")} <= {
+        "singcheck", "singcheck.version"}
+
+
+def test_the_checker_is_short():
+    lines = sum(len(p.read_text().splitlines())
+                for p in (ROOT / "singcheck" / "verify").glob("*.py"))
+    assert lines <= 1000, lines
+
+
+# --- the claim against independent computations ------------------------------------
+
+def _orthoglide_det(t, mode="+++", x=None, y=None, z=None):
+    """det A of the Orthoglide (l = 2) along heart1 at time t, mpmath, from the legs'
+    closed form ρ_i = X_i ± sqrt(4 - (other coordinates)²)."""
+    x = 8 * mpmath.sin(t) ** 3 / 7 if x is None else x(t)
+    y = (13 * mpmath.cos(t) / 14 - 5 * mpmath.cos(2 * t) / 14 - mpmath.cos(3 * t) / 10
+         - mpmath.cos(4 * t) / 14) if y is None else y(t)
+    z = mpmath.mpf(1) if z is None else z(t)
+    s = [1 if ch == "+" else -1 for ch in mode]
+    r1 = x + s[0] * mpmath.sqrt(4 - y ** 2 - z ** 2)
+    r2 = y + s[1] * mpmath.sqrt(4 - x ** 2 - z ** 2)
+    r3 = z + s[2] * mpmath.sqrt(4 - x ** 2 - y ** 2)
+    return mpmath.det(mpmath.matrix([[x - r1, y, z], [x, y - r2, z], [x, y, z - r3]]))
+
+
+def test_heart1_singular_times_hold_a_root_of_det_a(certs):
+    mpmath.mp.dps = 50
+    spans = certs["heart1"]["claim"]["singular_times"]["+++"]
+    assert len(spans) == 2
+    for lo, hi in spans:
+        a, b = (mpmath.mpf(Fraction(v).numerator) / Fraction(v).denominator for v in (lo, hi))
+        assert b - a < 1e-8
+        assert _orthoglide_det(a) * _orthoglide_det(b) < 0
+    # the paper's two real singularities of the prototype's mode (+++), near 0.978, 1.512
+    assert [round(float(Fraction(lo)), 4) for lo, _ in spans] == [0.9778, 1.5119]
+
+
+def test_helix_det_a_keeps_its_sign(certs):
+    mpmath.mp.dps = 30
+    c = certs["helix"]
+    assert c["claim"]["verdict"] == "singularity-free"
+    values = [_orthoglide_det(mpmath.mpf(k) / 10, "+++", mpmath.sin, mpmath.cos,
+                              lambda t: t / 20) for k in range(201)]
+    assert all(v > 0 for v in values) or all(v < 0 for v in values)
+    sign = "+" if values[0] > 0 else "-"
+    assert set(c["proof"]["signs"]["+++"]) == {sign}
+
+
+@given(st.fractions(min_value=-30, max_value=30, max_denominator=10 ** 6),
+       st.fractions(min_value=0, max_value=1, max_denominator=1000))
+@settings(max_examples=200, deadline=None)
+def test_sin_cos_enclose_mpmath(x, w):
+    mpmath.mp.dps = 40
+    t = Iv.q(x).hull(Iv.q(x + w / 100))
+    for k in range(3):
+        p = mpmath.mpf(x.numerator) / x.denominator + mpmath.mpf(w.numerator) / w.denominator \
+            / 100 * k / 2
+        for f, g in ((sin, mpmath.sin), (cos, mpmath.cos)):
+            box = f(t)
+            assert mpmath.mpf(box.lo) / ONE <= g(p) <= mpmath.mpf(box.hi) / ONE
+
+
+# --- tampering ---------------------------------------------------------------------
+
+def tampered(cert: dict, where: str, old: str, new: str) -> dict:
+    out = copy.deepcopy(cert)
+    assert old in out["claim"][where]
+    out["claim"][where] = out["claim"][where].replace(old, new, 1)
+    return out
+
+
+@pytest.mark.parametrize("where, old, new", [
+    ("robot_spec", "parameters: {l: 2}", "parameters: {l: 201/100}"),
+    ("robot_spec", "rho1: [0, 4]", "rho1: [0, 2]"),
+    ("trajectory_spec", "x: 8/7*sin(t)^3", "x: 9/7*sin(t)^3"),
+    ("trajectory_spec", "5/14*cos(2*t)", "5/14*cos(2*t) + 1/1000"),
+    ("trajectory_spec", "range: [-pi, pi]", "range: [-pi, 3/2]"),  # drops t ≈ 1.5119
+    ("trajectory_spec", "range: [-pi, pi]", "range: [-pi, 4]"),
+    ("trajectory_spec", "range: [-pi, pi]", "range: [-pi, 1]"),
+])
+def test_tampered_heart1_specs_fail(certs, where, old, new):
+    assert failures(tampered(certs["heart1"], where, old, new))
+
+
+def test_a_claim_still_true_of_edited_specs_still_passes(certs):
+    """The checker judges the claim about the specs it holds, not their bytes: on
+    [-π, 3] heart1 is still singular at the same two times, and the cover still fits."""
+    assert failures(tampered(certs["heart1"], "trajectory_spec", "range: [-pi, pi]",
+                             "range: [-pi, 3]")) == []
+
+
+@pytest.mark.parametrize("where, old, new", [
+    ("trajectory_spec", "x: sin(t)", "x: 2*sin(t)"),
+    ("trajectory_spec", "range: [0, 20]", "range: [0, 21]"),
+    ("robot_spec", "parameters: {l: 2}", "parameters: {l: 1}"),  # legs not real
+    ("robot_spec", "rho3: [0, 4]", "rho3: [0, 1]"),  # rho3 = z + sqrt(3) > 1: infeasible
+])
+def test_tampered_helix_specs_fail(certs, where, old, new):
+    assert failures(tampered(certs["helix"], where, old, new))
+
+
+def test_tampered_claims_fail(certs):
+    for name, verdict in (("heart1", "singularity-free"), ("heart1", "infeasible"),
+                          ("helix", "singular")):
+        c = copy.deepcopy(certs[name])
+        c["claim"]["verdict"] = verdict
+        assert any("verdict" in f for f in failures(c)), (name, verdict)
+    c = copy.deepcopy(certs["heart1"])  # a singular time moved by 0.01
+    lo, hi = (Fraction(v) + Fraction(1, 100) for v in c["claim"]["singular_times"]["+++"][0])
+    c["claim"]["singular_times"]["+++"][0] = [str(lo), str(hi)]
+    assert failures(c)
+    c = copy.deepcopy(certs["heart1"])  # a singular time dropped
+    c["claim"]["singular_times"]["+++"].pop()
+    assert failures(c)
+    c = copy.deepcopy(certs["heart1"])  # an infeasible mode said feasible
+    c["claim"]["modes"]["-++"] = "feasible"
+    c["proof"]["signs"]["-++"] = c["proof"]["signs"]["+++"]
+    assert any("-++" in f for f in failures(c))
+    c = copy.deepcopy(certs["helix"])  # the feasible mode said infeasible: no witness
+    c["claim"]["modes"]["+++"] = "infeasible"
+    del c["proof"]["signs"]["+++"]
+    c["proof"]["infeasible"]["+++"] = {"t": "1", "leg": 0}
+    assert failures(c)
+    c = copy.deepcopy(certs["helix"])
+    c["claim"]["trajectory"] = "heart1"
+    assert failures(c)
+
+
+@given(st.data())
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                  HealthCheck.function_scoped_fixture])
+def test_mutated_proofs_never_pass_wrongly(certs, data):
+    """A flipped sign always fails; any other mutation of the proof either fails or
+    leaves the (true) claim proven — never a crash."""
+    name = data.draw(st.sampled_from(["heart1", "helix"]))
+    c = copy.deepcopy(certs[name])
+    proof = c["proof"]
+    kind = data.draw(st.sampled_from(["flip", "cut", "drop", "witness"]))
+    if kind == "flip":
+        s = proof["signs"]["+++"]
+        i = data.draw(st.sampled_from([k for k, ch in enumerate(s) if ch != "0"]))
+        proof["signs"]["+++"] = s[:i] + ("-" if s[i] == "+" else "+") + s[i + 1:]
+        assert failures(c)
+        return
+    if kind == "cut":
+        i = data.draw(st.integers(0, len(proof["cuts"]) - 1))
+        proof["cuts"][i] = str(data.draw(st.fractions(-25, 25, max_denominator=2 ** 20)))
+    elif kind == "drop":
+        i = data.draw(st.integers(0, len(proof["cuts"]) - 1))
+        del proof["cuts"][i]
+        proof["signs"] = {m: s[:i] + s[i + 1:] for m, s in proof["signs"].items()}
+    else:
+        mode = data.draw(st.sampled_from(sorted(proof["infeasible"])))
+        proof["infeasible"][mode] = {"t": str(data.draw(st.fractions(-25, 25))),
+                                     "leg": data.draw(st.integers(-1, 3))}
+    fails = failures(c)
+    assert all(not f.startswith("unreadable") for f in fails)
+
+
+# --- unreadable files and odd specs ------------------------------------------------
+
+@pytest.mark.parametrize("text", ["not json", "[]", '{"format": "singcheck-certificate"}',
+                                  '{"format": "other", "version": 1}'])
+def test_unreadable_files_exit_2(tmp_path, text):
+    out = verify_subprocess(tmp_path, text)
+    assert out.returncode == 2 and out.stdout.count("\n") == 1 and "unreadable" in out.stdout
+
+
+@pytest.mark.parametrize("old, new", [
+    ("parameters: {l: 2}", "parameters: {l: __import__('os').getpid()}"),
+    ("parameters: {l: 2}", "parameters: !!python/object:os.system {l: 2}"),
+    ("parameters: {l: 2}", "parameters: &a {l: 2}"),
+    ("parameters: {l: 2}", "parameters: {l: 2x}"),
+    ("parameters: {l: 2}", "parameters: {l: 2^100000}"),
+    ("parameters: {l: 2}", "parameters:\t{l: 2}"),
+    ("name: orthoglide", "name: orthoglide\nname: again"),
+])
+def test_odd_specs_are_refused_in_one_line(certs, tmp_path, old, new):
+    out = verify_subprocess(tmp_path, tampered(certs["heart1"], "robot_spec", old, new))
+    assert out.returncode == 2, out.stdout
+    assert out.stdout.count("\n") == 1 and "Traceback" not in out.stderr
+
+
+def test_revolute_robots_are_not_recheckable(tmp_path):
+    from singcheck.certify.certificate import build_certificate
+
+    robot = (ROBOTS / "five-bar.yaml").read_text()
+    path = (TRAJECTORIES / "five-bar-free.yaml").read_text()
+    cert = build_certificate(robot, path, {"name": "five-bar-free",
+                                           "verdict": "singularity-free",
+                                           "working_modes": [], "candidates": []})
+    assert cert["proof"] is None and "not_recheckable" in cert
+    out = verify_subprocess(tmp_path, cert)
+    assert out.returncode == 1 and "not re-checkable" in out.stdout
+    cert["proof"] = {"cuts": [], "signs": {}, "infeasible": {}}  # a forged proof
+    assert failures(cert)
+
+
+def test_certificate_file_names_are_safe(tmp_path):
+    from singcheck.certify.certificate import write_certificate
+
+    used: set = set()
+    for name in ["../../evil", "a/b", "x\x00y", "..", "heart1", "heart1"]:
+        target = write_certificate(tmp_path, {"claim": {"trajectory": name}}, used)
+        assert target.parent == tmp_path and ".." not in target.name
+        assert target.name.endswith(".cert.json") and not target.name.startswith(".")
+    assert len(list(tmp_path.iterdir())) == 6
+
+
+def test_certificates_validate_against_their_schema(certs):
+    jsonschema = pytest.importorskip("jsonschema")
+    schema = json.loads((ROOT / "singcheck" / "schemas" / "certificate.schema.json").read_text())
+    jsonschema.Draft202012Validator.check_schema(schema)
+    v = jsonschema.Draft202012Validator(schema)
+    for cert in certs.values():
+        assert [e.message for e in v.iter_errors(cert)] == []
+    bad = copy.deepcopy(certs["helix"])
+    bad["proof"]["cuts"][0] = "0.5"
+    assert list(v.iter_errors(bad))
+
+
+def test_the_verify_command_and_module_agree(certs, tmp_path):
+    path = tmp_path / "h.cert.json"
+    path.write_text(json.dumps(certs["helix"]))
+    out = singcheck("verify", str(path))
+    assert out.returncode == 0 and "proven: helix: singularity-free" in out.stdout
+    assert main([str(path), str(tmp_path / "missing.json")]) == 2

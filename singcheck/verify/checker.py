@@ -16,8 +16,7 @@ from __future__ import annotations
 from fractions import Fraction
 from itertools import product
 
-from singcheck.verify import numbers as nb
-from singcheck.verify.numbers import Iv, NotDecided
+from singcheck.verify.numbers import PI, Iv, NotDecided, cos, sin
 from singcheck.verify.reader import (
     NotRational,
     Refused,
@@ -155,7 +154,7 @@ class Path:
         if op == "num":
             return Iv.q(tree[1])
         if op == "pi":
-            return nb.PI
+            return PI
         if op == "var":
             if tree[1] in env:
                 return env[tree[1]]
@@ -170,7 +169,7 @@ class Path:
         if op == "^":
             return args[0] ** tree[2]
         if op in ("sin", "cos"):
-            return (nb.sin if op == "sin" else nb.cos)(args[0])
+            return (sin if op == "sin" else cos)(args[0])
         if op == "sqrt":
             return args[0].sqrt()
         a, b = args

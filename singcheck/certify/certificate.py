@@ -24,7 +24,7 @@ import re
 from fractions import Fraction
 from pathlib import Path
 
-from singcheck.verify.checker import NotRecheckable, Robot, outside, piece_values
+from singcheck.verify.checker import NotRecheckable, Robot, outside, piece_values, singular_at
 from singcheck.verify.checker import Path as PathSpec
 from singcheck.verify.numbers import ONE, Iv, NotDecided
 from singcheck.verify.reader import Refused
@@ -137,6 +137,39 @@ class _Prover:
             self.signs[m].append(out[m].replace("?", "0"))
 
 
+def simplest_between(a: Fraction, b: Fraction) -> Fraction:
+    """The rational of smallest denominator in [a, b] (a ≤ b).
+
+    >>> simplest_between(Fraction(-1, 10**12), Fraction(1, 10**12))
+    Fraction(0, 1)
+    >>> simplest_between(Fraction(3, 10), Fraction(4, 10))
+    Fraction(1, 3)
+    """
+    if a <= 0 <= b:
+        return Fraction(0)
+    if b < 0:
+        return -simplest_between(-b, -a)
+    whole = a.numerator // a.denominator
+    if whole == a or whole + 1 <= b:
+        return a if whole == a else Fraction(whole + 1)
+    return whole + 1 / simplest_between(1 / (b - whole), 1 / (a - whole))
+
+
+def _exact_roots(robot: Robot, path: PathSpec, spans: dict) -> dict[str, list[str]]:
+    """Per mode, the simplest rational of each singular time where det A = 0 exactly
+    (a root the checker proves without a sign change: a tangency at t = 0, say)."""
+    out: dict[str, list[str]] = {}
+    for m, found in spans.items():
+        for a, b in found:
+            t = simplest_between(a, b)
+            try:
+                if singular_at(robot, path, t, m):
+                    out.setdefault(m, []).append(_text(t))
+            except NotDecided:
+                pass
+    return out
+
+
 def _witness(robot: Robot, path: PathSpec, mode: str, times: list[Fraction]) -> dict | None:
     for t in times:
         for leg in range(len(robot.joints)):
@@ -181,6 +214,7 @@ def build_certificate(robot_text: str, trajectory_text: str, result: dict) -> di
     cert["proof"] = {
         "cuts": [_text(c) for c in prover.cuts],
         "signs": {m: "".join(s) for m, s in prover.signs.items()},
+        "exact_roots": _exact_roots(robot, path, spans),
         "infeasible": {m: _witness(robot, path, m, samples[:: max(1, len(samples) // 200)])
                        for m in robot.modes if modes.get(m) == "infeasible"},
     }

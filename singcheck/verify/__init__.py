@@ -23,7 +23,7 @@ import json
 import sys
 from fractions import Fraction
 
-from singcheck.verify.checker import NotRecheckable, Path, Robot, outside, piece_values
+from singcheck.verify.checker import NotRecheckable, Path, Robot, outside, piece_values, singular_at
 from singcheck.verify.numbers import Iv, NotDecided
 from singcheck.verify.reader import Refused
 
@@ -123,7 +123,9 @@ def check(cert: dict) -> tuple[list[str], str]:
             ok = False
         if not ok:
             fails.append(f"working mode {m}: not proven infeasible (no valid witness)")
-    fails += _singular_times(claim, feasible, signs, cuts, n)
+    exact = _get(proof, "exact_roots", dict) if "exact_roots" in proof else {}
+    fails += _singular_times(claim, feasible, signs, cuts, n, lambda m, a, b: any(
+        a <= _q(t) <= b and _singular_at(robot, path, _q(t), m) for t in exact.get(m, [])))
     derived = "infeasible" if not feasible else "singular" if any(
         claim.get("singular_times", {}).get(m) for m in feasible) else "singularity-free"
     if verdict != derived:
@@ -133,7 +135,17 @@ def check(cert: dict) -> tuple[list[str], str]:
     return fails, f"{path.name}: {derived} ({n} pieces, {len(feasible)} feasible mode(s))"
 
 
-def _singular_times(claim: dict, feasible: list[str], signs: dict, cuts: list, n: int):
+def _singular_at(robot, path, t: Fraction, mode: str) -> bool:
+    try:
+        return singular_at(robot, path, t, mode)
+    except NotDecided:
+        return False
+
+
+def _singular_times(claim: dict, feasible: list[str], signs: dict, cuts: list, n: int,
+                    root_in) -> list[str]:
+    """The runs of '0' pieces inside the claimed singular times, each of which holds a
+    sign change or an exact root (``root_in(mode, a, b)``)."""
     fails = []
     times = claim.get("singular_times", {})
     if not isinstance(times, dict) or set(times) - set(feasible):
@@ -163,9 +175,10 @@ def _singular_times(claim: dict, feasible: list[str], signs: dict, cuts: list, n
                 crossing[k] = True
             i = j + 1
         for (a, b), ok in zip(spans, crossing, strict=False):
-            if not ok:
-                fails.append(f"not re-checked: working mode {m} singular in t ∈ [{float(a):.12g}, "
-                             f"{float(b):.12g}] (no sign change of det A proven there)")
+            if not ok and not root_in(m, a, b):
+                fails.append(f"not re-checked: working mode {m} singular in t ∈ "
+                             f"[{float(a):.12g}, {float(b):.12g}] (neither a sign change of "
+                             "det A nor an exact rational root proven there)")
     return fails
 
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from fractions import Fraction
 from itertools import product
+from math import isqrt
 
 from singcheck.verify.numbers import PI, Iv, NotDecided, cos, sin
 from singcheck.verify.reader import (
@@ -141,42 +142,69 @@ class Path:
         if not isinstance(rng, list) or len(rng) != 2 or not isinstance(pose, dict) or \
                 set(pose) != set(robot.pose):
             raise Refused("range: [start, end]; pose: every pose variable of the robot")
-        self.known = {**{k: Iv.q(v) for k, v in robot.params.items()}}
-        self.start, self.end = (self._eval(parse_expr(x), {}) for x in rng)
+        self.known = {**robot.params}
+        self.start, self.end = (value(parse_expr(x), self.known, INTERVAL) for x in rng)
         self.trees = [parse_expr(pose[v]) for v in robot.pose]
-        for tree in self.trees:  # every name in a pose is known: refuse the others now
-            self._eval(tree, {self.param: Iv(0, 0)}, check_only=True)
+        if any(_unknown(tree, {*self.known, self.param}) for tree in self.trees):
+            raise Refused("pose: an unknown name")
         if not self.start.hi < self.end.lo:
             raise Refused("range: start must be below end")
 
-    def _eval(self, tree, env: dict, check_only: bool = False) -> Iv:
-        op = tree[0]
-        if op == "num":
-            return Iv.q(tree[1])
-        if op == "pi":
-            return PI
-        if op == "var":
-            if tree[1] in env:
-                return env[tree[1]]
-            if tree[1] in self.known:
-                return self.known[tree[1]]
-            raise Refused(f"unknown name {tree[1]!r}")
-        args = [self._eval(t, env, check_only) for t in tree[1:] if isinstance(t, tuple)]
-        if check_only:
-            return Iv(0, 0)
-        if op == "neg":
-            return -args[0]
-        if op == "^":
-            return args[0] ** tree[2]
-        if op in ("sin", "cos"):
-            return (sin if op == "sin" else cos)(args[0])
-        if op == "sqrt":
-            return args[0].sqrt()
-        a, b = args
-        return a + b if op == "+" else a - b if op == "-" else a * b if op == "*" else a / b
-
     def pose_on(self, t: Iv) -> list[Iv]:
-        return [self._eval(tree, {self.param: t}) for tree in self.trees]
+        return [value(tree, {**self.known, self.param: t}, INTERVAL) for tree in self.trees]
+
+
+def _unknown(tree, names: set) -> bool:
+    if tree[0] == "var":
+        return tree[1] not in names
+    return any(_unknown(s, names) for s in tree[1:] if isinstance(s, tuple))
+
+
+def value(tree, env: dict, leaf: dict):
+    """The value of an expression tree in an arithmetic: ``leaf`` says what numbers, π,
+    sin, cos and sqrt are in it (:data:`INTERVAL`, :data:`EXACT`); + - * / ^ are its
+    operators; ``env`` gives the names."""
+    op = tree[0]
+    if op in ("num", "pi"):
+        return leaf[op](*tree[1:])
+    if op == "var":
+        if tree[1] not in env:
+            raise Refused(f"unknown name {tree[1]!r}")
+        x = env[tree[1]]
+        return leaf["num"](x) if isinstance(x, Fraction) else x
+    v = [value(s, env, leaf) for s in tree[1:] if isinstance(s, tuple)]
+    if op in ("sin", "cos", "sqrt"):
+        return leaf[op](v[0])
+    if op == "neg":
+        return -v[0]
+    if op == "^":
+        return v[0] ** tree[2]
+    a, b = v
+    if op == "/" and not isinstance(b, Iv) and b == 0:
+        raise NotDecided("division by zero")
+    return a + b if op == "+" else a - b if op == "-" else a * b if op == "*" else a / b
+
+
+def _exact_root(x: Fraction) -> Fraction:
+    r = [isqrt(max(n, 0)) for n in (x.numerator, x.denominator)]
+    if Fraction(r[0] ** 2, r[1] ** 2) != x:
+        raise NotDecided("an irrational square root at an exact time")
+    return Fraction(r[0], r[1])
+
+
+def _exact_trig(x: Fraction, at_zero: int) -> Fraction:
+    if x != 0:
+        raise NotDecided("sin or cos of a non-zero rational")
+    return Fraction(at_zero)
+
+
+def _no_pi():
+    raise NotDecided("π at an exact time")
+
+
+INTERVAL = {"num": Iv.q, "pi": lambda: PI, "sin": sin, "cos": cos, "sqrt": Iv.sqrt}
+EXACT = {"num": Fraction, "pi": _no_pi, "sqrt": _exact_root,
+         "sin": lambda x: _exact_trig(x, 0), "cos": lambda x: _exact_trig(x, 1)}
 
 
 def branches_on(robot: Robot, pose: list[Iv]) -> list[dict]:
@@ -209,13 +237,14 @@ def branches_on(robot: Robot, pose: list[Iv]) -> list[dict]:
     return out
 
 
-def det(m: list[list[Iv]]) -> Iv:
+def det(m: list, mul=lambda a, b: a * b, add=lambda a, b, sign: a + b if sign > 0 else a - b):
+    """Cofactor expansion along the first row (a robot has a few legs)."""
     if len(m) == 1:
         return m[0][0]
-    total = Iv(0, 0)
+    total = None
     for j, head in enumerate(m[0]):
-        minor = det([row[:j] + row[j + 1:] for row in m[1:]])
-        total = total + head * minor if j % 2 == 0 else total - head * minor
+        term = mul(head, det([row[:j] + row[j + 1:] for row in m[1:]], mul, add))
+        total = term if total is None else add(total, term, -1 if j % 2 else 1)
     return total
 
 
@@ -246,3 +275,54 @@ def outside(robot: Robot, path: Path, t: Fraction, mode: str, leg: int) -> bool:
     lim = robot.limits.get(k)
     return v is not None and lim is not None and (
         v.hi < Iv.q(lim[0]).lo or v.lo > Iv.q(lim[1]).hi)
+
+
+# Numbers of Q(√d₀, …, √dₙ₋₁) as {mask: q}: Σ q·Π_{i in mask} √dᵢ.  A number whose
+# coefficients all vanish is 0 (whatever relations the √dᵢ have): all that is needed.
+def _mq_mul(x: dict, y: dict, ds: list) -> dict:
+    out: dict = {}
+    for m1, c1 in x.items():
+        for m2, c2 in y.items():
+            c = c1 * c2
+            for i, d in enumerate(ds):
+                if m1 >> i & m2 >> i & 1:
+                    c *= d
+            out[m1 ^ m2] = out.get(m1 ^ m2, 0) + c
+    return {m: c for m, c in out.items() if c}
+
+
+def _mq_add(x: dict, y: dict, sign: int = 1) -> dict:
+    out = dict(x)
+    for m, c in y.items():
+        out[m] = out.get(m, 0) + sign * c
+    return {m: c for m, c in out.items() if c}
+
+
+def _mq_poly(p: dict, values: list, ds: list) -> dict:
+    total: dict = {}
+    for e, c in p.items():
+        term = {0: c}
+        for k, d in enumerate(e):
+            for _ in range(d):
+                term = _mq_mul(term, values[k], ds)
+        total = _mq_add(total, term)
+    return total
+
+
+def singular_at(robot: Robot, path: Path, t: Fraction, mode: str) -> bool:
+    """Proven: at the rational time t the mode's branches are real and distinct and
+    det A = 0 exactly (the branches in Q(√D₀, …), D the legs' discriminants there)."""
+    pose = [value(tree, {**path.known, path.param: t}, EXACT) for tree in path.trees]
+    point = [Fraction(0)] * len(robot.joints) + pose
+    ds, joints = [], []
+    for k, a, b, c, disc, _ in robot.legs:
+        av, bv, cv, d = (_mq_poly(p, [{0: x} for x in point], []).get(0, Fraction(0))
+                         for p in (a, b, c, disc))
+        if (a and (d <= 0 or av == 0)) or (not a and bv == 0):
+            return False
+        ds.append(d if a else Fraction(1))
+        s = 1 if mode[k] == "+" else -1
+        joints.append({0: -bv / (2 * av), 1 << k: s / (2 * av)} if a else {0: -cv / bv})
+    values = joints + [({0: x} if x else {}) for x in pose]
+    return not det([[_mq_poly(p, values, ds) for p in leg[5]] for leg in robot.legs],
+                   lambda x, y: _mq_mul(x, y, ds), _mq_add)

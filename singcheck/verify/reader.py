@@ -97,57 +97,46 @@ def _depth(text: str) -> int:
     return sum((ch in "[{") - (ch in "]}") for ch in text)
 
 
+_FLOW = re.compile(r"[\[\]{},]|[^\[\]{},]+")
+
+
 def _flow_value(text: str, line: int, depth: int):
+    """A plain scalar, or a flow collection (``[a, [b]]``, ``{k: v}``) of them."""
     if text[0] not in "[{":
-        if text[0] in "&*!|>\"'%@`":
-            raise Refused(f"line {line}: YAML feature not accepted here: {text[:20]!r}")
-        return text
-    value, j = _flow(text, 0, line, depth)
-    if text[j:].strip():
+        return _flow([text], 0, line, depth)[0]  # (commas and all)
+    toks = [t for t in _FLOW.findall(text) if t.strip()]
+    value, j = _flow(toks, 0, line, depth)
+    if j != len(toks):
         raise Refused(f"line {line}: text after a flow collection")
     return value
 
 
-def _flow(s: str, j: int, line: int, depth: int):
+def _flow(toks: list[str], j: int, line: int, depth: int):
     if depth > MAX_DEPTH:
         raise Refused("nesting too deep")
-    close = "]" if s[j] == "[" else "}"
-    out: list | dict = [] if close == "]" else {}
+    tok = toks[j].strip() if j < len(toks) else ""
+    if tok not in ("[", "{"):
+        if not tok or tok[0] in "&*!|>\"'%@`:,]}":
+            raise Refused(f"line {line}: an empty or unaccepted item {tok[:20]!r}")
+        return tok, j + 1
+    close, out = ("]", []) if tok == "[" else ("}", {})
     j += 1
-    while True:
-        while j < len(s) and s[j] == " ":
-            j += 1
-        if j < len(s) and s[j] == close and not out:
-            return out, j + 1
-        key = None
-        if close == "}":
-            m = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*)\s*:\s").match(s, j)
-            if not m:
-                raise Refused(f"line {line}: expected 'key: value' in a flow mapping")
-            key, j = m.group(1), m.end()
-            if key in out:
-                raise Refused(f"line {line}: key {key} given twice")
-            while s[j] == " ":
-                j += 1
-        if j < len(s) and s[j] in "[{":
-            value, j = _flow(s, j, line, depth + 1)
-        else:
-            m = re.compile(r"[^,\[\]{}]*").match(s, j)
-            value, j = m.group(0).strip(), m.end()
-            if not value or value[0] in "&*!|>\"'%@`":
-                raise Refused(f"line {line}: an empty or unaccepted flow item")
-        if close == "}":
-            out[key] = value
-        else:
-            out.append(value)
-        while j < len(s) and s[j] == " ":
-            j += 1
-        if j < len(s) and s[j] == ",":
-            j += 1
-        elif j < len(s) and s[j] == close:
-            return out, j + 1
-        else:
-            raise Refused(f"line {line}: unclosed flow collection")
+    while j >= len(toks) or toks[j].strip() != close:
+        if j >= len(toks) or (len(out) and toks[j].strip() != ","):
+            raise Refused(f"line {line}: an unclosed flow collection")
+        j += len(out) > 0
+        if close == "]":
+            item, j = _flow(toks, j, line, depth + 1)
+            out.append(item)
+            continue
+        key, sep, rest = toks[j].partition(":") if j < len(toks) else ("", "", "")
+        key = key.strip()
+        if not sep or not key.isidentifier() or key in out or rest[:1] not in " ":
+            raise Refused(f"line {line}: expected 'key: value' (once each) in a flow mapping")
+        toks[j] = rest
+        j += not rest.strip()
+        out[key], j = _flow(toks, j, line, depth + 1)
+    return out, j + 1
 
 
 # --- expressions -------------------------------------------------------------------

@@ -12,7 +12,7 @@ The claim is singcheck's verdict (both engines, :mod:`.engines`); the cover is f
 branch-and-bound in the checker's own rational interval arithmetic, starting from a
 uniform grid and the claimed singular times, so that every piece it emits is one the
 checker can decide.  A claim it cannot support (a tangency, a mode singular along a
-stretch, a revolute robot, a path of segments) is written with ``proof: null`` and the
+stretch, a pose angle, a path of segments) is written with ``proof: null`` and the
 reason in ``not_recheckable``: the checker then fails it, never passes it.
 """
 

@@ -66,39 +66,72 @@ class Robot:
                 self.params[key] = constant(parse_expr(text_), self.params)
             except NotRational as e:
                 raise NotRecheckable(f"parameter {key} is not rational ({e})") from None
-        vs = tuple(self.joints + self.pose)
+        n = len(self.joints)  # the box: (ρ, cos θ, sin θ) per joint, then the pose
+        vs = tuple(x for j in self.joints for x in (j, f"cos({j})", f"sin({j})")) + \
+            tuple(self.pose)
         cons = spec["constraints"]
-        if not isinstance(cons, list) or len(cons) != len(self.joints):
+        if not isinstance(cons, list) or len(cons) != n:
             raise Refused("constraints: one per joint")
-        self.legs: list = [None] * len(self.joints)
-        n = len(self.joints)
+        self.legs: list = [None] * n
         for text_ in cons:
             try:
                 f = poly(parse_expr(text_), vs, self.params)
             except NotRational as e:
                 raise NotRecheckable(str(e)) from None
-            used = [k for k in range(n) if any(e[k] for e in f)]
+            used = [k for k in range(n) if any(e[3 * k] + e[3 * k + 1] + e[3 * k + 2]
+                                               for e in f)]
             if len(used) != 1 or self.legs[used[0]] is not None:
                 raise Refused("each constraint must involve exactly one joint, its own")
             k = used[0]
-            degree = max(e[k] for e in f)
+            jac = [3 * n + j for j in range(n)]
+            if any(e[3 * k + 1] + e[3 * k + 2] for e in f):  # revolute: a c + b s + d
+                if any(e[3 * k] for e in f):
+                    raise NotRecheckable(f"{self.joints[k]} is both a length and an angle")
+                f = _on_circle(f, 3 * k + 1, 3 * k + 2)
+                if any(e[3 * k + 1] + e[3 * k + 2] > 1 for e in f):
+                    raise NotRecheckable(f"leg {self.joints[k]} is not a·cos + b·sin + d")
+                a, b = coefficient(f, 3 * k + 1, 1), coefficient(f, 3 * k + 2, 1)
+                d = coefficient(coefficient(f, 3 * k + 1, 0), 3 * k + 2, 0)
+                disc = _sub(_sub(mul(a, a), {e: -v for e, v in mul(b, b).items()}), mul(d, d))
+                self.legs[k] = (k, a, b, d, disc, [derivative(f, i) for i in jac], "r")
+                continue
+            degree = max(e[3 * k] for e in f)
             if degree not in (1, 2):
                 raise NotRecheckable(f"{self.joints[k]} appears with degree {degree}")
-            a, b, c = (coefficient(f, k, d) for d in (2, 1, 0))
+            a, b, c = (coefficient(f, 3 * k, d) for d in (2, 1, 0))
             disc = _sub(mul(b, b), mul({e: 4 * v for e, v in a.items()}, c))
-            self.legs[k] = (k, a, b, c, disc, [derivative(f, n + j) for j in range(n)])
-        self.limits: dict[int, tuple[Fraction, Fraction]] = {}
+            self.legs[k] = (k, a, b, c, disc, [derivative(f, i) for i in jac], "p")
+        self.limits: dict[int, tuple] = {}
         for key, pair in (spec.get("joint_limits") or {}).items():
             if key not in self.joints or not isinstance(pair, list) or len(pair) != 2:
                 raise Refused(f"joint_limits: {key}")
+            k = self.joints.index(key)
+            if self.legs[k][6] == "r":  # θ inside [lo, hi] ⟺ cos(θ − m) ≥ cos(w/2)
+                lo, hi = (value(parse_expr(x), self.params, INTERVAL) for x in pair)
+                if (hi - lo).lo < (PI * 2).hi:  # (width 2π or more: no limit)
+                    m, half = (lo + hi) / 2, (hi - lo) / 2
+                    self.limits[k] = (cos(m), sin(m), cos(half))
+                continue
             try:
-                lo, hi = (constant(parse_expr(x), self.params) for x in pair)
+                self.limits[k] = tuple(constant(parse_expr(x), self.params) for x in pair)
             except NotRational as e:
                 raise NotRecheckable(f"joint_limits of {key}: {e}") from None
-            self.limits[self.joints.index(key)] = (lo, hi)
-        self.labels = ["+-" if leg[1] else "o" for leg in self.legs]
+        self.labels = ["+-" if leg[1] or leg[6] == "r" else "o" for leg in self.legs]
         self.modes = ["".join(m) for m in product(*self.labels)]
-        self._vs = vs
+
+
+def _on_circle(f: dict, ci: int, si: int) -> dict:
+    """f reduced modulo cos² + sin² = 1 (sin² → 1 − cos²)."""
+    out: dict = {}
+    todo = list(f.items())
+    while todo:
+        e, v = todo.pop()
+        if e[si] < 2:
+            out[e] = out.get(e, 0) + v
+            continue
+        e = e[:si] + (e[si] - 2,) + e[si + 1:]
+        todo += [(e, v), (e[:ci] + (e[ci] + 2,) + e[ci + 1:], -v)]
+    return {e: v for e, v in out.items() if v}
 
 
 def _sub(p: dict, q: dict) -> dict:
@@ -207,33 +240,56 @@ EXACT = {"num": Fraction, "pi": _no_pi, "sqrt": _exact_root,
          "sin": lambda x: _exact_trig(x, 0), "cos": lambda x: _exact_trig(x, 1)}
 
 
+def _inside(lim, v) -> bool:
+    if lim is None:
+        return True
+    if isinstance(v, tuple):  # an angle's (cos, sin)
+        return (v[0] * lim[0] + v[1] * lim[1] - lim[2]).lo >= 0
+    return Iv.q(lim[0]).hi <= v.lo and v.hi <= Iv.q(lim[1]).lo
+
+
+def _outside(lim, v) -> bool:
+    if lim is None or v is None:
+        return False
+    if isinstance(v, tuple):
+        return (v[0] * lim[0] + v[1] * lim[1] - lim[2]).negative()
+    return v.hi < Iv.q(lim[0]).lo or v.lo > Iv.q(lim[1]).hi
+
+
+def _box(robot: Robot, pose: list) -> list:
+    return [Iv(0, 0)] * (3 * len(robot.joints)) + pose
+
+
 def branches_on(robot: Robot, pose: list[Iv]) -> list[dict]:
     """Per leg, label → (enclosure of the branch, proven real, separated and inside the
-    limits?) over the pose box; enclosure None when it could not be enclosed."""
-    box = [Iv(0, 0)] * len(robot.joints) + pose
+    limits?) over the pose box; enclosure None when it could not be enclosed.  A
+    revolute leg's branch is the pair (cos θ, sin θ) = ((−ad + σb√Δ)/w, (−bd − σa√Δ)/w),
+    w = a² + b², Δ = w − d², σ = +1 for '+'."""
+    box = _box(robot, pose)
     out = []
-    for k, a, b, c, disc, _ in robot.legs:
-        lim = robot.limits.get(k)
-        found = {}
+    for k, a, b, c, disc, _, kind in robot.legs:
+        labels = "+-" if a or kind == "r" else "o"
         try:
             av, bv = evaluate(a, box), evaluate(b, box)
-            if a:
-                d = evaluate(disc, box)
-                root = d.sqrt() if d.positive() else None
-                two_a = av * 2
-                values = {"+": None if root is None else (root - bv) / two_a,
-                          "-": None if root is None else (-root - bv) / two_a}
-                real = d.positive() and av.sign() != 0
+            d = evaluate(disc, box) if labels == "+-" else None
+            root = d.sqrt() if d is not None and d.positive() else None
+            if kind == "r":
+                cv, w = evaluate(c, box), av ** 2 + bv ** 2
+                values = {lab: None if root is None else ((-av * cv + sg * bv * root) / w,
+                                                          (-bv * cv - sg * av * root) / w)
+                          for lab, sg in (("+", 1), ("-", -1))}
+                real = root is not None
+            elif a:
+                values = {lab: None if root is None else (sg * root - bv) / (av * 2)
+                          for lab, sg in (("+", 1), ("-", -1))}
+                real = root is not None and av.sign() != 0
             else:
                 values = {"o": -evaluate(c, box) / bv}
                 real = bv.sign() != 0
         except NotDecided:
-            values, real = {label: None for label in ("+-" if a else "o")}, False
-        for label, v in values.items():
-            inside = v is not None and real and (lim is None or (
-                Iv.q(lim[0]).hi <= v.lo and v.hi <= Iv.q(lim[1]).lo))
-            found[label] = (v, inside)
-        out.append(found)
+            values, real = {label: None for label in labels}, False
+        out.append({label: (v, v is not None and real and _inside(robot.limits.get(k), v))
+                    for label, v in values.items()})
     return out
 
 
@@ -254,27 +310,30 @@ def piece_values(robot: Robot, path: Path, t: Iv, modes: list[str]):
     legs = branches_on(robot, pose)
     dets = {}
     for mode in modes:
-        js = [legs[k][ch][0] for k, ch in enumerate(mode)]
-        if any(j is None for j in js):
-            dets[mode] = None
+        box = _box(robot, pose)
+        for k, ch in enumerate(mode):
+            v = legs[k][ch][0]
+            if v is None:
+                break
+            if isinstance(v, tuple):
+                box[3 * k + 1], box[3 * k + 2] = v
+            else:
+                box[3 * k] = v
+        else:
+            dets[mode] = det([[evaluate(p, box) for p in leg[5]] for leg in robot.legs])
             continue
-        box = js + pose
-        dets[mode] = det([[evaluate(p, box) for p in leg[5]] for leg in robot.legs])
+        dets[mode] = None
     return legs, dets
 
 
 def outside(robot: Robot, path: Path, t: Fraction, mode: str, leg: int) -> bool:
     """Proven: at time t the branch of ``leg`` in ``mode`` is not real, or is outside the
     closed joint limits."""
-    k, a, b, c, disc, _ = robot.legs[leg]
+    k, a, b, c, disc, _, kind = robot.legs[leg]
     pose = path.pose_on(Iv.q(t))
-    box = [Iv(0, 0)] * len(robot.joints) + pose
-    if a and evaluate(disc, box).negative():
+    if (a or kind == "r") and evaluate(disc, _box(robot, pose)).negative():
         return True
-    v = branches_on(robot, pose)[leg][mode[leg]][0]
-    lim = robot.limits.get(k)
-    return v is not None and lim is not None and (
-        v.hi < Iv.q(lim[0]).lo or v.lo > Iv.q(lim[1]).hi)
+    return _outside(robot.limits.get(k), branches_on(robot, pose)[leg][mode[leg]][0])
 
 
 # Numbers of Q(√d₀, …, √dₙ₋₁) as {mask: q}: Σ q·Π_{i in mask} √dᵢ.  A number whose
@@ -313,16 +372,24 @@ def singular_at(robot: Robot, path: Path, t: Fraction, mode: str) -> bool:
     """Proven: at the rational time t the mode's branches are real and distinct and
     det A = 0 exactly (the branches in Q(√D₀, …), D the legs' discriminants there)."""
     pose = [value(tree, {**path.known, path.param: t}, EXACT) for tree in path.trees]
-    point = [Fraction(0)] * len(robot.joints) + pose
-    ds, joints = [], []
-    for k, a, b, c, disc, _ in robot.legs:
+    values: list = [{} for _ in range(3 * len(robot.joints))] + \
+        [({0: x} if x else {}) for x in pose]
+    point = [m.get(0, Fraction(0)) for m in values]
+    ds = []
+    for k, a, b, c, disc, _, kind in robot.legs:
         av, bv, cv, d = (_mq_poly(p, [{0: x} for x in point], []).get(0, Fraction(0))
                          for p in (a, b, c, disc))
-        if (a and (d <= 0 or av == 0)) or (not a and bv == 0):
-            return False
-        ds.append(d if a else Fraction(1))
         s = 1 if mode[k] == "+" else -1
-        joints.append({0: -bv / (2 * av), 1 << k: s / (2 * av)} if a else {0: -cv / bv})
-    values = joints + [({0: x} if x else {}) for x in pose]
+        if kind == "r" and d > 0:
+            w = av * av + bv * bv
+            values[3 * k + 1] = {0: -av * cv / w, 1 << k: s * bv / w}
+            values[3 * k + 2] = {0: -bv * cv / w, 1 << k: -s * av / w}
+        elif kind == "p" and a and d > 0 and av != 0:
+            values[3 * k] = {0: -bv / (2 * av), 1 << k: s / (2 * av)}
+        elif kind == "p" and not a and bv != 0:
+            values[3 * k], d = {0: -cv / bv}, Fraction(1)
+        else:
+            return False
+        ds.append(d)
     return not det([[_mq_poly(p, values, ds) for p in leg[5]] for leg in robot.legs],
                    lambda x, y: _mq_mul(x, y, ds), _mq_add)

@@ -279,9 +279,11 @@ def poly(tree, variables: tuple, names: dict) -> dict:
     """The polynomial of a tree in ``variables`` with rational ``names`` substituted."""
     op = tree[0]
     n = len(variables)
-    if op == "var" and tree[1] in variables:
+    name = tree[1] if op == "var" else f"{op}({tree[1][1]})" if op in ("sin", "cos") and \
+        tree[1][0] == "var" else None  # (sin, cos of a joint angle are variables too)
+    if name in variables:
         e = [0] * n
-        e[variables.index(tree[1])] = 1
+        e[variables.index(name)] = 1
         return {tuple(e): Fraction(1)}
     if op in ("num", "var") or op == "/":
         c = constant(tree if op != "/" else tree[2], names)
@@ -305,8 +307,8 @@ def poly(tree, variables: tuple, names: dict) -> dict:
         for _ in range(tree[2]):
             out = mul(out, base)
         return out
-    raise NotRational(f"{op} in a constraint: only polynomial (prismatic) robots are "
-                      "re-checked")
+    raise NotRational(f"{op} in a constraint, of something other than a joint angle "
+                      "(pose angles are not re-checked yet)")
 
 
 def mul(p: dict, q: dict) -> dict:

@@ -196,7 +196,7 @@ def build_certificate(robot_text: str, trajectory_text: str, result: dict) -> di
         path = PathSpec(trajectory_text, robot)
         feasible = [m for m in robot.modes if modes.get(m) == "feasible"]
         spans = _spans(result, feasible)
-    except (NotRecheckable, Refused) as e:
+    except (NotRecheckable, Refused, NotDecided) as e:
         cert["not_recheckable"] = str(e)
         return cert
     cert["claim"]["singular_times"] = {

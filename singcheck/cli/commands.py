@@ -331,8 +331,13 @@ def _certify(directory, robot_text: str, texts: dict, doc: dict, used: set, prog
     """Write one trajectory's certificate (``--certificate``)."""
     from singcheck.certify.certificate import build_certificate, write_certificate
 
-    cert = build_certificate(robot_text, texts.get(doc["name"], ""), doc)
-    target = write_certificate(directory, cert, used)
+    try:
+        cert = build_certificate(robot_text, texts.get(doc["name"], ""), doc)
+        target = write_certificate(directory, cert, used)
+    except (OSError, ArithmeticError, ValueError, RecursionError) as e:  # the run stands
+        print(f"singcheck: warning: certificate of {doc['name']} not written: {e}",
+              file=sys.stderr)
+        return
     progress.note(f"certificate: {target}" + (
         f" (not re-checkable: {cert['not_recheckable']})" if cert["proof"] is None else
         f" ({cert['incomplete']})" if "incomplete" in cert else ""))

@@ -196,7 +196,7 @@ def main(argv: list[str] | None = None) -> int:
             if len(raw) > MAX_BYTES:
                 raise Malformed("larger than 64 MiB")
             fails, summary = check(json.loads(raw.decode("utf-8")))
-        except (OSError, ValueError, TypeError, RecursionError) as e:
+        except (OSError, ValueError, TypeError, ArithmeticError, RecursionError) as e:
             print(f"{name}: unreadable: {str(e).splitlines()[0] if str(e) else type(e).__name__}")
             code = 2
             continue

@@ -5,8 +5,9 @@ cut points, the signs to check and the witnesses of infeasibility, each re-check
 
 A prismatic leg F(ρ, X) = a ρ² + b ρ + c (a, b, c polynomials of the pose X) has the
 branches ρ± = (−b ± √D)/(2a), D = b² − 4ac (the label '+' or '-', in joint order, of a
-working mode); a linear leg (a ≡ 0) the one branch −c/b (label 'o').  On a piece T the
-pose is enclosed from the path's expressions, D's enclosure must be > 0 (real, distinct
+working mode); a linear leg (a ≡ 0) the one branch −c/b (label 'o'); a revolute leg
+a cos θ + b sin θ + d the branches of :func:`branches_on`.  On a piece T the pose is
+enclosed from the path's expressions, D's enclosure must be > 0 (real, distinct
 branches: the branch is continuous on T), a ≠ 0, and the branch's enclosure inside the
 closed joint limits; det A = det(∂F/∂X) along a mode is enclosed from the branches.
 """

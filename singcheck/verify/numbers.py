@@ -85,6 +85,8 @@ class Iv:
         if n == 0:
             return Iv(ONE, ONE)
         lo, hi = self.lo, self.hi
+        if max(abs(lo), abs(hi)).bit_length() * n > 200_000:
+            raise NotDecided("a power too large")
         if n % 2 == 0:
             if lo >= 0:
                 a, b = lo, hi

@@ -252,7 +252,8 @@ def _atom(toks, j, d):
 
 def constant(tree, names: dict | None = None) -> Fraction:
     """The exact rational value of a tree of numbers and rational ``names``; anything else
-    (π, sqrt, sin, a variable) is :class:`Refused`."""
+    (π, sqrt, sin: :class:`NotRational`; an unknown name, a value of more than 4096 bits
+    on the way: :class:`Refused`)."""
     names = names or {}
     op = tree[0]
     if op == "num":
@@ -261,16 +262,24 @@ def constant(tree, names: dict | None = None) -> Fraction:
         if tree[1] not in names:
             raise Refused(f"unknown name {tree[1]!r}")
         return names[tree[1]]
-    if op == "neg":
-        return -constant(tree[1], names)
-    if op == "^":
-        return constant(tree[1], names) ** tree[2]
-    if op in "+-*/" and len(op) == 1:
+    if op in ("neg", "^"):
+        a = constant(tree[1], names)
+        value = -a if op == "neg" else a ** tree[2] if _bits(a) * tree[2] <= 8 * MAX_BITS \
+            else None
+    elif op in "+-*/" and len(op) == 1:
         a, b = constant(tree[1], names), constant(tree[2], names)
         if op == "/" and b == 0:
             raise Refused("division by zero")
-        return a + b if op == "+" else a - b if op == "-" else a * b if op == "*" else a / b
-    raise NotRational(f"not a rational constant: {op}")
+        value = a + b if op == "+" else a - b if op == "-" else a * b if op == "*" else a / b
+    else:
+        raise NotRational(f"not a rational constant: {op}")
+    if value is None or _bits(value) > 8 * MAX_BITS:
+        raise Refused("a constant too large")
+    return value
+
+
+def _bits(q: Fraction) -> int:
+    return max(q.numerator.bit_length(), q.denominator.bit_length())
 
 
 # --- polynomials: {exponents: Fraction} over a fixed tuple of variables -------------

@@ -67,9 +67,10 @@ class Robot:
                 self.params[key] = constant(parse_expr(text_), self.params)
             except NotRational as e:
                 raise NotRecheckable(f"parameter {key} is not rational ({e})") from None
-        n = len(self.joints)  # the box: (ρ, cos θ, sin θ) per joint, then the pose
-        vs = tuple(x for j in self.joints for x in (j, f"cos({j})", f"sin({j})")) + \
-            tuple(self.pose)
+        n = len(self.joints)  # the box: (v, cos v, sin v) per joint, then per pose variable
+        if len(self.pose) != n:
+            raise Refused("as many pose variables as joints")
+        vs = tuple(x for v in self.joints + self.pose for x in (v, f"cos({v})", f"sin({v})"))
         cons = spec["constraints"]
         if not isinstance(cons, list) or len(cons) != n:
             raise Refused("constraints: one per joint")
@@ -84,24 +85,25 @@ class Robot:
             if len(used) != 1 or self.legs[used[0]] is not None:
                 raise Refused("each constraint must involve exactly one joint, its own")
             k = used[0]
-            jac = [3 * n + j for j in range(n)]
+            jac = [_d_pose(f, 3 * n + 3 * j) for j in range(n)]
             if any(e[3 * k + 1] + e[3 * k + 2] for e in f):  # revolute: a c + b s + d
                 if any(e[3 * k] for e in f):
                     raise NotRecheckable(f"{self.joints[k]} is both a length and an angle")
                 f = _on_circle(f, 3 * k + 1, 3 * k + 2)
+                jac = [_on_circle(p, 3 * k + 1, 3 * k + 2) for p in jac]
                 if any(e[3 * k + 1] + e[3 * k + 2] > 1 for e in f):
                     raise NotRecheckable(f"leg {self.joints[k]} is not a·cos + b·sin + d")
                 a, b = coefficient(f, 3 * k + 1, 1), coefficient(f, 3 * k + 2, 1)
                 d = coefficient(coefficient(f, 3 * k + 1, 0), 3 * k + 2, 0)
-                disc = _sub(_sub(mul(a, a), {e: -v for e, v in mul(b, b).items()}), mul(d, d))
-                self.legs[k] = (k, a, b, d, disc, [derivative(f, i) for i in jac], "r")
+                disc = _combine((1, mul(a, a)), (1, mul(b, b)), (-1, mul(d, d)))
+                self.legs[k] = (k, a, b, d, disc, jac, "r")
                 continue
             degree = max(e[3 * k] for e in f)
             if degree not in (1, 2):
                 raise NotRecheckable(f"{self.joints[k]} appears with degree {degree}")
             a, b, c = (coefficient(f, 3 * k, d) for d in (2, 1, 0))
-            disc = _sub(mul(b, b), mul({e: 4 * v for e, v in a.items()}, c))
-            self.legs[k] = (k, a, b, c, disc, [derivative(f, i) for i in jac], "p")
+            disc = _combine((1, mul(b, b)), (-4, mul(a, c)))
+            self.legs[k] = (k, a, b, c, disc, jac, "p")
         self.limits: dict[int, tuple] = {}
         for key, pair in (spec.get("joint_limits") or {}).items():
             if key not in self.joints or not isinstance(pair, list) or len(pair) != 2:
@@ -117,6 +119,8 @@ class Robot:
                 self.limits[k] = tuple(constant(parse_expr(x), self.params) for x in pair)
             except NotRational as e:
                 raise NotRecheckable(f"joint_limits of {key}: {e}") from None
+        self.angles = {j for j in range(n) for leg in self.legs for p in leg[1:4]
+                       for e in p if e[3 * n + 3 * j + 1] + e[3 * n + 3 * j + 2]}
         self.labels = ["+-" if leg[1] or leg[6] == "r" else "o" for leg in self.legs]
         self.modes = ["".join(m) for m in product(*self.labels)]
 
@@ -135,11 +139,22 @@ def _on_circle(f: dict, ci: int, si: int) -> dict:
     return {e: v for e, v in out.items() if v}
 
 
-def _sub(p: dict, q: dict) -> dict:
-    out = dict(p)
-    for e, v in q.items():
-        out[e] = out.get(e, 0) - v
+def _combine(*terms) -> dict:
+    """Σ k·p over the (k, p) pairs."""
+    out: dict = {}
+    for k, p in terms:
+        for e, v in p.items():
+            out[e] = out.get(e, 0) + k * v
     return {e: v for e, v in out.items() if v}
+
+
+def _d_pose(f: dict, i: int) -> dict:
+    """∂f/∂X for the pose variable X at index i, its cos and sin at i + 1, i + 2:
+    ∂f/∂X − sin X·∂f/∂cos + cos X·∂f/∂sin."""
+    def unit(j):
+        return {tuple(int(m == j) for m in range(len(next(iter(f))))): Fraction(1)}
+    return _combine((1, derivative(f, i)), (-1, mul(unit(i + 2), derivative(f, i + 1))),
+                    (1, mul(unit(i + 1), derivative(f, i + 2))))
 
 
 def evaluate(p: dict, values: list[Iv]) -> Iv:
@@ -258,7 +273,10 @@ def _outside(lim, v) -> bool:
 
 
 def _box(robot: Robot, pose: list) -> list:
-    return [Iv(0, 0)] * (3 * len(robot.joints)) + pose
+    zero = Iv(0, 0)
+    return [zero] * (3 * len(robot.joints)) + [
+        x for j, v in enumerate(pose)
+        for x in ((v, cos(v), sin(v)) if j in robot.angles else (v, zero, zero))]
 
 
 def branches_on(robot: Robot, pose: list[Iv]) -> list[dict]:
@@ -373,8 +391,11 @@ def singular_at(robot: Robot, path: Path, t: Fraction, mode: str) -> bool:
     """Proven: at the rational time t the mode's branches are real and distinct and
     det A = 0 exactly (the branches in Q(√D₀, …), D the legs' discriminants there)."""
     pose = [value(tree, {**path.known, path.param: t}, EXACT) for tree in path.trees]
-    values: list = [{} for _ in range(3 * len(robot.joints))] + \
-        [({0: x} if x else {}) for x in pose]
+    if any(pose[j] for j in robot.angles):
+        raise NotDecided("sin or cos of a non-zero pose angle")
+    values: list = [{} for _ in range(3 * len(robot.joints))] + [
+        ({0: x} if x else {}) if i == 0 else {0: Fraction(1)} if i == 1 and j in robot.angles
+        else {} for j, x in enumerate(pose) for i in range(3)]
     point = [m.get(0, Fraction(0)) for m in values]
     ds = []
     for k, a, b, c, disc, _, kind in robot.legs:

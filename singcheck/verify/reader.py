@@ -316,8 +316,8 @@ def poly(tree, variables: tuple, names: dict) -> dict:
         for _ in range(tree[2]):
             out = mul(out, base)
         return out
-    raise NotRational(f"{op} in a constraint, of something other than a joint angle "
-                      "(pose angles are not re-checked yet)")
+    raise NotRational(f"{op} in a constraint, of something other than a joint or pose "
+                      "variable")
 
 
 def mul(p: dict, q: dict) -> dict:

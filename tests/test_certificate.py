@@ -101,7 +101,7 @@ def test_the_checker_imports_nothing_of_singcheck_but_itself(certs, tmp_path):
 
 def test_the_checker_is_short():
     """Short enough to review in an afternoon (the aim was 800 lines; with revolute legs,
-    pose angles and exact roots it holds 1,167, docstrings included): this bound keeps
+    pose angles and exact roots it holds 1,172, docstrings included): this bound keeps
     it from growing unnoticed."""
     lines = sum(len(p.read_text().splitlines())
                 for p in (ROOT / "singcheck" / "verify").glob("*.py"))

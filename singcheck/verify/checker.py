@@ -157,18 +157,23 @@ def _d_pose(f: dict, i: int) -> dict:
                     (1, mul(unit(i + 1), derivative(f, i + 2))))
 
 
+_COMPILED: dict = {}  # id(p) → (p, [(coefficient's enclosure, [(variable, power)])])
+
+
 def evaluate(p: dict, values: list[Iv]) -> Iv:
     """An enclosure of the polynomial p over the box ``values`` (one per variable)."""
+    hit = _COMPILED.get(id(p))
+    if hit is None or hit[0] is not p:
+        hit = _COMPILED[id(p)] = (p, [(Iv.q(c), [(k, d) for k, d in enumerate(e) if d])
+                                      for e, c in p.items()])
     total = Iv(0, 0)
     powers: dict = {}
-    for e, c in p.items():
-        term = Iv.q(c)
-        for k, d in enumerate(e):
-            if d:
-                if (k, d) not in powers:
-                    powers[k, d] = values[k] ** d
-                term = term * powers[k, d]
-        total = total + term
+    for c, factors in hit[1]:
+        for k, d in factors:
+            if (k, d) not in powers:
+                powers[k, d] = values[k] ** d
+            c = c * powers[k, d]
+        total = total + c
     return total
 
 

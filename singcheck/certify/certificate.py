@@ -12,7 +12,7 @@ The claim is singcheck's verdict (both engines, :mod:`.engines`); the cover is f
 branch-and-bound in the checker's own rational interval arithmetic, starting from a
 uniform grid and the claimed singular times, so that every piece it emits is one the
 checker can decide.  A claim it cannot support (a tangency, a mode singular along a
-stretch, a pose angle, a path of segments) is written with ``proof: null`` and the
+stretch, a constant like sqrt(3), a spline) is written with ``proof: null`` and the
 reason in ``not_recheckable``: the checker then fails it, never passes it.
 """
 
@@ -206,6 +206,7 @@ def build_certificate(robot_text: str, trajectory_text: str, result: dict) -> di
     points = {_dyadic(lo + (hi - lo) * k // GRID, (hi - lo) // GRID) for k in range(1, GRID)}
     points |= {x for s in spans.values() for span in s for x in span
                if lo < Iv.q(x).lo and Iv.q(x).hi < hi}
+    points |= set(path.joins)  # a piece lies in one segment
     ends: list = [None, *sorted(points), None]
     for a, b in zip(ends, ends[1:], strict=False):
         prover.piece(a, b, 0)

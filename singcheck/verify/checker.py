@@ -178,34 +178,65 @@ def evaluate(p: dict, values: list[Iv]) -> Iv:
 
 
 class Path:
-    """The path's parameter, range and pose expressions (trees, evaluated on intervals)."""
+    """The path's parameter, range and pose expressions (trees, evaluated on intervals):
+    one piece, or segments joined end to end at rational times, the pose continuous
+    there (decided exactly)."""
 
     def __init__(self, text: str, robot: Robot) -> None:
         spec = parse_yaml(text)
         if not isinstance(spec, dict):
             raise Refused("a trajectory spec must be a mapping")
-        if set(spec) - PATH_KEYS and set(spec) & {"segments", "waypoints", "interpolation"}:
-            raise NotRecheckable("paths of segments or waypoints are not re-checked yet")
-        if set(spec) != PATH_KEYS:
-            raise Refused("a trajectory spec needs exactly " + ", ".join(sorted(PATH_KEYS)))
+        if "waypoints" in spec or "interpolation" in spec:
+            raise NotRecheckable("paths through waypoints are not re-checked yet")
+        pieces = spec.get("segments", [{k: spec.get(k) for k in ("range", "pose")}])
+        if set(spec) not in (PATH_KEYS, {"name", "parameter", "segments"}) or \
+                not isinstance(pieces, list) or not pieces:
+            raise Refused("a trajectory spec needs name, parameter, and range and pose, or "
+                          "segments")
         self.name, self.param = spec["name"], spec["parameter"]
         if not isinstance(self.param, str) or not self.param.isidentifier() or \
                 self.param in robot.joints + robot.pose + list(robot.params) + ["pi"]:
             raise Refused("parameter: a new name")
-        rng, pose = spec["range"], spec["pose"]
-        if not isinstance(rng, list) or len(rng) != 2 or not isinstance(pose, dict) or \
-                set(pose) != set(robot.pose):
-            raise Refused("range: [start, end]; pose: every pose variable of the robot")
-        self.known = {**robot.params}
-        self.start, self.end = (value(parse_expr(x), self.known, INTERVAL) for x in rng)
-        self.trees = [parse_expr(pose[v]) for v in robot.pose]
-        if any(_unknown(tree, {*self.known, self.param}) for tree in self.trees):
-            raise Refused("pose: an unknown name")
-        if not self.start.hi < self.end.lo:
-            raise Refused("range: start must be below end")
+        self.known, self.segments, ends, self.joins = {**robot.params}, [], [], []
+        for piece in pieces:
+            rng, pose = (piece.get(k) if isinstance(piece, dict) else None
+                         for k in ("range", "pose"))
+            if not isinstance(rng, list) or len(rng) != 2 or not isinstance(pose, dict) or \
+                    set(pose) != set(robot.pose) or len(piece) != 2:
+                raise Refused("range: [start, end]; pose: every pose variable of the robot")
+            trees = [parse_expr(pose[v]) for v in robot.pose]
+            if any(_unknown(tree, {*self.known, self.param}) for tree in trees):
+                raise Refused("pose: an unknown name")
+            start, end = (value(parse_expr(x), self.known, INTERVAL) for x in rng)
+            if not start.hi < end.lo:
+                raise Refused("range: start must be below end")
+            self.segments.append((start, end, trees))
+            ends.append(rng)
+        self.start, self.end = self.segments[0][0], self.segments[-1][1]
+        for k in range(len(ends) - 1):
+            try:
+                join = constant(parse_expr(ends[k][1]), self.known)
+                if join != constant(parse_expr(ends[k + 1][0]), self.known):
+                    raise Refused(f"segments {k + 1} and {k + 2} do not meet")
+                here = [[value(t, {**self.known, self.param: join}, EXACT) for t in trees]
+                        for trees in (self.segments[k][2], self.segments[k + 1][2])]
+            except (NotRational, NotDecided):
+                raise NotRecheckable(f"the pose's continuity at the join of segments "
+                                     f"{k + 1} and {k + 2} cannot be decided") from None
+            if here[0] != here[1]:
+                raise Refused(f"the pose jumps between segments {k + 1} and {k + 2}")
+            self.joins.append(join)
+
+    def trees_on(self, t: Iv) -> list:
+        """The pose expressions of the segment holding all of t."""
+        for start, end, trees in self.segments:
+            if start.lo <= t.lo and t.hi <= end.hi:
+                return trees
+        raise NotDecided("a piece across a join of segments")
 
     def pose_on(self, t: Iv) -> list[Iv]:
-        return [value(tree, {**self.known, self.param: t}, INTERVAL) for tree in self.trees]
+        env = {**self.known, self.param: t}
+        return [value(tree, env, INTERVAL) for tree in self.trees_on(t)]
 
 
 def _unknown(tree, names: set) -> bool:
@@ -395,7 +426,8 @@ def _mq_poly(p: dict, values: list, ds: list) -> dict:
 def singular_at(robot: Robot, path: Path, t: Fraction, mode: str) -> bool:
     """Proven: at the rational time t the mode's branches are real and distinct and
     det A = 0 exactly (the branches in Q(√D₀, …), D the legs' discriminants there)."""
-    pose = [value(tree, {**path.known, path.param: t}, EXACT) for tree in path.trees]
+    pose = [value(tree, {**path.known, path.param: t}, EXACT)
+            for tree in path.trees_on(Iv.q(t))]
     if any(pose[j] for j in robot.angles):
         raise NotDecided("sin or cos of a non-zero pose angle")
     values: list = [{} for _ in range(3 * len(robot.joints))] + [

@@ -68,6 +68,11 @@ def _block(lines, i, indent, depth):
         if seq:
             rest = body[1:].strip()
             key = None
+            if re.match(r"[A-Za-z_][A-Za-z0-9_]*\s*:(\s|$)", rest):  # "- key: value ..."
+                lines[i] = (n, indent + len(body) - len(rest), rest)
+                value, i = _block(lines, i, lines[i][1], depth + 1)
+                out.append(value)
+                continue
         else:
             m = re.fullmatch(r"([A-Za-z_][A-Za-z0-9_]*)\s*:(?:\s+(.*))?", body)
             if not m:

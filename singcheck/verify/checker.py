@@ -186,28 +186,30 @@ class Path:
         spec = parse_yaml(text)
         if not isinstance(spec, dict):
             raise Refused("a trajectory spec must be a mapping")
-        if "waypoints" in spec or "interpolation" in spec:
-            raise NotRecheckable("paths through waypoints are not re-checked yet")
-        pieces = spec.get("segments", [{k: spec.get(k) for k in ("range", "pose")}])
-        if set(spec) not in (PATH_KEYS, {"name", "parameter", "segments"}) or \
-                not isinstance(pieces, list) or not pieces:
-            raise Refused("a trajectory spec needs name, parameter, and range and pose, or "
-                          "segments")
+        keys = set(spec) - {"interpolation"}
+        if keys not in (PATH_KEYS, {"name", "parameter", "segments"},
+                        {"name", "parameter", "waypoints"}) or \
+                (spec.get("interpolation") and "waypoints" not in spec):
+            raise Refused("a trajectory spec needs name, parameter, and range and pose, "
+                          "segments or waypoints")
         self.name, self.param = spec["name"], spec["parameter"]
         if not isinstance(self.param, str) or not self.param.isidentifier() or \
                 self.param in robot.joints + robot.pose + list(robot.params) + ["pi"]:
             raise Refused("parameter: a new name")
         self.known, self.segments, ends, self.joins = {**robot.params}, [], [], []
-        for piece in pieces:
+        raw = _waypoints(spec, robot, self.param) if "waypoints" in spec else []
+        for piece in spec.get("segments", [{k: spec.get(k) for k in ("range", "pose")}]) \
+                if not raw else []:
             rng, pose = (piece.get(k) if isinstance(piece, dict) else None
                          for k in ("range", "pose"))
             if not isinstance(rng, list) or len(rng) != 2 or not isinstance(pose, dict) or \
                     set(pose) != set(robot.pose) or len(piece) != 2:
                 raise Refused("range: [start, end]; pose: every pose variable of the robot")
-            trees = [parse_expr(pose[v]) for v in robot.pose]
+            raw.append(([parse_expr(x) for x in rng], [parse_expr(pose[v]) for v in robot.pose]))
+        for rng, trees in raw:
             if any(_unknown(tree, {*self.known, self.param}) for tree in trees):
                 raise Refused("pose: an unknown name")
-            start, end = (value(parse_expr(x), self.known, INTERVAL) for x in rng)
+            start, end = (value(x, self.known, INTERVAL) for x in rng)
             if not start.hi < end.lo:
                 raise Refused("range: start must be below end")
             self.segments.append((start, end, trees))
@@ -215,8 +217,8 @@ class Path:
         self.start, self.end = self.segments[0][0], self.segments[-1][1]
         for k in range(len(ends) - 1):
             try:
-                join = constant(parse_expr(ends[k][1]), self.known)
-                if join != constant(parse_expr(ends[k + 1][0]), self.known):
+                join = constant(ends[k][1], self.known)
+                if join != constant(ends[k + 1][0], self.known):
                     raise Refused(f"segments {k + 1} and {k + 2} do not meet")
                 here = [[value(t, {**self.known, self.param: join}, EXACT) for t in trees]
                         for trees in (self.segments[k][2], self.segments[k + 1][2])]
@@ -237,6 +239,50 @@ class Path:
     def pose_on(self, t: Iv) -> list[Iv]:
         env = {**self.known, self.param: t}
         return [value(tree, env, INTERVAL) for tree in self.trees_on(t)]
+
+
+def _waypoints(spec: dict, robot: Robot, param: str) -> list:
+    """The pieces between waypoints, [(range, pose trees)]: straight lines, or the
+    natural cubic spline (second derivatives M with M₀ = Mₙ = 0 solving
+    hᵢ₋₁Mᵢ₋₁ + 2(hᵢ₋₁ + hᵢ)Mᵢ + hᵢMᵢ₊₁ = 6(Δᵢ − Δᵢ₋₁), Δᵢ = (yᵢ₊₁ − yᵢ)/hᵢ; on a piece
+    y = yᵢ + (Δᵢ − h(2Mᵢ + Mᵢ₊₁)/6)u + Mᵢu²/2 + (Mᵢ₊₁ − Mᵢ)u³/6h, u = t − tᵢ)."""
+    kind, rows = spec.get("interpolation", "cubic"), spec["waypoints"]
+    names = [param, *robot.pose]
+    if kind not in ("linear", "cubic") or not isinstance(rows, list) or \
+            not 2 <= len(rows) <= 10_000 or any(not isinstance(r, dict) or set(r) != set(names)
+                                                for r in rows):
+        raise Refused(f"waypoints: 2 or more {{{', '.join(names)}}}, interpolation linear "
+                      "or cubic")
+    table = [[constant(parse_expr(r[v])) for v in names] for r in rows]
+    ts = [row[0] for row in table]
+    if any(a >= b for a, b in zip(ts, ts[1:], strict=False)):
+        raise Refused(f"waypoints: {param} must increase")
+    n, hs = len(ts) - 1, [b - a for a, b in zip(ts, ts[1:], strict=False)]
+    coefficients = []  # per pose variable, per piece: [c0, c1, c2, c3] in u
+    for j in range(1, len(names)):
+        ys = [row[j] for row in table]
+        slope = [(ys[i + 1] - ys[i]) / hs[i] for i in range(n)]
+        m = [Fraction(0)] * (n + 1)
+        if kind == "cubic" and n > 1:  # Thomas' algorithm over Q
+            diag, rhs = [Fraction(0)] * (n + 1), [Fraction(0)] * (n + 1)
+            for i in range(1, n):
+                w = hs[i - 1] / diag[i - 1] if i > 1 else Fraction(0)
+                diag[i] = 2 * (hs[i - 1] + hs[i]) - w * hs[i - 1]
+                rhs[i] = 6 * (slope[i] - slope[i - 1]) - w * rhs[i - 1]
+            for i in range(n - 1, 0, -1):
+                m[i] = (rhs[i] - hs[i] * m[i + 1]) / diag[i]
+        coefficients.append([[ys[i], slope[i] - hs[i] * (2 * m[i] + m[i + 1]) / 6, m[i] / 2,
+                              (m[i + 1] - m[i]) / (6 * hs[i])] for i in range(n)])
+    out = []
+    for i in range(n):
+        u = ("-", ("var", param), ("num", ts[i]))
+        trees = []
+        for per_piece in coefficients:
+            c = per_piece[i]
+            trees.append(("+", ("num", c[0]), ("*", u, ("+", ("num", c[1]), ("*", u, (
+                "+", ("num", c[2]), ("*", u, ("num", c[3]))))))))
+        out.append(([("num", ts[i]), ("num", ts[i + 1])], trees))
+    return out
 
 
 def _unknown(tree, names: set) -> bool:

@@ -560,3 +560,46 @@ def test_paths_through_waypoints_are_rechecked(tmp_path, kind):
              for v in (lo, hi)]
         assert d[0] * d[1] < 0
     assert failures(tampered(cert, "trajectory_spec", "x: 9/10", "x: 8/10"))
+
+
+def _expressions():
+    """Texts of rational expressions built from the grammar (numbers in every exact
+    form, + - * / ^ **, parentheses, unary signs)."""
+    number = st.sampled_from(["2", "0.1", "1e-3", "3/4", ".5", "17", "2.50", "1E2"])
+    return st.recursive(number, lambda inner: st.one_of(
+        st.tuples(inner, st.sampled_from([" + ", " - ", "*", " / "]), inner).map("".join),
+        st.tuples(inner, st.sampled_from(["^", "**"]), st.sampled_from(["0", "1", "2", "3"]))
+        .map(lambda p: f"({p[0]}){p[1]}{p[2]}"),
+        inner.map(lambda e: f"-({e})"), inner.map(lambda e: f"+{e}")), max_leaves=12)
+
+
+@given(_expressions())
+@settings(max_examples=300, deadline=None)
+def test_the_checkers_grammar_agrees_with_singcheck(text):
+    """Two independent readers of the expression grammar give the same exact value
+    (or both refuse: a division by zero)."""
+    _agree(text)
+
+
+@pytest.mark.parametrize("text", ["-2^2", "2^3^2", "2**-1", "2^1/2", "(1/3)^2*9", "2 3",
+                                  "1/(2-2)", "2^65", "0.1e1", "1/2/3", "2x", "--1"])
+def test_the_checkers_grammar_agrees_on_corner_cases(text):
+    _agree(text)
+
+
+def _agree(text: str) -> None:
+    from singcheck.spec.grammar import ExprError, compile_constant, parse
+    from singcheck.verify.reader import Refused, constant, parse_expr
+
+    try:
+        theirs = compile_constant(parse(text))
+    except (ExprError, ZeroDivisionError):
+        theirs = None
+    try:
+        mine = constant(parse_expr(text))
+    except Refused:
+        mine = None
+    if theirs is None or mine is None:
+        assert theirs is None and mine is None, (text, theirs, mine)
+    else:
+        assert theirs.pi_coefficient == 0 and theirs.rational == mine, text

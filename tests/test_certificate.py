@@ -603,3 +603,27 @@ def _agree(text: str) -> None:
         assert theirs is None and mine is None, (text, theirs, mine)
     else:
         assert theirs.pi_coefficient == 0 and theirs.rational == mine, text
+
+
+def test_an_infeasible_path_is_proven_by_its_witnesses(tmp_path):
+    """leaves-workspace (x = 3 sin t on [0, π/2]): every mode leaves the workspace or the
+    limits; each witness is re-checked by mpmath from the legs' closed form."""
+    mpmath.mp.dps = 30
+    out = singcheck("run", ORTHO, str(TRAJECTORIES / "leaves-workspace.yaml"), "--no-regions",
+                    "-q", "--format", "json", "--certificate", str(tmp_path))
+    assert out.returncode == 1, out.stderr
+    cert = json.loads((tmp_path / "leaves-workspace.cert.json").read_text())
+    assert cert["claim"]["verdict"] == "infeasible" and failures(cert) == []
+    for mode, w in cert["proof"]["infeasible"].items():
+        t = mpmath.mpf(Fraction(w["t"]).numerator) / Fraction(w["t"]).denominator
+        pose = [3 * mpmath.sin(t), mpmath.mpf(0), mpmath.mpf(1)]
+        k = w["leg"]
+        d = 4 - sum(v ** 2 for i, v in enumerate(pose) if i != k)
+        if d >= 0:
+            rho = pose[k] + (1 if mode[k] == "+" else -1) * mpmath.sqrt(d)
+            assert not 0 <= rho <= 4, (mode, w)
+    c = copy.deepcopy(cert)
+    c["claim"]["modes"]["+++"] = "feasible"
+    c["claim"]["verdict"] = "singularity-free"
+    c["proof"]["signs"]["+++"] = "+" * (len(c["proof"]["cuts"]) + 1)
+    assert failures(c)

@@ -627,3 +627,22 @@ def test_an_infeasible_path_is_proven_by_its_witnesses(tmp_path):
     c["claim"]["verdict"] = "singularity-free"
     c["proof"]["signs"]["+++"] = "+" * (len(c["proof"]["cuts"]) + 1)
     assert failures(c)
+
+
+def test_one_certificate_per_document_of_a_batch(tmp_path):
+    """A file of two documents, two workers, jsonl: each trajectory gets its own
+    certificate holding its own document's text."""
+    spec = tmp_path / "two.yaml"
+    spec.write_text((TRAJECTORIES / "heart2.yaml").read_text() + "---\n"
+                    + (TRAJECTORIES / "helix.yaml").read_text())
+    out = singcheck("run", ORTHO, str(spec), "--no-regions", "-q", "-j", "2", "--format",
+                    "jsonl", "--certificate", str(tmp_path / "certs"))
+    assert out.returncode == 0, out.stderr
+    assert len(out.stdout.splitlines()) == 2
+    names = sorted(p.name for p in (tmp_path / "certs").iterdir())
+    assert names == ["heart2.cert.json", "helix.cert.json"]
+    for name in ("heart2", "helix"):
+        cert = json.loads((tmp_path / "certs" / f"{name}.cert.json").read_text())
+        assert f"name: {name}\n" in cert["claim"]["trajectory_spec"]
+        assert cert["claim"]["trajectory_spec"].count("name:") == 1
+        assert main([str(tmp_path / "certs" / f"{name}.cert.json")]) == 0

@@ -332,7 +332,7 @@ def _certify(directory, robot_text: str, texts: dict, doc: dict, used: set, prog
     from singcheck.certify.certificate import build_certificate, write_certificate
 
     try:
-        cert = build_certificate(robot_text, texts.get(doc["name"], ""), doc)
+        cert = build_certificate(robot_text, texts.pop(doc["name"], ""), doc)
         target = write_certificate(directory, cert, used)
     except (OSError, ArithmeticError, ValueError, RecursionError) as e:  # the run stands
         print(f"singcheck: warning: certificate of {doc['name']} not written: {e}",

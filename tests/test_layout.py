@@ -9,8 +9,9 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parent.parent / "singcheck"
 
 # the pipeline, bottom to top; a module may import its own stage and those below it
-STAGES = ["algebra", "spec", "model", "elimination", "roots", "certify", "spaces", "report",
-          "api", "cli"]
+# (verify, the certificate checker, is the floor under all: it imports nothing of singcheck)
+STAGES = ["verify", "algebra", "spec", "model", "elimination", "roots", "certify", "spaces",
+          "report", "api", "cli"]
 FOUNDATION = {"errors", "budget", "atomic", "version",  # importable by every stage
               "schemas"}  # data files (the JSON Schemas) and a reader
 ONLY_IN = {"click": {"cli"}, "rich": {"report"}, "matplotlib": {"report"}}

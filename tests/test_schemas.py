@@ -40,7 +40,7 @@ def errors(v, instance) -> list[str]:
             for e in v.iter_errors(instance)]
 
 
-@pytest.mark.parametrize("name", ["robot", "trajectory", "report"])
+@pytest.mark.parametrize("name", ["robot", "trajectory", "report", "certificate"])
 def test_the_schema_command_prints_the_schema_file(name):
     out = singcheck("schema", name)
     assert out.returncode == 0, out.stderr
@@ -66,7 +66,7 @@ def test_the_schemas_ship_as_package_data():
 
     assert [schema(n)["title"] for n in NAMES] == [
         "singcheck robot spec", "singcheck trajectory spec",
-        "singcheck JSON report (schema_version 1)"]
+        "singcheck JSON report (schema_version 1)", "singcheck certificate (version 1)"]
 
 
 @pytest.mark.parametrize("path", ROBOT_FILES, ids=lambda p: p.name)

@@ -151,12 +151,15 @@ def cli() -> None:
                    "on a path the exact engine refuses; exact: the exact engine, held "
                    "against the intervals, and such a path refused; interval: the interval "
                    "engine alone (a tangency stays unknown).")
+@click.option("--certificate", "certificate_dir", type=click.Path(file_okay=False),
+              help="Write DIR/<trajectory>.cert.json for each trajectory: the claim and a "
+                   "proof that `singcheck verify` re-checks without a CAS.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
 def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs,
         time_limit, no_regions, wait_regions, scheduler, plot_dir, interpolation, as_csv,
-        columns, scale, engine, quiet,
+        columns, scale, engine, certificate_dir, quiet,
         verbose) -> None:  # engine: which certifies (--backend eliminates)
     """Certify each TRAJECTORY of ROBOT (YAML spec files; - reads standard input; a
     trajectory may also be a CSV table of poses).  A YAML file may hold several
@@ -190,7 +193,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
                     verbose, progress, jobs, plot_dir, interpolation, time_limit=time_limit,
                     regions=False if no_regions else "wait" if wait_regions else True,
                     scheduler=scheduler, table=table,
-                    all_csv=as_csv, certify_with=engine)
+                    all_csv=as_csv, certify_with=engine, certificate_dir=certificate_dir)
     sys.exit(int(code))
 
 
@@ -263,7 +266,8 @@ def _factor(text: str):
 
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
          progress, jobs, plot_dir=None, interpolation="cubic", *, time_limit=300.0,
-         regions=True, scheduler=None, table=None, all_csv=False, certify_with="auto"):
+         regions=True, scheduler=None, table=None, all_csv=False, certify_with="auto",
+         certificate_dir=None):
     from contextlib import closing
     from itertools import chain, islice
 
@@ -275,6 +279,13 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     # the first documents (all of a small batch) are parsed here, before any work: a bad
     # one stops the run at once (exit 2, one line); past them, the documents are parsed
     # by the workers, and a bad one is that trajectory's result
+    texts: dict = {}
+    robot_text = ""  # a robot read from standard input: its certificates say "no spec"
+    if certificate_dir:
+        documents = _texts_kept(documents, texts)
+        if robot != "-":
+            with open(robot, encoding="utf-8") as f:
+                robot_text = f.read()
     first = [document.parse(spec) for document in islice(documents, api.LOOKAHEAD)]
     total = len(first) if len(first) < api.LOOKAHEAD else None  # None: not known yet
     items = chain(first, documents)
@@ -299,10 +310,13 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     else:
         batch = api.check_batch(machine, items, jobs=jobs, **options)
     code = ExitCode.SINGULARITY_FREE
+    used: set = set()  # certificate file names written
     with _sink(fmt, output, projection) as sink, progress.bar(total) as advance, \
             closing(batch) as docs:
         for doc in docs:
             sink.add(doc)
+            if certificate_dir:
+                _certify(certificate_dir, robot_text, texts, doc, used, progress)
             code = _worst([code, _outcome(doc)])
             advance(doc["name"], doc["verdict"])
         sink.finish(code, tolerance, verbose)
@@ -310,6 +324,30 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         _plot_all(_certificates(machine, _parsed(kept, spec), time_limit, tolerance),
                   plot_dir, progress)
     return code
+
+
+def _texts_kept(documents, texts: dict):
+    """``documents``, each one's text kept in ``texts`` under its name (for
+    --certificate: a certificate holds the spec texts as read)."""
+    for document in documents:
+        texts[document.name] = document.text
+        yield document
+
+
+def _certify(directory, robot_text: str, texts: dict, doc: dict, used: set, progress) -> None:
+    """Write one trajectory's certificate (``--certificate``)."""
+    from singcheck.certify.certificate import build_certificate, write_certificate
+
+    try:
+        cert = build_certificate(robot_text, texts.pop(doc["name"], ""), doc)
+        target = write_certificate(directory, cert, used)
+    except (OSError, ArithmeticError, ValueError, RecursionError) as e:  # the run stands
+        print(f"singcheck: warning: certificate of {doc['name']} not written: {e}",
+              file=sys.stderr)
+        return
+    progress.note(f"certificate: {target}" + (
+        f" (not re-checkable: {cert['not_recheckable']})" if cert["proof"] is None else
+        f" ({cert['incomplete']})" if "incomplete" in cert else ""))
 
 
 def _keeping(items, kept: list):
@@ -706,7 +744,7 @@ Examples:
   singcheck schema robot > robot.schema.json
   singcheck schema report | check-jsonschema --schemafile /dev/stdin report.json
 """)
-@click.argument("name", type=click.Choice(["robot", "trajectory", "report"]))
+@click.argument("name", type=click.Choice(["robot", "trajectory", "report", "certificate"]))
 def schema(name) -> None:
     """Print the JSON Schema (Draft 2020-12) of a robot spec, a trajectory document or
     the JSON report (each jsonl line: the report's $defs/jsonl_line).  Editors with the
@@ -715,6 +753,21 @@ def schema(name) -> None:
     from singcheck.schemas import schema_text
 
     click.echo(schema_text(name), nl=False)
+
+
+@cli.command(epilog="""\b
+Examples:
+  singcheck run robots/orthoglide.yaml trajectories/heart1.yaml --certificate certs
+  singcheck verify certs/heart1.cert.json
+""")
+@click.argument("certificates", nargs=-1, required=True, type=click.Path(dir_okay=False))
+def verify(certificates) -> None:
+    """Re-check CERTIFICATES (written by run --certificate) without a CAS: exit 0 when
+    every claim is proven, 1 with one line per failed or not re-checked step, 2 for an
+    unreadable file.  The same as python -m singcheck.verify (docs/certificate.md)."""
+    from singcheck.verify import main as verify_main
+
+    sys.exit(verify_main(list(certificates)))
 
 
 def _register_space_commands() -> None:

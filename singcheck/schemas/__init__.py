@@ -11,11 +11,11 @@ from __future__ import annotations
 
 from importlib.resources import files
 
-NAMES = ("robot", "trajectory", "report")
+NAMES = ("robot", "trajectory", "report", "certificate")
 
 
 def schema_text(name: str) -> str:
-    """The schema ``name`` (robot, trajectory or report) as JSON text."""
+    """The schema ``name`` (robot, trajectory, report or certificate) as JSON text."""
     if name not in NAMES:
         raise ValueError(f"no schema {name!r} (one of {', '.join(NAMES)})")
     return (files(__package__) / f"{name}.schema.json").read_text(encoding="utf-8")

@@ -49,7 +49,7 @@ from dataclasses import dataclass
 
 from flint import arb
 
-from singcheck.algebra.intervals import evaluate
+from singcheck.algebra.intervals import evaluate, fraction_ball
 from singcheck.algebra.radicals import radical_balls
 from singcheck.budget import checkpoint
 from singcheck.certify.covers import halves, pieces
@@ -237,7 +237,7 @@ def _rows_and_derivatives(path, joints: list, variables: list, dvariables: list 
     point = _flat_joints(joints) + list(variables) + _radicals(model)
     powers: dict = {}
     raw = [[evaluate(e, point, powers) for e in row] for row in model.A]
-    inverse = 1 / arb(length)
+    inverse = 1 / fraction_ball(length)
     scale = [inverse if v in model.angles else None for v in model.pose]
 
     def scaled(rows):

@@ -77,14 +77,15 @@ def _matches(leg, branch, value: arb, tolerance: float) -> bool | None:
     if leg.kind == REVOLUTE:
         if not isinstance(branch, tuple) or not all(isinstance(b, arb) for b in branch):
             return False  # not real there
-        gap = ((branch[0] - value.cos()) ** 2 + (branch[1] - value.sin()) ** 2).sqrt()
+        square = (branch[0] - value.cos()) ** 2 + (branch[1] - value.sin()) ** 2
     else:
         if not isinstance(branch, arb):
             return False
-        gap = abs(branch - value)
-    if gap < tolerance:
+        square = (branch - value) ** 2
+    bound = arb(tolerance) ** 2  # compared squared: no square root of a ball around 0
+    if square < bound:
         return True
-    if gap > tolerance:
+    if square > bound:
         return False
     return None
 

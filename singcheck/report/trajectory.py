@@ -268,6 +268,15 @@ def _singular_at(m: dict[str, Any]) -> str:
     return ", ".join(_num(x, 6) for x in m["singular_times"]) or "—"
 
 
+def row_mode(c: dict[str, Any], feasible: list[str]) -> str | None:
+    """The mode a candidate's row is about: the first feasible mode singular there, else
+    the first feasible mode whose joints it has."""
+    for label in [*c["singular_modes"], *feasible]:
+        if label in feasible and label in c["joints"]:
+            return label
+    return None
+
+
 def mode_line(mode: dict[str, Any]) -> str:
     """The table's line on the working mode the verdict is about."""
     how = {"--mode": "--mode", "document": "the trajectory's mode key",
@@ -320,16 +329,17 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
         if t["candidates"]:
             table = Table(title=title, title_justify="left")
             for col in ("#", *(["segment"] if pieces else []), t["parameter"], *pose,
-                        *[j + (f" [{feasible[0]}]" if feasible else "") for j in joints]):
+                        *joints, "joints of"):
                 table.add_column(col, justify="right")
             table.add_column("singular modes")
             table.add_column("status")
             for i, c in enumerate(t["candidates"], 1):
-                shown = c["joints"].get(feasible[0], {}) if feasible else {}
+                own = row_mode(c, feasible)
+                shown = c["joints"].get(own, {}) if own else {}
                 style = {"real": "red", "spurious": "green"}.get(c["status"], "magenta")
                 table.add_row(str(i), *([str(c.get("segment", 1))] if pieces else []),
                               _num(c["t"], 9), *[_num(c["pose"][v], 4) for v in pose],
-                              *[_num(shown.get(j), 4) for j in joints],
+                              *[_num(shown.get(j), 4) for j in joints], own or "—",
                               ", ".join(c["singular_modes"]) or "none",
                               f"[{style}]{c['status']}[/{style}]")
             console.print(table)

@@ -319,3 +319,17 @@ def test_clearance_length_key_is_read_and_checked(tmp_path):
     robot.write_text(spec + "clearance: {length: 0}\n")
     with pytest.raises(SpecError, match="clearance.length: must be positive"):
         parse_robot(robot.read_text(), str(robot))
+
+
+def test_the_report_with_mode_and_clearance_validates_against_its_schema():
+    from tests.test_schemas import errors, validator
+
+    out = _run("robots/five-bar.yaml", "trajectories/five-bar-free.yaml",
+               "trajectories/five-bar-cross.yaml", "--format", "json", "--mode", "+-",
+               "--min-clearance", "0.6")
+    doc = json.loads(out.stdout)
+    assert [t["verdict"] for t in doc["trajectories"]] == ["near-singular", "singular"]
+    assert errors(validator("report"), doc) == []
+    broken = json.loads(out.stdout)
+    broken["trajectories"][0]["clearance"]["+-"].pop("interval")
+    assert errors(validator("report"), broken)  # the schema does check the new keys

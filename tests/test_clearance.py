@@ -333,3 +333,34 @@ def test_the_report_with_mode_and_clearance_validates_against_its_schema():
     broken = json.loads(out.stdout)
     broken["trajectories"][0]["clearance"]["+-"].pop("interval")
     assert errors(validator("report"), broken)  # the schema does check the new keys
+
+
+def test_the_clearance_figure_follows_the_oracle(five_bar, tmp_path):
+    pytest.importorskip("matplotlib")
+    from singcheck.certify.modes import clearances
+    from singcheck.report.plots import clearance_curves, write_figures
+
+    traj = load_trajectory(str(ROOT / "trajectories/five-bar-free.yaml"), five_bar)
+    report = check(five_bar, traj, regions=False).certificate
+    t, k = clearance_curves(report, ["+-"], samples=50)["+-"]
+    for ti, ki in zip(t, k, strict=True):
+        assert ki == pytest.approx(float(_kappa(_five_bar_rows(*_five_bar_free(
+            mpmath.mpf(ti)), "+-"))), abs=1e-9)
+    found = clearances(report)
+    assert min(k) >= found["+-"].lo  # samples never below the certified lower bound
+    files = write_figures(report, tmp_path, formats=("png",), clearance=found, gate=0.6)
+    assert tmp_path / "five-bar-free-clearance.png" in files
+    plain = write_figures(report, tmp_path / "plain", formats=("png",))
+    assert not any("clearance" in p.name for p in plain)  # only when asked
+
+
+def test_the_html_page_has_the_clearance_figure(tmp_path):
+    pytest.importorskip("plotly")
+    out = subprocess.run([sys.executable, "-m", "singcheck", "plot", "robots/five-bar.yaml",
+                          "trajectories/five-bar-free.yaml", "--out", str(tmp_path),
+                          "--format", "html", "--plotly", "cdn", "--min-clearance", "0.6",
+                          "-q"], capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 0, out.stderr
+    page = (tmp_path / "singcheck.html").read_text()
+    assert "clearance \\u03ba(t)" in page or "clearance κ(t)" in page  # JSON-escaped
+    assert "--min-clearance 0.6" in page and "certified min (+-)" in page

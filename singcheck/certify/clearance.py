@@ -397,6 +397,12 @@ def minimum_clearance(path, mode, length=1, rel_tol: float = REL_TOL,
         count += 1
         heapq.heappush(heap, (low, count, piece))
 
+    for end in (interval.start.ball(), interval.end.ball()):  # a minimum at a range end
+        m_end, _ = gram_at(path, mode, end, length)
+        if m_end is not None:
+            up, estimate = lambda_upper(m_end)  # over the whole ball: holds at the end
+            if up < best[0]:
+                best = (up, estimate, float(end.mid()))
     for piece in pieces(interval):
         visit(piece)
     met = False

@@ -325,6 +325,13 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     engine = api.elimination_engine(backend_name, timeout, not no_cache, progress.note)
     with progress.status(f"projecting {spec.name} onto its workspace ({engine.name})"):
         machine = api.robot_from_spec(spec, cache=not no_cache, engine=engine)
+    if selection.get("mode"):  # the labels need the model's legs
+        from singcheck.certify.modes import check_label
+
+        try:
+            check_label(machine.model, selection["mode"])
+        except SpecError as e:
+            raise click.BadParameter(e.message, param_hint="--mode") from None
     projection = machine.projection
     if projection.expanded:
         degree = projection.singularity_surface.total_degree()
@@ -349,22 +356,16 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
             advance(doc["name"], doc["verdict"])
         sink.finish(code, tolerance, verbose)
     if plot_dir:
-        _plot_all(_certificates(machine, _parsed(kept, spec), time_limit, tolerance),
-                  plot_dir, progress)
+        certificates = _certificates(machine, _parsed(kept, spec), time_limit, tolerance)
+        gate = selection.get("min_clearance")
+        _plot_all(certificates, plot_dir, progress,
+                  _clearances(certificates, bool(selection.get("clearance")), gate), gate)
     return code
 
 
 def _check_selection(spec, selection: dict) -> None:
-    """--mode and --start-joints checked against the robot before any work (exit 2, one
-    line): a label the robot has, joints it has."""
-    from singcheck.certify.modes import check_label
-    from singcheck.model.robot import build_model
-
-    if selection.get("mode"):
-        try:
-            check_label(build_model(spec), selection["mode"])
-        except SpecError as e:
-            raise click.BadParameter(e.message, param_hint="--mode") from None
+    """--start-joints checked against the robot before any work (exit 2, one line): joints
+    it has, and not with --mode (whose label is checked once the model is built)."""
     for name in selection.get("start_joints") or {}:
         if name not in spec.joints:
             raise click.BadParameter(f"{name!r} is not a joint of {spec.name} (joints: "
@@ -548,20 +549,38 @@ def _certificates(machine, specs, time_limit: float, tolerance: float = 1e-9) ->
     return out
 
 
-def _plot_all(certificates, out_dir: str, progress) -> list:
+def _clearances(certificates, want: bool, gate: float | None) -> list | None:
+    """Each certificate's certified clearance per feasible mode (None: not asked)."""
+    if not want and gate is None:
+        return None
+    from singcheck.certify.modes import clearances
+
+    out = []
+    for certificate in certificates:
+        spec = certificate.path.projection.model.spec
+        length = spec.clearance_length if spec.clearance_length is not None else 1
+        out.append(clearances(certificate, length))
+    return out
+
+
+def _plot_all(certificates, out_dir: str, progress, clearance: list | None = None,
+              gate: float | None = None) -> list:
     try:
         from singcheck.report.plots import write_figures
     except ImportError as e:
         raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
                         "missing): pip install 'singcheck[plot]'") from None
     written = []
-    for certificate in certificates:
-        written += write_figures(certificate, out_dir)
+    for i, certificate in enumerate(certificates):
+        written += write_figures(certificate, out_dir,
+                                 clearance=None if clearance is None else clearance[i],
+                                 gate=gate)
     progress.note(f"wrote {len(written)} figure files to {out_dir}")
     return written
 
 
-def _plot_html(certificates, out_dir: str, plotly_js: str = "inline"):
+def _plot_html(certificates, out_dir: str, plotly_js: str = "inline",
+               clearance: list | None = None, gate: float | None = None):
     try:
         import plotly  # noqa: F401
 
@@ -569,7 +588,8 @@ def _plot_html(certificates, out_dir: str, plotly_js: str = "inline"):
     except ImportError as e:
         raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
                         "pip install 'singcheck[html]'") from None
-    return write_html(certificates, os.path.join(out_dir, "singcheck.html"), plotly_js)
+    return write_html(certificates, os.path.join(out_dir, "singcheck.html"), plotly_js,
+                      clearance, gate)
 
 
 @cli.command(epilog="""\b
@@ -603,9 +623,14 @@ Examples:
               help="Seconds allowed to each trajectory's certification and to each region "
               "analysis; past it that figure is not drawn and the command ends with exit "
               "3, unknown: time limit.")
+@click.option("--clearance", "want_clearance", is_flag=True,
+              help="Also draw κ(t), the clearance of each feasible mode, with its certified "
+              "minimum (see `singcheck run --help`).")
+@click.option("--min-clearance", type=click.FloatRange(min=0, min_open=True), metavar="D",
+              help="Draw the gate line κ = D on the clearance figure (implies --clearance).")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 def plot(robot, trajectories, out_dir, backend, fmt, plotly_js, spaces, slices, time_limit,
-         quiet) -> None:
+         want_clearance, min_clearance, quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
     and the working modes in joint space with the joint-limit box (PNG and SVG); when
@@ -632,10 +657,12 @@ def plot(robot, trajectories, out_dir, backend, fmt, plotly_js, spaces, slices, 
             specs = [load_trajectory(p, machine.spec) for p in trajectories]
             certificates = _certificates(machine, specs, time_limit)
             complete &= len(certificates) == len(specs)
+            kappa = _clearances(certificates, want_clearance, min_clearance)
             if fmt == "html":
-                click.echo(str(_plot_html(certificates, out_dir, plotly_js)))
+                click.echo(str(_plot_html(certificates, out_dir, plotly_js, kappa,
+                                          min_clearance)))
             else:
-                for path in _plot_all(certificates, out_dir, progress):
+                for path in _plot_all(certificates, out_dir, progress, kappa, min_clearance):
                     click.echo(str(path))
     if not complete:
         sys.exit(int(ExitCode.UNKNOWN))

@@ -364,3 +364,44 @@ def test_the_html_page_has_the_clearance_figure(tmp_path):
     page = (tmp_path / "singcheck.html").read_text()
     assert "clearance \\u03ba(t)" in page or "clearance κ(t)" in page  # JSON-escaped
     assert "--min-clearance 0.6" in page and "certified min (+-)" in page
+
+
+def _rpr_rows(t, length):
+    """∂F/∂(x, y, φ) of robots/3-rpr.yaml on 3-rpr-free (x = 3 - cos t, y = 1/2 + sin t,
+    φ = t), the φ column divided by ``length``."""
+    x, y, phi = 3 - mpmath.cos(t), mpmath.mpf(1) / 2 + mpmath.sin(t), t
+    c, s = mpmath.cos(phi), mpmath.sin(phi)
+    u2, v2 = x + c - 5, y + s
+    u3, v3 = x - s - 1, y + c - 4
+    rows = [[2 * x, 2 * y, 0],
+            [2 * u2, 2 * v2, 2 * u2 * -s + 2 * v2 * c],
+            [2 * u3, 2 * v3, 2 * u3 * -c + 2 * v3 * -s]]
+    return [[r[0], r[1], r[2] / length] for r in rows]
+
+
+@pytest.mark.parametrize("length", [None, Fraction(1, 2), Fraction(3)])
+def test_the_angle_column_is_scaled_by_the_clearance_length(length):
+    text = (ROOT / "robots/3-rpr.yaml").read_text()
+    if length is not None:
+        text += f"clearance: {{length: {length}}}\n"
+    robot = robot_from_spec(parse_robot(text, "3-rpr.yaml"), "flint", cache=False)
+    traj = load_trajectory(str(ROOT / "trajectories/3-rpr-free.yaml"), robot)
+    doc = check(robot, traj, regions=False, clearance=True).to_dict()
+    scale = mpmath.mpf(length.numerator) / length.denominator if length else 1
+    oracle, _ = _minimum(lambda t: _kappa(_rpr_rows(t, scale)), 0, 1, samples=600)
+    assert doc["clearance"], doc["reason"]
+    for c in doc["clearance"].values():  # det A is free of the joints: every mode alike
+        _assert_encloses(c, oracle, _kappa(_rpr_rows(mpmath.mpf(c["t"]), scale)))
+    assert doc["clearance_settings"]["angle_length"] == str(length or 1)
+    assert doc["clearance_settings"]["angle_length_default"] is (length is None)
+
+
+def test_the_orthoglide_isotropic_pose_has_clearance_one():
+    """At (4/3, 4/3, 4/3) mode +++ has ρ_i = 4/3 + 2/3: the rows (P - ρ_i e_i)/2 are
+    (-1/3, 2/3, 2/3) and its permutations, orthonormal: κ = 1 exactly."""
+    robot = load_robot(str(ROOT / "robots/orthoglide.yaml"), "sympy", cache=False)
+    text = "name: iso\nparameter: t\nrange: [0, 1]\npose: {x: 4/3, y: 4/3, z: 4/3}\n"
+    traj = parse_trajectory(text, "iso.yaml", robot.spec)
+    doc = check(robot, traj, regions=False, clearance=True, mode="+++").to_dict()
+    lo, hi = doc["clearance"]["+++"]["interval"]
+    assert 1 - 1e-6 <= lo <= 1 <= hi + 1e-15 and hi <= 1 + 1e-12

@@ -23,7 +23,16 @@ operation rounds outward), giving M(t) = M₀ + E(t) for every t ∈ T with M₀
   little, and is *proven* a lower bound of λ_min(M₀) by a Cholesky factorisation of
   M₀ - ℓ₀·I in ball arithmetic whose every pivot is proven > 0 (Sylvester: a
   symmetric matrix is positive definite exactly when its leading minors, the products
-  of the pivots, are).  So κ ≥ √max(0, ℓ₀ - ‖r‖_F) on all of T.
+  of the pivots, are).  So κ ≥ √max(0, ℓ₀ - ‖r‖_F) on all of T.  This bound is first
+  order in the width of T, which near a smooth minimum would need very many pieces.
+* **Second-order lower bound on T** (centred form, :func:`piece_lower`): the derivative
+  M' along the path is enclosed over T too (the pose's derivative, each joint's from its
+  leg's constraint, ρ' = -(∂F_i/∂X·X')/(∂F_i/∂ρ), then A' and the Gram matrix's).  By
+  the mean value theorem per entry, M(t) = M(t_c) + h·(G₀ + F) with G₀ the midpoints of
+  the enclosure of M' and |F| ≤ its radii; h ↦ λ_min(M(t_c) + h·G₀) is concave (a
+  minimum of linear functions vᵀ(…)v), so on |h| ≤ w/2 it is at least its smaller value
+  at h = ±w/2 (each bounded as above), and Weyl takes off (w/2)·‖radii of M'‖_F, a
+  second-order term.  The larger of the two lower bounds is used.
 * **Upper bound at a point** (Rayleigh): for any vector v ≠ 0, λ_min(M(t₀)) ≤
   vᵀM(t₀)v / vᵀv; v is the floating-point eigenvector of M₀ at t₀ and the quotient is
   enclosed in ball arithmetic, so κ(t₀) ≤ the square root of its upper end.
@@ -62,9 +71,10 @@ BUDGET = 6000
 #: the narrowest piece halved again, relative to the range's length
 MIN_WIDTH = 2.0 ** -44
 
-METHOD = ("branch-and-bound over t: on each piece, λ_min(M) ≥ ℓ₀ - ‖radii‖_F (Weyl; ℓ₀ "
-          "proven by a ball Cholesky of M₀ - ℓ₀I), at points a Rayleigh quotient, M = NNᵀ "
-          "enclosed in ball arithmetic")
+METHOD = ("ball arithmetic (arb) on M = NNᵀ, N = D^(-1/2)·A, branch-and-bound over t: on "
+          "each piece λ_min(M) ≥ a Weyl bound around a ball-Cholesky-proven ℓ₀ and a "
+          "centred (second-order) form with M' along the path; at points an enclosed "
+          "Rayleigh quotient")
 METHOD_SINGULAR = "0 exactly: det A = 0 at a proven singular time of the mode"
 
 
@@ -408,8 +418,8 @@ def minimum_clearance(path, mode, length=1, rel_tol: float = REL_TOL,
     met = False
     while heap:
         low, _, piece = heap[0]
-        hi = math.sqrt(best[0]) if best[0] < math.inf else math.inf
-        lo = math.sqrt(low)
+        hi = _root_up(best[0])
+        lo = _root_down(low)
         if hi - lo <= wanted_gap(hi, rel_tol):
             met = True
             break
@@ -419,11 +429,21 @@ def minimum_clearance(path, mode, length=1, rel_tol: float = REL_TOL,
         for half in halves(piece):
             visit(half)
     low = heap[0][0] if heap else 0.0
-    hi = math.sqrt(best[0]) if best[0] < math.inf else 1.0
-    lo = min(math.sqrt(low), hi)
+    hi = _root_up(best[0]) if best[0] < math.inf else 1.0
+    lo = min(_root_down(low), hi)
     estimate = min(max(math.sqrt(max(best[1], 0.0)), lo), hi) if best[1] < math.inf else hi
     t = _to_global(path, arb(best[2]))
     return Clearance(mode.label, estimate, lo, hi, t, met, METHOD, count)
+
+
+def _root_up(x: float) -> float:
+    """An upper bound of √x (the float square root, one ulp up: rounding)."""
+    return math.inf if x == math.inf else math.nextafter(math.sqrt(max(x, 0.0)), math.inf)
+
+
+def _root_down(x: float) -> float:
+    """A lower bound of √x (≥ 0)."""
+    return max(0.0, math.nextafter(math.sqrt(max(x, 0.0)), 0.0))
 
 
 def singular_clearance(mode_label: str, t: float) -> Clearance:

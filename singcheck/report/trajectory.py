@@ -285,7 +285,7 @@ def mode_line(mode: dict[str, Any]) -> str:
     return f"  working mode {mode['label']} only (chosen by {how})"
 
 
-def clearance_lines(t: dict[str, Any]) -> list[str]:
+def clearance_lines(t: dict[str, Any], verbose: bool = False) -> list[str]:
     """The table's lines on the certified clearance κ of each considered mode."""
     settings = t.get("clearance_settings") or {}
     length = settings.get("angle_length", "1")
@@ -301,6 +301,8 @@ def clearance_lines(t: dict[str, Any]) -> list[str]:
             "is what the budget reached)"
         lines.append(f"    {label}: min {_num(c['min'], 9)} ∈ [{lo:.9g}, {hi:.9g}] at "
                      f"{t['parameter']} ≈ {_num(c['t'], 9)}{flag}")
+        if verbose and c.get("method"):
+            lines.append(f"      proof: {c['method']}")
     if settings.get("min_clearance") is not None:
         lines.append(f"    gate: --min-clearance {settings['min_clearance']:g}")
     return lines
@@ -367,7 +369,7 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
         if t.get("mode"):
             console.print(mode_line(t["mode"]))
         if t.get("clearance") is not None:
-            for line in clearance_lines(t):
+            for line in clearance_lines(t, verbose):
                 console.print(line)
         if pieces:
             console.print(segments_line(segments))

@@ -405,3 +405,19 @@ def test_the_orthoglide_isotropic_pose_has_clearance_one():
     doc = check(robot, traj, regions=False, clearance=True, mode="+++").to_dict()
     lo, hi = doc["clearance"]["+++"]["interval"]
     assert 1 - 1e-6 <= lo <= 1 <= hi + 1e-15 and hi <= 1 + 1e-12
+
+
+def test_infeasible_names_the_leg_whose_branches_are_complex(five_bar):
+    text = "name: off\nparameter: t\nrange: [0, 1/10]\npose:\n  x: -3 + t\n  y: 2\n"
+    report = check(five_bar, parse_trajectory(text, "off.yaml", five_bar.spec),
+                   regions=False)
+    # the oracle: leg 2 (base (1, 0)) has Δ = W - d² < 0 all along, leg 1 has Δ > 0
+    for i in range(11):
+        t = mpmath.mpf(i) / 100
+        x, y = -3 + t, mpmath.mpf(2)
+        for base, negative in ((-1, False), (1, True)):
+            a, b, d = -4 * (x - base), -4 * y, (x - base) ** 2 + y ** 2
+            assert (a * a + b * b - d * d < 0) is negative
+    assert report.verdict == "infeasible"
+    assert "modes ++, +-, -+, --: th2 has no real solution along the path: both its " \
+           "branches are complex from the start to the end" in report.reason

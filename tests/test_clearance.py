@@ -421,3 +421,30 @@ def test_infeasible_names_the_leg_whose_branches_are_complex(five_bar):
     assert report.verdict == "infeasible"
     assert "modes ++, +-, -+, --: th2 has no real solution along the path: both its " \
            "branches are complex from the start to the end" in report.reason
+
+
+def test_a_spent_budget_reports_the_interval_honestly(five_bar):
+    from singcheck.certify.clearance import minimum_clearance
+    from singcheck.report.trajectory import clearance_lines
+
+    traj = load_trajectory(str(ROOT / "trajectories/five-bar-free.yaml"), five_bar)
+    report = check(five_bar, traj, regions=False).certificate
+    mode = next(m for m in report.modes if m.feasible)
+    c = minimum_clearance(report.path, mode, budget=4)
+    oracle, _ = _minimum(lambda t: _kappa(_five_bar_rows(*_five_bar_free(t), "+-")), 0, 1)
+    assert c.met is False and c.hi - c.lo > TOL * c.hi  # not refined enough ...
+    assert c.lo <= oracle <= c.hi  # ... but still an enclosure
+    lines = clearance_lines({"parameter": "t", "clearance": {"+-": c.to_json()}})
+    assert "tolerance not met" in lines[1]
+
+
+def test_the_gate_is_unknown_when_the_interval_straddles_the_threshold(five_bar):
+    from singcheck.certify.clearance import Clearance
+    from singcheck.certify.modes import gate
+
+    traj = load_trajectory(str(ROOT / "trajectories/five-bar-free.yaml"), five_bar)
+    report = check(five_bar, traj, regions=False).certificate
+    wide = {"+-": Clearance("+-", 0.45, 0.4, 0.5, 0.5, False, "test")}
+    assert gate(report, wide, 0.45)[0] == "unknown"
+    assert gate(report, wide, 0.55)[0] == "near-singular"
+    assert gate(report, wide, 0.35)[0] == "singularity-free"

@@ -23,7 +23,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
-from singcheck.budget import TimeLimitExceeded, deadline
+from singcheck.budget import TimeLimitExceeded, deadline, remaining
 from singcheck.certify.classification import Candidate, TrajectoryReport
 from singcheck.certify.path import PathModel
 from singcheck.certify.pieces import certify_trajectory
@@ -195,13 +195,13 @@ class Report:
                 lo, hi = exit_time
                 doc["reason"] += f"; the path leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"
         elif self.time_limited:
-            doc["reason"] += f" ({self.time_limited} while naming the workspace region)"
+            doc["reason"] += f" ({self.time_limited})"
         doc.update(self.extra)  # the chosen mode, the clearance (when asked for)
         return doc
 
 
 def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAULT_TOLERANCE,
-          regions: bool = True, time_limit: float | None = None,
+          regions: bool | str = True, time_limit: float | None = None,
           notify: Notify = _quiet, engine: str = "auto", mode: str | None = None,
           start_joints: dict | None = None, clearance: bool = False,
           min_clearance: float | None = None) -> Report:
@@ -210,10 +210,12 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
 
     ``time_limit`` (seconds) bounds the whole certification; past it the report's verdict
     is ``unknown`` with the reason (the region statement alone past it is left out, with
-    the reason).  Prints nothing; ``notify`` hears of long steps.  ``engine``: ``auto``
-    (both engines: the exact one where it can run, always held against the interval
-    one; the interval engine alone on a path the exact one refuses), ``exact`` (refuse
-    such a path) or ``interval`` (the interval engine alone).
+    the reason).  The region statement has its own budget of :data:`REGION_BUDGET`
+    seconds (``regions="wait"``: none), past which it is left out and the reason says
+    so: it never holds the verdict back.  Prints nothing; ``notify`` hears of long steps.
+    ``engine``: ``auto`` (both engines: the exact one where it can run, always held
+    against the interval one; the interval engine alone on a path the exact one
+    refuses), ``exact`` (refuse such a path) or ``interval`` (the interval engine alone).
 
     ``mode`` (a working mode's label, else the trajectory's own ``mode``) or
     ``start_joints`` (joint name → exact value at the path's start, which picks the one
@@ -250,20 +252,27 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
             if clearance or min_clearance is not None:
                 extra.update(_clearance(robot, certificate, min_clearance))
         except TimeLimitExceeded as e:
-            return Report(trajectory, certificate, time_limited=str(e), extra=extra)
+            return Report(trajectory, certificate, time_limited=f"{e} while certifying the "
+                          "clearance", extra=extra)
         if not regions or any(r.path.mu is None for r in full.pieces or [full]):
             return Report(trajectory, certificate, extra=extra)  # no region statement
         from singcheck.spaces.path_regions import path_in_workspace, pieces_in_workspace
 
         mu_roots = [c.t for c in full.candidates] if full.mu_roots_complete else None
+        budget = None if regions == "wait" else REGION_BUDGET
+        left = remaining()
+        own = budget is not None and (left is None or left > budget)
         try:
-            if full.pieces:
-                where = pieces_in_workspace(full, tolerance, robot.region_cache, notify)
-            else:
-                where = path_in_workspace(full.path, tolerance, mu_roots=mu_roots,
-                                          region_cache=robot.region_cache, notify=notify)
+            with deadline(budget):
+                if full.pieces:
+                    where = pieces_in_workspace(full, tolerance, robot.region_cache, notify)
+                else:
+                    where = path_in_workspace(full.path, tolerance, mu_roots=mu_roots,
+                                              region_cache=robot.region_cache, notify=notify)
         except TimeLimitExceeded as e:
-            return Report(trajectory, certificate, time_limited=str(e), extra=extra)
+            why = (f"workspace region not computed: its own budget of {budget:g} s ran out "
+                   "(--regions waits for it)") if own else f"{e} while naming the workspace region"
+            return Report(trajectory, certificate, time_limited=why, extra=extra)
         return Report(trajectory, certificate, where, extra=extra)
 
 
@@ -285,6 +294,11 @@ def _clearance(robot: Robot, certificate: TrajectoryReport, threshold: float | N
                                    "angle_length_default": given is None,
                                    "tolerance": f"hi - lo <= {REL_TOL:g}*max(min, 1e-3)",
                                    "min_clearance": threshold}}
+
+
+#: seconds the region statement may take beside a verdict (``regions="wait"``: no budget
+#: of its own, only the trajectory's time limit): it never holds the verdict back
+REGION_BUDGET = 2.0
 
 
 #: the default per-trajectory time limit of a batch (seconds): generous, but finite

@@ -11,7 +11,7 @@ import time
 import pytest
 
 from singcheck import api
-from tests.conftest import ROBOTS
+from tests.conftest import ROBOTS, TRAJECTORIES
 from tests.test_hardening import (  # noqa: F401
     BIG_CONSTANT,
     cache_env,
@@ -352,3 +352,18 @@ def test_a_costly_leg_is_refused_up_front_though_legs_compose_lazily(orthoglide_
         P.build_path(orthoglide_projection, spec)
     message = str(refused.value)
     assert "too costly: a leg's constraint along the path" in message and "\n" not in message
+
+
+def test_the_region_statement_never_holds_the_verdict(monkeypatch):
+    """Past its own budget the region statement is left out, with the reason and how to
+    ask for it; the verdict is the one certified (heart 1: singular).  With
+    ``regions="wait"`` it is computed within the trajectory's time limit."""
+    robot = api.load_robot(ROBOTS / "orthoglide.yaml", backend="flint", cache=False)
+    traj = api.load_trajectory(TRAJECTORIES / "heart1.yaml", robot)
+    monkeypatch.setattr(api, "REGION_BUDGET", 1e-6)
+    hurried = api.check(robot, traj, time_limit=120)
+    assert hurried.verdict == "singular" and hurried.workspace is None
+    assert "workspace region not computed: its own budget" in hurried.to_dict()["reason"]
+    assert "--regions waits for it" in hurried.to_dict()["reason"]
+    waited = api.check(robot, traj, time_limit=120, regions="wait")
+    assert waited.verdict == "singular" and waited.workspace is not None

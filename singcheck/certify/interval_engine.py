@@ -117,8 +117,8 @@ def mode_values(path, modes: list, t: arb):
 
 
 def search_det_a(path, modes: list, refine: set[str] | None = None,
-                 budget: int | None = None, hints: dict | None = None
-                 ) -> dict[str, ModeSearch]:
+                 budget: int | None = None, hints: dict | None = None,
+                 mean_value_form: bool = True) -> dict[str, ModeSearch]:
     """Branch-and-bound of det A along each of ``modes`` (given as feasible) over the
     path's closed range.  Only the modes in ``refine`` (default: all) are refined past the
     first cover; the others are enclosed once on each of its pieces (a mode said to be
@@ -140,9 +140,15 @@ def search_det_a(path, modes: list, refine: set[str] | None = None,
     while todo:  # breadth first: a spent budget leaves the whole range equally refined
         checkpoint()
         piece, open_modes = todo.popleft()
-        _, _, values = mode_values(path, open_modes, piece)
+        _, joints, values = mode_values(path, open_modes, piece)
         left -= 1
         lo, hi = float(piece.lower()), float(piece.upper())
+        unproven = [m for m in open_modes if not (isinstance(values[m.label], arb)
+                                                 and excludes_zero(values[m.label]))]
+        if unproven and mean_value_form:
+            for label, v in mean_value(path, unproven, piece, joints).items():
+                if excludes_zero(v) or not isinstance(values[label], arb):
+                    values[label] = v
         again = []
         for mode in open_modes:
             v = values[mode.label]
@@ -179,4 +185,111 @@ def _summarise(label: str, found: dict) -> ModeSearch:
     if run:
         out.windows.append(Window(run[0][0], run[-1][1], max(r[2] for r in run), before,
                                   None))
+    return out
+
+
+# -- the mean-value form: det A(T) ⊆ det A(m) + (d/dt det A)(T)·(T − m) ---------------------
+
+_DERIVATIVES: dict = {}
+
+
+def _derivative_parts(model):
+    """Per model, once: ∂det A/∂v for every variable v it involves, and per leg its
+    constraint's partial derivatives in the pose variables and in its joint."""
+    from singcheck.algebra.polynomials import coefficient_in, memo_per_object
+    from singcheck.model.robot import REVOLUTE
+
+    def build(model):
+        names = model.context.names()
+        n_joint = len(model.joint_variables)
+        n_pose = len(model.pose_variables)
+        pose_range = range(n_joint, n_joint + n_pose)
+        det = [(i, model.det_A.derivative(i)) for i, d in enumerate(model.det_A.degrees())
+               if d > 0 and i < n_joint + n_pose]
+        legs = []
+        for leg in model.legs:
+            f = leg.constraint
+            dx = [(i, f.derivative(i)) for i in pose_range if f.degrees()[i] > 0]
+            idx = [names.index(v) for v in leg.variables]
+            if leg.kind == REVOLUTE:
+                legs.append((REVOLUTE, idx, dx, (coefficient_in(f, idx[0], 1),
+                                                 coefficient_in(f, idx[1], 1))))
+            else:
+                legs.append(("prismatic", idx, dx, f.derivative(idx[0])))
+        return n_joint, det, legs
+
+    return memo_per_object(_DERIVATIVES, model, build)
+
+
+_PATH_DERIVATIVES: dict = {}
+
+
+def _pose_derivatives(path) -> list | None:
+    """d/dt of each pose variable along the path (None where the path ring has angle
+    functions of its own: no mean-value form there)."""
+    from singcheck.algebra.polynomials import memo_per_object
+    from singcheck.algebra.radicals import has_angle_functions, path_derivative
+
+    def build(path):
+        if any(has_angle_functions(x.context()) for x in path.coordinates):
+            return None
+        return [path_derivative(x) for x in path.coordinates]
+
+    return memo_per_object(_PATH_DERIVATIVES, path, build)
+
+
+def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
+    """det A per mode over the ball ``t`` in mean-value form (None for a mode where it
+    could not be formed): det A at the midpoint, plus the enclosure of its derivative
+    along the mode over ``t`` times (t − m).  The derivative: ∂det A/∂v · v' summed over
+    the pose variables (v' from d/dt of the path) and the joints (implicit
+    differentiation of each leg f(ρ, X) = 0: ρ' = −(∇ₓf·X')/(∂f/∂ρ); a revolute joint's
+    θ' = −(∇ₓf·X')/(b·cos θ − a·sin θ), then (cos θ)' = −sin θ·θ', (sin θ)' = cos θ·θ').
+    Every quantity is a ball enclosing its values over ``t``, so the result encloses
+    det A over ``t`` (the mean value theorem, on a continuous branch of a feasible mode).
+    ``joints``: each mode's joint balls over ``t`` (:func:`mode_values`)."""
+    from singcheck.algebra.intervals import evaluate
+    from singcheck.algebra.radicals import evaluate_path, radical_balls
+    from singcheck.model.robot import REVOLUTE
+
+    model = path.projection.model
+    dpose = _pose_derivatives(path)
+    if dpose is None or len(model.det_A) > 5000:
+        return {}
+    n_joint, det_parts, legs = _derivative_parts(model)
+    m = arb(t.mid())
+    _, _, at_mid = mode_values(path, modes, m)
+    variables = path.pose_variables_at(t)
+    rates = [evaluate_path(d, t) for d in dpose]
+    radicals = [b for _, b in sorted(radical_balls(model.context).items())]
+    out = {}
+    for mode in modes:
+        js, mid = joints[mode.label], at_mid[mode.label]
+        if not isinstance(mid, arb) or any(j is None for j in js):
+            continue
+        flat = []
+        for j in js:
+            flat += list(j) if isinstance(j, tuple) else [j]
+        if not all(isinstance(v, arb) for v in flat):
+            continue
+        point = flat + list(variables) + radicals
+        powers: dict = {}
+        speed = [arb(0)] * n_joint + rates
+        for kind, idx, dx, lead in legs:
+            push = arb(0)
+            for i, p in dx:
+                push += evaluate(p, point, powers) * speed[i]
+            if kind == REVOLUTE:
+                c, s = point[idx[0]], point[idx[1]]
+                a, b = (evaluate(q, point, powers) for q in lead)
+                rate = -push / (b * c - a * s)
+                speed[idx[0]], speed[idx[1]] = -s * rate, c * rate
+            else:
+                speed[idx[0]] = -push / evaluate(lead, point, powers)
+        slope = arb(0)
+        for i, p in det_parts:
+            slope += evaluate(p, point, powers) * speed[i]
+        value = mid + slope * (t - m)
+        if value.is_finite():
+            out[mode.label] = value
     return out

@@ -131,6 +131,10 @@ def cli() -> None:
 @click.option("--no-regions", is_flag=True,
               help="Skip the workspace-region statement (where the path lies among the "
                    "regions of the workspace): faster batches.")
+@click.option("--regions", "wait_regions", is_flag=True,
+              help="Wait for the workspace-region statement however long it takes (within "
+                   "--time-limit); by default it gets 2 s beside the verdict and is left "
+                   "out, with the reason, past them.")
 @click.option("--scheduler", metavar="ADDRESS", envvar="SINGCHECK_SCHEDULER",
               show_envvar=True,
               help="Run the batch on this dask.distributed scheduler (e.g. "
@@ -175,8 +179,8 @@ def cli() -> None:
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
 def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs,
-        time_limit, no_regions, scheduler, plot_dir, interpolation, as_csv, columns, scale,
-        engine, mode, start_joints, want_clearance, min_clearance, quiet,
+        time_limit, no_regions, wait_regions, scheduler, plot_dir, interpolation, as_csv,
+        columns, scale, engine, mode, start_joints, want_clearance, min_clearance, quiet,
         verbose) -> None:  # engine: which certifies (--backend eliminates)
     """Certify each TRAJECTORY of ROBOT (YAML spec files; - reads standard input; a
     trajectory may also be a CSV table of poses).  A YAML file may hold several
@@ -210,7 +214,8 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
                     verbose, progress, jobs, plot_dir, interpolation, time_limit=time_limit,
-                    regions=not no_regions, scheduler=scheduler, table=table,
+                    regions=False if no_regions else "wait" if wait_regions else True,
+                    scheduler=scheduler, table=table,
                     all_csv=as_csv, certify_with=engine, selection=selection)
     sys.exit(int(code))
 

@@ -196,12 +196,15 @@ class Report:
                 doc["reason"] += f"; the path leaves the workspace at t ∈ [{lo:.9g}, {hi:.9g}]"
         elif self.time_limited:
             doc["reason"] += f" ({self.time_limited})"
+        doc.update(self.extra)  # the chosen mode, the clearance (when asked for)
         return doc
 
 
 def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAULT_TOLERANCE,
           regions: bool | str = True, time_limit: float | None = None,
-          notify: Notify = _quiet, engine: str = "auto") -> Report:
+          notify: Notify = _quiet, engine: str = "auto", mode: str | None = None,
+          start_joints: dict | None = None, clearance: bool = False,
+          min_clearance: float | None = None) -> Report:
     """Certify one trajectory of ``robot``: candidate singular times, their classification
     per working mode, the verdict, and (``regions``) where the path lies in the workspace.
 
@@ -213,36 +216,86 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
     ``engine``: ``auto`` (both engines: the exact one where it can run, always held
     against the interval one; the interval engine alone on a path the exact one
     refuses), ``exact`` (refuse such a path) or ``interval`` (the interval engine alone).
+
+    ``mode`` (a working mode's label, else the trajectory's own ``mode``) or
+    ``start_joints`` (joint name → exact value at the path's start, which picks the one
+    mode matching them: :func:`singcheck.certify.modes.mode_at_start`) makes the verdict
+    about that mode alone.  ``clearance`` adds each considered mode's certified minimum
+    of κ (:mod:`singcheck.certify.clearance`); ``min_clearance`` (implies it) makes a
+    nonsingular path whose κ is proven below it ``near-singular``.  A label the robot
+    lacks, or start joints matching no mode or several, raise
+    :class:`~singcheck.errors.SpecError`.
     """
+    from singcheck.certify import modes as working
+
+    label = mode or trajectory.mode
+    chosen_by = "--mode" if mode else "document" if label else None
+    if label:
+        working.check_label(robot.model, label, trajectory.path,
+                            None if mode else "mode")
     with deadline(time_limit):
         try:
             certificate = certify_trajectory(robot.projection, trajectory, tolerance, engine)
         except TimeLimitExceeded as e:
             return Report(trajectory, None, time_limited=str(e))
-        if not regions or any(r.path.exact_refused for r in certificate.pieces or [certificate]):
-            return Report(trajectory, certificate)  # no region statement without ξ along it
+        full = certificate
+        extra: dict = {}
+        try:
+            if start_joints and not label:
+                label, chosen_by = working.mode_at_start(certificate, start_joints), \
+                    "--start-joints"
+            if label:
+                certificate = working.restrict(certificate, label)
+                extra["mode"] = {"label": label, "chosen_by": chosen_by}
+                if chosen_by == "--start-joints":
+                    extra["mode"]["start_tolerance"] = working.START_TOLERANCE
+            if clearance or min_clearance is not None:
+                extra.update(_clearance(robot, certificate, min_clearance))
+        except TimeLimitExceeded as e:
+            return Report(trajectory, certificate, time_limited=f"{e} while certifying the "
+                          "clearance", extra=extra)
+        if not regions or any(r.path.exact_refused for r in full.pieces or [full]):
+            return Report(trajectory, certificate, extra=extra)  # no region statement
         from singcheck.spaces.path_regions import path_in_workspace, pieces_in_workspace
 
-        mu_roots = ([c.t for c in certificate.candidates]
-                    if certificate.mu_roots_complete else None)
         budget = None if regions == "wait" else region_budget()
         left = remaining()
         own = budget is not None and (left is None or left > budget)
         try:
             with deadline(budget):
-                if not _with_mu(certificate):
-                    return Report(trajectory, certificate)
-                if certificate.pieces:
-                    where = pieces_in_workspace(certificate, tolerance, robot.region_cache,
-                                                notify)
+                if not _with_mu(full):
+                    return Report(trajectory, certificate, extra=extra)
+                mu_roots = [c.t for c in full.candidates] if full.mu_roots_complete else None
+                if full.pieces:
+                    where = pieces_in_workspace(full, tolerance, robot.region_cache, notify)
                 else:
-                    where = path_in_workspace(certificate.path, tolerance, mu_roots=mu_roots,
+                    where = path_in_workspace(full.path, tolerance, mu_roots=mu_roots,
                                               region_cache=robot.region_cache, notify=notify)
         except TimeLimitExceeded as e:
             why = (f"workspace region not computed: its own budget of {budget:g} s ran out "
                    "(--regions waits for it)") if own else f"{e} while naming the workspace region"
-            return Report(trajectory, certificate, time_limited=why)
-        return Report(trajectory, certificate, where)
+            return Report(trajectory, certificate, time_limited=why, extra=extra)
+        return Report(trajectory, certificate, where, extra=extra)
+
+
+def _clearance(robot: Robot, certificate: TrajectoryReport, threshold: float | None) -> dict:
+    """The clearance keys of the report (and the gate applied to ``certificate``'s
+    verdict, in place)."""
+    from fractions import Fraction
+
+    from singcheck.certify import modes as working
+    from singcheck.certify.clearance import REL_TOL
+
+    given = robot.spec.clearance_length
+    length = given if given is not None else Fraction(1)
+    found = working.clearances(certificate, length)
+    if threshold is not None:
+        certificate.verdict, certificate.reason = working.gate(certificate, found, threshold)
+    return {"clearance": {label: c.to_json() for label, c in found.items()},
+            "clearance_settings": {"angle_length": str(length),
+                                   "angle_length_default": given is None,
+                                   "tolerance": f"hi - lo <= {REL_TOL:g}*max(min, 1e-3)",
+                                   "min_clearance": threshold}}
 
 
 def _with_mu(certificate) -> bool:
@@ -413,7 +466,7 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
                 tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
                 time_limit: float | None = DEFAULT_TIME_LIMIT, jobs: int = 1,
                 ordered: bool = True, notify: Notify = _quiet,
-                engine: str = "auto") -> Iterator[dict]:
+                engine: str = "auto", **selection) -> Iterator[dict]:
     """Certify many trajectories, in ``jobs`` forked processes when there are more than 4;
     yields each one's JSON trajectory object as soon as it is known: in input order, or
     (``ordered=False``) in the order they finish.
@@ -423,11 +476,12 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
     which the workers parse), so memory does not grow with their number.  One
     trajectory's failure is its own result (:func:`check_item`); a worker process that
     dies makes the trajectories it held ``error`` results.  ``time_limit`` bounds each
-    trajectory (and the shared region maps, once)."""
+    trajectory (and the shared region maps, once).  ``selection``: :func:`check`'s
+    ``mode``, ``start_joints``, ``clearance`` and ``min_clearance``, for each trajectory."""
     from itertools import chain, islice
 
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
-                   notify=notify, engine=engine)
+                   notify=notify, engine=engine, **selection)
     items = iter(trajectories)
     head = list(islice(items, LOOKAHEAD))
     if jobs > 1 and len(head) > 4:

@@ -66,7 +66,8 @@ def check_on_cluster(address: str, robot: Robot,
                      trajectories: Iterable[TrajectorySpec | Document], *,
                      tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
                      time_limit: float | None = DEFAULT_TIME_LIMIT, ordered: bool = True,
-                     notify: Notify = _quiet, engine: str = "auto") -> Iterator[dict]:
+                     notify: Notify = _quiet, engine: str = "auto",
+                     **selection) -> Iterator[dict]:
     """:func:`singcheck.api.check_batch` on the dask.distributed scheduler at
     ``address``: yields each trajectory's JSON object in input order, or
     (``ordered=False``) as the tasks finish.  ``trajectories`` is read lazily, a bounded
@@ -83,7 +84,7 @@ def check_on_cluster(address: str, robot: Robot,
         threads = sum(w.get("nthreads", 1) for w in workers.values())
         notify(f"dask scheduler {address}: {len(workers)} worker(s)")
         options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
-                       engine=engine)
+                       engine=engine, **selection)
         items = iter(trajectories)
         head = list(islice(items, LOOKAHEAD))
         shared_regions(robot, head, options, notify)

@@ -589,6 +589,20 @@ def _on_surface_candidate(path, mode, status, proof) -> Candidate:
                      state, on_surface=(t, end) if status == SINGULAR else None)
 
 
+def infeasibility(modes) -> str:
+    """Why each mode is infeasible, per mode (modes sharing every reason grouped): which
+    joint leaves which limit when, which branch is complex or meets the other."""
+    by_reason: dict[str, list[str]] = {}
+    for m in modes:
+        if m.status != INFEASIBLE:
+            continue
+        reasons = list(dict.fromkeys(b.reason for b in m.branches
+                                     if b.status == INFEASIBLE and b.reason)) or [m.reason]
+        by_reason.setdefault("; ".join(reasons), []).append(m.label)
+    return "; ".join(f"mode{'s' if len(labels) > 1 else ''} {', '.join(labels)}: {why}"
+                     for why, labels in by_reason.items())
+
+
 def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
     """The verdict and its one-sentence reason from the modes' feasibility, the
     classified candidates and what root isolation left undecided."""
@@ -605,11 +619,8 @@ def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
         return VERDICT_SINGULAR, (f"working mode {label} is singular at t ≈ "
                                   f"{float(c.t.mid()):.6g}")
     if not feasible and not unsure:
-        reasons = list(dict.fromkeys(b.reason for m in modes if m.status == INFEASIBLE
-                                     for b in m.branches
-                                     if b.status == INFEASIBLE and b.reason))
         return VERDICT_INFEASIBLE, "no working mode stays in the workspace and joint limits: " \
-            + "; ".join(reasons)
+            + infeasibility(modes)
     if unsure:
         return VERDICT_UNKNOWN, "feasibility of working mode(s) " + ", ".join(
             f"{m.label} ({m.reason})" for m in unsure) + " could not be proven"

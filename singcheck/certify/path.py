@@ -178,7 +178,12 @@ def joint_float(value) -> float | None:
     if isinstance(value, arb):
         return float(value.mid())
     if isinstance(value, tuple) and all(isinstance(v, arb) for v in value):
-        return float(arb.atan2(value[1], value[0]).mid())
+        # from the midpoints: atan2 of balls whose sine straddles 0 on the negative cosine
+        # side (θ = π) is the whole (-π, π], whose midpoint 0 is the wrong display
+        import math
+
+        angle = math.atan2(float(value[1].mid()), float(value[0].mid()))
+        return math.pi if angle <= -math.pi else angle
     return None
 
 

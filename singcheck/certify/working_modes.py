@@ -247,8 +247,8 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when,
         if d > 0:
             return FEASIBLE, "", None
         if d < 0:
-            return INFEASIBLE, f"{joint} has no real solution along the path " \
-                "(outside the workspace)", None
+            return INFEASIBLE, f"{joint} has no real solution along the path: both its " \
+                "branches are complex from the start to the end (outside the workspace)", None
     return UNKNOWN, f"the sign of the discriminant of {joint} could not be decided", None
 
 

@@ -34,12 +34,25 @@ Working modes (+++, +-, ooo, ...): one character per leg, in the order of the jo
   -  the other branch: -√D (the other elbow posture)
   o  the only branch of a leg linear in its joint (ρ = -c/b): nothing to choose
 A mode is feasible when each of its branches stays real, apart from the other branch
-and inside the joint limits along the whole path.
+and inside the joint limits along the whole path.  A robot runs in one mode: --mode
+LABEL (or mode: LABEL in a trajectory document, quoted: mode: "-+") makes the verdict,
+exit status, table and JSON about that mode alone; --start-joints th1=pi/2,th2=0.3
+picks the one mode whose joints at the start are within 1e-6 of those values (for an
+angle, of (cos, sin): about 1e-6 rad); none or several is an error (exit 2).
+
+\b
+Clearance (--clearance, --min-clearance D): κ(t), the smallest singular value of the
+leg-normalised Jacobian D^(-1/2)·A (A = ∂F/∂X, each leg's row scaled to length 1), is
+0 exactly at a parallel singularity and 1 where the legs' rows are orthonormal; a pose
+angle's column is divided by the robot's clearance: {length: L} (default 1).  Each
+considered mode gets its certified minimum over the path and where, within
+1e-6·max(κ, 1e-3) (ball arithmetic, branch-and-bound over t).  With --min-clearance D a
+nonsingular path whose κ is proven below D is near-singular (exit 1).
 
 \b
 Exit status:
   0  every trajectory is proven singularity-free
-  1  some trajectory is singular or infeasible
+  1  some trajectory is singular, infeasible or near-singular (--min-clearance)
   2  bad command line or bad spec file
   3  some trajectory could not be decided (unknown), none singular
   4  an elimination backend is missing or failed
@@ -154,12 +167,26 @@ def cli() -> None:
 @click.option("--certificate", "certificate_dir", type=click.Path(file_okay=False),
               help="Write DIR/<trajectory>.cert.json for each trajectory: the claim and a "
                    "proof that `singcheck verify` re-checks without a CAS.")
+@click.option("--mode", "mode", metavar="LABEL",
+              help="The robot's working mode (e.g. +-+, see below): the verdict, exit status, "
+                   "table and JSON are about it alone; overrides a document's mode key.")
+@click.option("--start-joints", metavar="NAME=VALUE,...",
+              help="Pick the working mode whose joints at each path's start are within 1e-6 "
+                   "of these exact values (angles in radians, pi allowed; for an angle the "
+                   "distance of (cos, sin)); no match or several is an error.")
+@click.option("--clearance", "want_clearance", is_flag=True,
+              help="Also certify each considered mode's minimum clearance κ over the path "
+                   "(see below).")
+@click.option("--min-clearance", type=click.FloatRange(min=0, min_open=True), metavar="D",
+              help="A nonsingular path whose clearance κ in a considered mode is proven "
+                   "below D is near-singular (exit 1); implies --clearance.")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 @click.option("-v", "--verbose", is_flag=True,
               help="Show root enclosures and the proof used for every mode and candidate.")
 def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output, jobs,
         time_limit, no_regions, wait_regions, scheduler, plot_dir, interpolation, as_csv,
-        columns, scale, engine, certificate_dir, quiet,
+        columns, scale, engine, certificate_dir, mode, start_joints, want_clearance,
+        min_clearance, quiet,
         verbose) -> None:  # engine: which certifies (--backend eliminates)
     """Certify each TRAJECTORY of ROBOT (YAML spec files; - reads standard input; a
     trajectory may also be a CSV table of poses).  A YAML file may hold several
@@ -188,12 +215,15 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
         require_extra("plot")
     progress = Progress(quiet)
     table = csv_format(interpolation, columns, scale)
+    selection = {"mode": mode, "start_joints": _start_joints(start_joints),
+                 "clearance": want_clearance, "min_clearance": min_clearance}
     with exit_codes():
         code = _run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
                     verbose, progress, jobs, plot_dir, interpolation, time_limit=time_limit,
                     regions=False if no_regions else "wait" if wait_regions else True,
                     scheduler=scheduler, table=table,
-                    all_csv=as_csv, certify_with=engine, certificate_dir=certificate_dir)
+                    all_csv=as_csv, certify_with=engine, certificate_dir=certificate_dir,
+                    selection=selection)
     sys.exit(int(code))
 
 
@@ -205,7 +235,7 @@ _SEVERITY = [ExitCode.SINGULARITY_FREE, ExitCode.UNKNOWN, ExitCode.SINGULAR,
 
 def _outcome(doc: dict) -> ExitCode:
     verdict = doc["verdict"]
-    if verdict in ("singular", "infeasible"):
+    if verdict in ("singular", "infeasible", "near-singular"):
         return ExitCode.SINGULAR
     if verdict == "singularity-free":
         return ExitCode.SINGULARITY_FREE
@@ -250,6 +280,23 @@ def _pairs(text: str | None, option: str, value) -> list[tuple[str, object]]:
     return list(out.items())
 
 
+def _start_joints(text: str | None) -> dict | None:
+    """--start-joints as {joint: exact value a + b·π}; a malformed one is exit 2."""
+    if not text:
+        return None
+    return dict(_pairs(text, "--start-joints", _angle_or_number))
+
+
+def _angle_or_number(text: str):
+    from singcheck.spec.grammar import ExprError, compile_constant, parse
+
+    try:
+        return compile_constant(parse(text))
+    except ExprError as e:
+        raise ValueError(f"{e} in {text!r} (give an exact number, e.g. 1/2, 0.25 or "
+                         "2*pi/3)") from None
+
+
 def _factor(text: str):
     """An exact, non-zero rational factor (singcheck's grammar: 1/1000, 0.001, 1e-3)."""
     from singcheck.spec.grammar import ExprError, compile_constant, parse
@@ -267,7 +314,7 @@ def _factor(text: str):
 def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, output, verbose,
          progress, jobs, plot_dir=None, interpolation="cubic", *, time_limit=300.0,
          regions=True, scheduler=None, table=None, all_csv=False, certify_with="auto",
-         certificate_dir=None):
+         certificate_dir=None, selection=None):
     from contextlib import closing
     from itertools import chain, islice
 
@@ -292,9 +339,18 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     kept: list = []
     if plot_dir:
         items = _keeping(items, kept)
+    selection = {k: v for k, v in (selection or {}).items() if v}
+    _check_selection(spec, selection)
     engine = api.elimination_engine(backend_name, timeout, not no_cache, progress.note)
     with progress.status(f"projecting {spec.name} onto its workspace ({engine.name})"):
         machine = api.robot_from_spec(spec, cache=not no_cache, engine=engine)
+    if selection.get("mode"):  # the labels need the model's legs
+        from singcheck.certify.modes import check_label
+
+        try:
+            check_label(machine.model, selection["mode"])
+        except SpecError as e:
+            raise click.BadParameter(e.message, param_hint="--mode") from None
     projection = machine.projection
     if projection.expanded:
         degree = projection.singularity_surface.total_degree()
@@ -302,7 +358,8 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     else:
         progress.note(f"singularity surface: not expanded: {projection.not_expanded}")
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
-                   ordered=fmt != "jsonl", notify=progress.note, engine=certify_with)
+                   ordered=fmt != "jsonl", notify=progress.note, engine=certify_with,
+                   **selection)
     if scheduler:
         from singcheck.cluster import check_on_cluster
 
@@ -321,8 +378,10 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
             advance(doc["name"], doc["verdict"])
         sink.finish(code, tolerance, verbose)
     if plot_dir:
-        _plot_all(_certificates(machine, _parsed(kept, spec), time_limit, tolerance),
-                  plot_dir, progress)
+        certificates = _certificates(machine, _parsed(kept, spec), time_limit, tolerance)
+        gate = selection.get("min_clearance")
+        _plot_all(certificates, plot_dir, progress,
+                  _clearances(certificates, bool(selection.get("clearance")), gate), gate)
     return code
 
 
@@ -348,6 +407,18 @@ def _certify(directory, robot_text: str, texts: dict, doc: dict, used: set, prog
     progress.note(f"certificate: {target}" + (
         f" (not re-checkable: {cert['not_recheckable']})" if cert["proof"] is None else
         f" ({cert['incomplete']})" if "incomplete" in cert else ""))
+
+
+def _check_selection(spec, selection: dict) -> None:
+    """--start-joints checked against the robot before any work (exit 2, one line): joints
+    it has, and not with --mode (whose label is checked once the model is built)."""
+    for name in selection.get("start_joints") or {}:
+        if name not in spec.joints:
+            raise click.BadParameter(f"{name!r} is not a joint of {spec.name} (joints: "
+                                     f"{', '.join(spec.joints)})", param_hint="--start-joints")
+    if selection.get("mode") and selection.get("start_joints"):
+        raise click.BadParameter("give --mode or --start-joints, not both",
+                                 param_hint="--start-joints")
 
 
 def _keeping(items, kept: list):
@@ -524,20 +595,38 @@ def _certificates(machine, specs, time_limit: float, tolerance: float = 1e-9) ->
     return out
 
 
-def _plot_all(certificates, out_dir: str, progress) -> list:
+def _clearances(certificates, want: bool, gate: float | None) -> list | None:
+    """Each certificate's certified clearance per feasible mode (None: not asked)."""
+    if not want and gate is None:
+        return None
+    from singcheck.certify.modes import clearances
+
+    out = []
+    for certificate in certificates:
+        spec = certificate.path.projection.model.spec
+        length = spec.clearance_length if spec.clearance_length is not None else 1
+        out.append(clearances(certificate, length))
+    return out
+
+
+def _plot_all(certificates, out_dir: str, progress, clearance: list | None = None,
+              gate: float | None = None) -> list:
     try:
         from singcheck.report.plots import write_figures
     except ImportError as e:
         raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
                         "missing): pip install 'singcheck[plot]'") from None
     written = []
-    for certificate in certificates:
-        written += write_figures(certificate, out_dir)
+    for i, certificate in enumerate(certificates):
+        written += write_figures(certificate, out_dir,
+                                 clearance=None if clearance is None else clearance[i],
+                                 gate=gate)
     progress.note(f"wrote {len(written)} figure files to {out_dir}")
     return written
 
 
-def _plot_html(certificates, out_dir: str, plotly_js: str = "inline"):
+def _plot_html(certificates, out_dir: str, plotly_js: str = "inline",
+               clearance: list | None = None, gate: float | None = None):
     try:
         import plotly  # noqa: F401
 
@@ -545,7 +634,8 @@ def _plot_html(certificates, out_dir: str, plotly_js: str = "inline"):
     except ImportError as e:
         raise SpecError(f"--format html needs plotly and numpy ({e.name} is missing): "
                         "pip install 'singcheck[html]'") from None
-    return write_html(certificates, os.path.join(out_dir, "singcheck.html"), plotly_js)
+    return write_html(certificates, os.path.join(out_dir, "singcheck.html"), plotly_js,
+                      clearance, gate)
 
 
 @cli.command(epilog="""\b
@@ -579,9 +669,14 @@ Examples:
               help="Seconds allowed to each trajectory's certification and to each region "
               "analysis; past it that figure is not drawn and the command ends with exit "
               "3, unknown: time limit.")
+@click.option("--clearance", "want_clearance", is_flag=True,
+              help="Also draw κ(t), the clearance of each feasible mode, with its certified "
+              "minimum (see `singcheck run --help`).")
+@click.option("--min-clearance", type=click.FloatRange(min=0, min_open=True), metavar="D",
+              help="Draw the gate line κ = D on the clearance figure (implies --clearance).")
 @click.option("-q", "--quiet", is_flag=True, help="No progress notes on stderr.")
 def plot(robot, trajectories, out_dir, backend, fmt, plotly_js, spaces, slices, time_limit,
-         quiet) -> None:
+         want_clearance, min_clearance, quiet) -> None:
     """Draw the paper's figures for each TRAJECTORY of ROBOT: μ(t) with its certified
     roots, det A along the feasible modes, the path with ξ(X) = 0 in the workspace,
     and the working modes in joint space with the joint-limit box (PNG and SVG); when
@@ -608,10 +703,12 @@ def plot(robot, trajectories, out_dir, backend, fmt, plotly_js, spaces, slices, 
             specs = [load_trajectory(p, machine.spec) for p in trajectories]
             certificates = _certificates(machine, specs, time_limit)
             complete &= len(certificates) == len(specs)
+            kappa = _clearances(certificates, want_clearance, min_clearance)
             if fmt == "html":
-                click.echo(str(_plot_html(certificates, out_dir, plotly_js)))
+                click.echo(str(_plot_html(certificates, out_dir, plotly_js, kappa,
+                                          min_clearance)))
             else:
-                for path in _plot_all(certificates, out_dir, progress):
+                for path in _plot_all(certificates, out_dir, progress, kappa, min_clearance):
                     click.echo(str(path))
     if not complete:
         sys.exit(int(ExitCode.UNKNOWN))

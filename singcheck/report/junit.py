@@ -53,8 +53,8 @@ def testcase(robot: dict[str, Any], t: dict[str, Any]) -> ET.Element:
     if verdict == "singular":
         times = _singular_times(t)
         message = f"singular: {times}" if times else f"singular: {t['reason']}"
-    elif verdict == "infeasible":
-        message = f"infeasible: {t['reason']}"
+    elif verdict in ("infeasible", "near-singular"):
+        message = f"{verdict}: {t['reason']}"
     elif verdict in ("unknown", "error"):
         kind = t.get("error", {}).get("kind", "")
         el = ET.SubElement(case, "error", message=t["reason"],
@@ -68,10 +68,23 @@ def testcase(robot: dict[str, Any], t: dict[str, Any]) -> ET.Element:
     return case
 
 
+def clearance_properties(trajectories: list[dict[str, Any]]) -> dict[str, str]:
+    """``clearance.TRAJECTORY.MODE`` = "min κ in [lo, hi] at t = …" per considered mode
+    (suite properties: the JUnit schema gives a testcase none)."""
+    out = {}
+    for t in trajectories:
+        for label, c in (t.get("clearance") or {}).items():
+            lo, hi = c["interval"]
+            out[f"clearance.{t['name']}.{label}"] = (f"{c['min']:.9g} in [{lo:.9g}, {hi:.9g}] "
+                                                      f"at {t['parameter']} = {c['t']:.9g}")
+    return out
+
+
 def junit_xml(robot: dict[str, Any], trajectories: list[dict[str, Any]],
               properties: dict[str, str]) -> str:
     """The whole report: one suite (this run's robot) holding one case per trajectory."""
-    failures = sum(t["verdict"] in ("singular", "infeasible") for t in trajectories)
+    failures = sum(t["verdict"] in ("singular", "infeasible", "near-singular")
+                   for t in trajectories)
     errors = sum(t["verdict"] in ("unknown", "error") for t in trajectories)
     total = sum(t.get("time_s", 0) for t in trajectories)
     counts = {"tests": str(len(trajectories)), "failures": str(failures),
@@ -81,7 +94,7 @@ def junit_xml(robot: dict[str, Any], trajectories: list[dict[str, Any]],
                           timestamp=datetime.now(UTC).strftime("%Y-%m-%dT%H:%M:%S"),
                           hostname=platform.node() or "localhost")
     props = ET.SubElement(suite, "properties")
-    for name, value in properties.items():
+    for name, value in {**properties, **clearance_properties(trajectories)}.items():
         if value is not None:  # not known on this run (ξ not expanded: no degree)
             ET.SubElement(props, "property", name=name, value=str(value))
     for t in trajectories:

@@ -332,9 +332,60 @@ def _limit_box(ax, limits) -> None:
                 ax.plot(*[[x, y] for x, y in zip(a, b, strict=True)], color="grey", lw=0.6)
 
 
+def clearance_curves(report: TrajectoryReport, labels, samples: int = 400) -> dict:
+    """κ(t) sampled along each mode (floating point, for the figure only: the marks on it
+    are the certified minima): label -> (t in the user's parameter, κ) arrays."""
+    from flint import arb
+
+    from singcheck.certify.clearance import kappa_at
+
+    spec = report.path.projection.model.spec
+    length = spec.clearance_length if spec.clearance_length is not None else 1
+    pieces = report.pieces or [report]
+    out = {}
+    for label in labels:
+        ts, ks = [], []
+        for piece in pieces:
+            mode = next(m for m in piece.modes if m.label == label)
+            lo = float(piece.path.trajectory.range.start)
+            hi = float(piece.path.trajectory.range.end)
+            for t in np.linspace(lo, hi, max(2, samples // len(pieces))):
+                k = kappa_at(piece.path, mode, float(t), length)
+                ts.append(float(piece.path.trajectory.to_global(arb(float(t))).mid()))
+                ks.append(np.nan if k is None else k)
+        out[label] = (np.array(ts), np.array(ks))
+    return out
+
+
+def _clearance_figure(plt, report: TrajectoryReport, clearance: dict, gate, title: str):
+    """κ(t) per considered mode, its certified minimum (a marker with the interval) and
+    the --min-clearance line."""
+    fig, ax = plt.subplots(figsize=(7, 4))
+    curves = clearance_curves(report, list(clearance))
+    for label, c in clearance.items():
+        t, k = curves[label]
+        line, = ax.plot(t, k, lw=1, label=f"κ along mode {label}")
+        lo, hi = c.lo, c.hi
+        ax.errorbar([c.t], [c.estimate], yerr=[[c.estimate - lo], [hi - c.estimate]],
+                    fmt="v", color=line.get_color(), ms=7,
+                    label=f"certified min ({label}): {c.estimate:.6g} ∈ [{lo:.6g}, {hi:.6g}]")
+    if gate is not None:
+        ax.axhline(gate, color="red", lw=1, ls="--", label=f"--min-clearance {gate:g}")
+    ax.set_ylim(0, 1.02)
+    ax.set_xlabel(report.trajectory.parameter)
+    ax.set_ylabel("κ (leg-normalised Jacobian)")
+    ax.set_title(title)
+    if clearance or gate is not None:
+        ax.legend(fontsize=7)
+    return fig
+
+
 def write_figures(report: TrajectoryReport, out_dir: str | Path,
-                  formats: tuple[str, ...] = ("png", "svg"), dpi: int = 120) -> list[Path]:
-    """Write the figures for one trajectory; returns the files written."""
+                  formats: tuple[str, ...] = ("png", "svg"), dpi: int = 120,
+                  clearance: dict | None = None, gate: float | None = None) -> list[Path]:
+    """Write the figures for one trajectory; returns the files written.  With
+    ``clearance`` (label -> :class:`~singcheck.certify.clearance.Clearance`), also κ(t)
+    per mode with its certified minimum and the ``gate`` line."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -360,6 +411,9 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
             " and at its singular times" if any(m.singular_times for m in report.modes
                                                 if m.feasible) else
             " (no singular time on a feasible mode)"))
+    if clearance is not None:
+        makers["clearance"] = lambda: _clearance_figure(
+            plt, report, clearance, gate, f"{robot} · {name}: clearance κ(t)")
     written = []
     for key in makers:
         fig = makers[key]()
@@ -374,19 +428,21 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
 
 
 def write_html(reports: list[TrajectoryReport], target: str | Path,
-               plotly_js: str = "inline") -> Path:
+               plotly_js: str = "inline", clearances: list | None = None,
+               gate: float | None = None) -> Path:
     """One self-contained interactive page (plotly, its JavaScript inlined once) with
     the same four figures for every trajectory, and the robot moving along it
     (:mod:`singcheck.report.animation`) when its spec has a drawing.  ``plotly_js="cdn"``:
     the page loads plotly's JavaScript from its CDN instead (a few MB smaller; needs the
-    network to be viewed)."""
+    network to be viewed).  ``clearances`` (per report, label -> Clearance) adds κ(t)
+    per mode with its certified minimum and the ``gate`` line."""
     import plotly.graph_objects as go
 
     from singcheck.atomic import write_atomically
 
     parts = []
     first = True
-    for report in reports:
+    for index, report in enumerate(reports):
         d = figure_data(report)
         robot = report.path.projection.model.name
         figs = []
@@ -446,6 +502,9 @@ def write_html(reports: list[TrajectoryReport], target: str | Path,
         else:
             js.update_layout(xaxis_title=names[0], yaxis_title=names[1])
         figs.append(js)
+        if clearances is not None:
+            figs.append(_clearance_html(go, report, clearances[index], gate,
+                                        f"{robot} · {report.name}: clearance κ(t)"))
         from singcheck.report.animation import animation_figure
 
         moving = animation_figure(report, d, f"{robot} · {report.name}: the robot along "
@@ -459,3 +518,23 @@ def write_html(reports: list[TrajectoryReport], target: str | Path,
             "</title></head><body>\n" + "\n".join(parts) + "\n</body></html>\n")
     write_atomically(target, page, make_parents=True)
     return Path(target)
+
+
+def _clearance_html(go, report: TrajectoryReport, clearance: dict, gate, title: str):
+    fig = go.Figure()
+    curves = clearance_curves(report, list(clearance))
+    for label, c in clearance.items():
+        t, k = curves[label]
+        fig.add_trace(go.Scatter(x=t, y=k, mode="lines", name=f"κ ({label})"))
+        fig.add_trace(go.Scatter(
+            x=[c.t], y=[c.estimate], mode="markers", name=f"certified min ({label})",
+            marker={"symbol": "triangle-down", "size": 11},
+            error_y={"type": "data", "symmetric": False, "array": [c.hi - c.estimate],
+                     "arrayminus": [c.estimate - c.lo]},
+            hovertext=f"min κ ∈ [{c.lo:.9g}, {c.hi:.9g}] at t ≈ {c.t:.9g}"))
+    if gate is not None:
+        fig.add_hline(y=gate, line_dash="dash", line_color="red",
+                      annotation_text=f"--min-clearance {gate:g}")
+    fig.update_layout(title=title, yaxis_range=[0, 1.02],
+                      xaxis_title=report.trajectory.parameter, yaxis_title="κ")
+    return fig

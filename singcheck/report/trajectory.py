@@ -21,6 +21,7 @@ _VERDICT_STYLE = {
     "singularity-free": "bold green",
     "singular": "bold red",
     "infeasible": "bold yellow",
+    "near-singular": "bold yellow",
     "unknown": "bold magenta",
 }
 
@@ -267,6 +268,46 @@ def _singular_at(m: dict[str, Any]) -> str:
     return ", ".join(_num(x, 6) for x in m["singular_times"]) or "—"
 
 
+def row_mode(c: dict[str, Any], feasible: list[str]) -> str | None:
+    """The mode a candidate's row is about: the first feasible mode singular there, else
+    the first feasible mode whose joints it has."""
+    for label in [*c["singular_modes"], *feasible]:
+        if label in feasible and label in c["joints"]:
+            return label
+    return None
+
+
+def mode_line(mode: dict[str, Any]) -> str:
+    """The table's line on the working mode the verdict is about."""
+    how = {"--mode": "--mode", "document": "the trajectory's mode key",
+           "--start-joints": "--start-joints, joints at the start within "
+                             f"{mode.get('start_tolerance', 1e-6):g}"}[mode["chosen_by"]]
+    return f"  working mode {mode['label']} only (chosen by {how})"
+
+
+def clearance_lines(t: dict[str, Any], verbose: bool = False) -> list[str]:
+    """The table's lines on the certified clearance κ of each considered mode."""
+    settings = t.get("clearance_settings") or {}
+    length = settings.get("angle_length", "1")
+    note = " (default)" if settings.get("angle_length_default", True) else ""
+    head = ("  clearance κ (smallest singular value of the leg-normalised Jacobian; a pose "
+            f"angle's column ÷ L = {length}{note}):")
+    lines = [head]
+    if not t["clearance"]:
+        lines.append("    none: no considered working mode is feasible")
+    for label, c in t["clearance"].items():
+        lo, hi = c["interval"]
+        flag = "" if c.get("tolerance_met", True) else " (tolerance not met: the interval " \
+            "is what the budget reached)"
+        lines.append(f"    {label}: min {_num(c['min'], 9)} ∈ [{lo:.9g}, {hi:.9g}] at "
+                     f"{t['parameter']} ≈ {_num(c['t'], 9)}{flag}")
+        if verbose and c.get("method"):
+            lines.append(f"      proof: {c['method']}")
+    if settings.get("min_clearance") is not None:
+        lines.append(f"    gate: --min-clearance {settings['min_clearance']:g}")
+    return lines
+
+
 def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, Any]],
                   verbose: bool = False) -> None:
     """Print one candidates table and one working-modes table per trajectory.
@@ -290,16 +331,17 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
         if t["candidates"]:
             table = Table(title=title, title_justify="left")
             for col in ("#", *(["segment"] if pieces else []), t["parameter"], *pose,
-                        *[j + (f" [{feasible[0]}]" if feasible else "") for j in joints]):
+                        *joints, "joints of"):
                 table.add_column(col, justify="right")
             table.add_column("singular modes")
             table.add_column("status")
             for i, c in enumerate(t["candidates"], 1):
-                shown = c["joints"].get(feasible[0], {}) if feasible else {}
+                own = row_mode(c, feasible)
+                shown = c["joints"].get(own, {}) if own else {}
                 style = {"real": "red", "spurious": "green"}.get(c["status"], "magenta")
                 table.add_row(str(i), *([str(c.get("segment", 1))] if pieces else []),
                               _num(c["t"], 9), *[_num(c["pose"][v], 4) for v in pose],
-                              *[_num(shown.get(j), 4) for j in joints],
+                              *[_num(shown.get(j), 4) for j in joints], own or "—",
                               ", ".join(c["singular_modes"]) or "none",
                               f"[{style}]{c['status']}[/{style}]")
             console.print(table)
@@ -324,6 +366,11 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
             lo, hi = u["t_interval"]
             console.print(f"  undecided for {t['parameter']} in [{lo:.9g}, {hi:.9g}]: "
                           f"{u['reason']}")
+        if t.get("mode"):
+            console.print(mode_line(t["mode"]))
+        if t.get("clearance") is not None:
+            for line in clearance_lines(t, verbose):
+                console.print(line)
         if pieces:
             console.print(segments_line(segments))
         if t.get("workspace"):

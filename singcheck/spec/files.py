@@ -47,9 +47,10 @@ __all__ = ["RobotSpec", "TrajectorySpec", "load_robot", "load_trajectory",
 
 ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
               "parameters": False, "constraints": True, "joint_limits": False,
-              "drawing": False}
+              "drawing": False, "clearance": False}
 TRAJECTORY_KEYS = {"name": True, "parameter": True, "range": False, "pose": False,
-                   "segments": False, "waypoints": False, "interpolation": False}
+                   "segments": False, "waypoints": False, "interpolation": False,
+                   "mode": False}
 RESERVED = {"pi", "sin", "cos", "sqrt"}
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z_0-9]*\Z")
 MAX_BYTES = 1_000_000
@@ -108,6 +109,9 @@ class RobotSpec:
         return tuple(radical_name(p) for p in self.radicals)
 
     drawing: tuple[DrawingBody, ...] = ()  # the optional ``drawing`` key
+    #: ``clearance: {length: L}``: a pose angle's column of A is divided by L when the
+    #: clearance κ is computed (None: not given, 1)
+    clearance_length: Fraction | None = None
 
     @property
     def drawing_dimension(self) -> int | None:
@@ -425,9 +429,25 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                        {v: final[v] for v in joints + pose if v not in angles}, parameters,
                        {v: tuple(final[n] for n in angle_names(v)) for v in angles}) \
         if "drawing" in top else ()
+    length = _clearance_length(doc, top["clearance"][1]) if "clearance" in top else None
     return RobotSpec(path, name, description, joints, pose, parameters, ctx,
                      tuple(constraints), tuple(constraint_lines), limits, lines,
-                     angles=angles, radicals=used, drawing=drawing)
+                     angles=angles, radicals=used, drawing=drawing, clearance_length=length)
+
+
+def _clearance_length(doc: _Doc, node) -> Fraction:
+    """The ``clearance`` key: ``{length: L}``, L > 0 exact (the length that turns a pose
+    angle's column of A into a length, for the clearance κ)."""
+    items = doc.mapping(node, "clearance")
+    for key, (knode, _) in items.items():
+        if key != "length":
+            raise doc.error(knode, f"clearance.{key}", "unknown key (clearance has: length)")
+    if "length" not in items:
+        raise doc.error(node, "clearance", "expected {length: L}")
+    length = doc.number(items["length"][1], "clearance.length")
+    if not length > 0:
+        raise doc.error(items["length"][1], "clearance.length", "must be positive")
+    return length
 
 
 def _drawing(doc: _Doc, node, ctx, variables, parameters,
@@ -509,6 +529,22 @@ def parse_trajectory(text: str, path: str, robot: RobotSpec) -> TrajectorySpec:
 
 
 def _trajectory(root, path: str, robot: RobotSpec) -> TrajectorySpec:
+    """A trajectory document, with its optional ``mode`` (a working mode's label, checked
+    against the robot when the path is certified)."""
+    from dataclasses import replace
+
+    spec = _trajectory_body(root, path, robot)
+    top = _Doc(path).keys(root, TRAJECTORY_KEYS, "trajectory")
+    if "mode" in top:
+        label = _Doc(path).text(top["mode"][1], "mode")
+        if not label or set(label) - set("+-o"):
+            raise _Doc(path).error(top["mode"][1], "mode", f"{label!r} is not a working "
+                                   "mode label (one of +, -, o per leg, e.g. +-+)")
+        spec = replace(spec, mode=label)
+    return spec
+
+
+def _trajectory_body(root, path: str, robot: RobotSpec) -> TrajectorySpec:
     doc = _Doc(path)
     top = doc.keys(root, TRAJECTORY_KEYS, "trajectory")
     lines = {k: _line(knode) for k, (knode, _) in top.items()}

@@ -51,6 +51,8 @@ class TrajectorySpec:
     #: t₀ when the pose is written in the local time u = t − t₀ (interpolated pieces: small
     #: u keeps ball evaluations tight and coefficients small); ``range`` is then in u.
     time_offset: Fraction = Fraction(0)
+    #: the working mode the verdict is about (the document's ``mode`` key; None: all)
+    mode: str | None = None
 
     def __repr__(self) -> str:  # short: the pose polynomials can run to kilobytes
         pieces = f", {len(self.segments)} pieces" if self.segments else ""

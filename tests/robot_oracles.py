@@ -701,11 +701,15 @@ def judge(oracle: Oracle, pose: Callable[[object], list], start, end, samples: i
     values = {mode: [] for mode in candidates}
     for X, b in zip(poses, branches, strict=True):  # each pose once, for every mode
         for mode in candidates:
-            values[mode].append(oracle.det_A([b[i][k] for i, k in enumerate(mode)], X))
+            q = None if None in b else [b[i][k] for i, k in enumerate(mode)]
+            values[mode].append(None if q is None else oracle.det_A(q, X))
     modes = []
     for mode in itertools.product((0, 1), repeat=len(oracle.legs)):
         if mode not in values:
             modes.append(ModeJudgement(mode, BAD, [], False, False))
+            continue
+        if None in values[mode]:  # marginal, and not even real at some sample: no verdict
+            modes.append(ModeJudgement(mode, MARGINAL, [], False, False))
             continue
 
         def g(t, mode=mode):

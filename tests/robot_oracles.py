@@ -13,6 +13,7 @@ disagreement with singcheck's answer instead of being copied into the expected o
 
 from __future__ import annotations
 
+import functools
 import itertools
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -37,6 +38,7 @@ class Leg:
     lo: object
     hi: object
     revolute: bool = False
+    abc: Callable[[list], tuple] | None = None  # the leg's equation's coefficients
 
 
 @dataclass(frozen=True)
@@ -54,6 +56,21 @@ class Oracle:
                 return None
             out.append(both[k])
         return out
+
+
+def last_pose_memo(f):
+    """f(X) remembered for the last pose X only (the legs of a pose are asked for once per
+    leg and per branch)."""
+    last: dict = {}
+
+    def memo(X):
+        key = tuple(X)
+        if key not in last:
+            last.clear()
+            last[key] = f(X)
+        return last[key]
+
+    return memo
 
 
 def _revolute(abc: Callable[[list], tuple]) -> Callable[[list], tuple | None]:
@@ -79,17 +96,19 @@ def _wrap(lo):
 
 
 def revolute_leg(joint: str, abc, lo, hi) -> Leg:
+    abc = last_pose_memo(abc)
     raw, wrap = _revolute(abc), _wrap(lo)
 
     def branches(X):
         both = raw(X)
         return None if both is None else tuple(wrap(v) for v in both)
 
-    return Leg(joint, branches, lo, hi, revolute=True)
+    return Leg(joint, branches, lo, hi, revolute=True, abc=abc)
 
 
 def quadratic_leg(joint: str, abc, lo, hi) -> Leg:
     """ρ = (-b ± √(b² - 4ac)) / 2a for ``a ρ² + b ρ + c = 0``."""
+    abc = last_pose_memo(abc)
 
     def branches(X):
         a, b, c = abc(X)
@@ -98,15 +117,46 @@ def quadratic_leg(joint: str, abc, lo, hi) -> Leg:
             return None
         return (-b + mp.sqrt(d)) / (2 * a), (-b - mp.sqrt(d)) / (2 * a)
 
-    return Leg(joint, branches, lo, hi)
+    return Leg(joint, branches, lo, hi, abc=abc)
+
+
+def det(rows) -> object:
+    """A determinant by Gaussian elimination with partial pivoting (plain lists of mpf:
+    the same 50 digits as ``mp.det``, without its matrix objects)."""
+    m = [list(row) for row in rows]
+    n, value = len(m), mp.mpf(1)
+    for c in range(n):
+        p = max(range(c, n), key=lambda r: abs(m[r][c]))
+        if m[p][c] == 0:
+            return mp.mpf(0)
+        if p != c:
+            m[c], m[p], value = m[p], m[c], -value
+        value *= m[c][c]
+        for r in range(c + 1, n):
+            f = m[r][c] / m[c][c]
+            m[r] = [m[r][k] - f * m[c][k] if k > c else 0 for k in range(n)]
+    return value
+
+
+@functools.lru_cache(maxsize=1 << 14)
+def cos_sin(angle) -> tuple:
+    """cos and sin of a joint angle (the same branch values recur in every mode)."""
+    return mp.cos(angle), mp.sin(angle)
 
 
 def det3(rows) -> object:
-    return mp.det(mp.matrix(rows))
+    (a, b, c), (d, e, f), (g, h, i) = rows
+    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
 
 
 def cross(u, v):
     return [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+
+
+def exact(v) -> object:
+    """An int or Fraction as an mpf (to 50 digits)."""
+    v = Fraction(v)
+    return mp.mpf(v.numerator) / v.denominator
 
 
 # --- the robots --------------------------------------------------------------------------
@@ -276,20 +326,20 @@ def rotation_zyx(cz, sz, cy, sy, cx, sx):
             (-sy, cy * sx, cy * cx))
 
 
-def gough_stewart_legs(p, R):
+def gough_stewart_legs(p, R, base=GS_BASE, platform=GS_PLATFORM):
     """u_i = p + R b_i - a_i for the six legs (b_i, a_i in their planes z = 0)."""
     out = []
-    for (ax, ay), (bx, by) in zip(GS_BASE, GS_PLATFORM, strict=True):
+    for (ax, ay), (bx, by) in zip(base, platform, strict=True):
         out.append([p[0] + R[0][0] * bx + R[0][1] * by - ax,
                     p[1] + R[1][0] * bx + R[1][1] * by - ay,
                     p[2] + R[2][0] * bx + R[2][1] * by])
     return out
 
 
-def plucker_matrix(p, R):
+def plucker_matrix(p, R, base=GS_BASE, platform=GS_PLATFORM):
     """Rows (u_i, a_i × u_i): the legs' lines in Plücker coordinates."""
     rows = []
-    for u, (ax, ay) in zip(gough_stewart_legs(p, R), GS_BASE, strict=True):
+    for u, (ax, ay) in zip(gough_stewart_legs(p, R, base, platform), base, strict=True):
         rows.append([*u, *cross([ax, ay, 0], u)])
     return rows
 
@@ -303,19 +353,137 @@ def gough_stewart() -> Oracle:
                          mp.cos(X[5]), mp.sin(X[5]))
         return X[:3], R
 
+    base, platform = ([[exact(v) for v in point] for point in points]
+                      for points in (GS_BASE, GS_PLATFORM))  # to 50 digits once
+
+    @last_pose_memo
+    def legs_at(X):
+        return gough_stewart_legs(*pose_parts(X), base, platform)
+
     def abc(i):
         def f(X):
-            u = gough_stewart_legs(*pose_parts(X))[i]
+            u = legs_at(X)[i]
             return -1, 0, u[0] ** 2 + u[1] ** 2 + u[2] ** 2
 
         return f
 
     def det_A(q, X):
-        p, R = pose_parts(X)
-        return -64 * mp.cos(X[4]) * mp.det(mp.matrix(plucker_matrix(p, R)))
+        rows = [[*u, *cross([ax, ay, 0], u)] for u, (ax, ay) in zip(legs_at(X), base,
+                                                                       strict=True)]
+        return -64 * mp.cos(X[4]) * det(rows)
 
     legs = tuple(quadratic_leg(f"r{i + 1}", abc(i), 1, 5) for i in range(6))
     return Oracle("gough-stewart", ("x", "y", "z", "psi", "theta", "phi"), legs, det_A)
+
+
+# The 6-RUS rotary hexapod (tests/data/robots/6-rus.yaml): base points 2 u_i, arms of
+# length 1 turning in the vertical plane tangent to the base circle (elbow
+# 2 u_i + cos θ t_i - sin θ e_z, t_i = (-u_iy, u_ix, 0)), distal links 5/2 to the platform
+# points p + R u_i.  Directions u_i with rational cosines and sines.
+RUS_DIRECTIONS = ((1, 0), (Fraction(-3, 5), Fraction(4, 5)), (Fraction(-3, 5), Fraction(-4, 5)),
+                  (-1, 0), (Fraction(3, 5), Fraction(-4, 5)), (Fraction(3, 5), Fraction(4, 5)))
+RUS_BASE, RUS_ARM, RUS_LINK = 2, 1, Fraction(5, 2)
+
+
+def matmul(A, B):
+    return [[sum(A[i][k] * B[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+
+
+def matvec(A, v):
+    return [sum(A[i][k] * v[k] for k in range(3)) for i in range(3)]
+
+
+def euler_zyx(psi, theta, phi):
+    """R = Rz(ψ)·Ry(θ)·Rx(φ) and its three partial derivatives, as 3×3 lists."""
+    cz, sz, cy, sy, cx, sx = (mp.cos(psi), mp.sin(psi), mp.cos(theta), mp.sin(theta),
+                              mp.cos(phi), mp.sin(phi))
+    Rz, dRz = [[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]], [[-sz, -cz, 0], [cz, -sz, 0], [0, 0, 0]]
+    Ry, dRy = [[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]], [[-sy, 0, cy], [0, 0, 0], [-cy, 0, -sy]]
+    Rx, dRx = [[1, 0, 0], [0, cx, -sx], [0, sx, cx]], [[0, 0, 0], [0, -sx, -cx], [0, cx, -sx]]
+    return (matmul(matmul(Rz, Ry), Rx), matmul(matmul(dRz, Ry), Rx),
+            matmul(matmul(Rz, dRy), Rx), matmul(matmul(Rz, Ry), dRx))
+
+
+def six_rus() -> Oracle:
+    """det A = det[∂F_i/∂(x, y, z, ψ, θ, φ)] / 2⁶ with F_i = |P_i - E_i|² - (5/2)²:
+    row i is (d_i, d_i·(∂R/∂ψ) u_i, d_i·(∂R/∂θ) u_i, d_i·(∂R/∂φ) u_i), d_i = P_i - E_i."""
+
+    rotation = last_pose_memo(lambda X: euler_zyx(X[3], X[4], X[5]))
+
+    def parts(i, X):
+        ux, uy = (exact(v) for v in RUS_DIRECTIONS[i])
+        R, *dR = rotation(X)
+        Ru = matvec(R, [ux, uy, 0])
+        w = [X[k] + Ru[k] - RUS_BASE * (ux, uy, 0)[k] for k in range(3)]  # P_i - 2 u_i
+        return (ux, uy), w, [matvec(D, [ux, uy, 0]) for D in dR]
+
+    def abc(i):
+        def f(X):  # |w - la(cos θ t - sin θ e_z)|² - lb² = a cos θ + b sin θ + c
+            (ux, uy), w, _ = parts(i, X)
+            return (-2 * RUS_ARM * (-uy * w[0] + ux * w[1]), 2 * RUS_ARM * w[2],
+                    w[0] ** 2 + w[1] ** 2 + w[2] ** 2 + RUS_ARM ** 2 - exact(RUS_LINK) ** 2)
+
+        return f
+
+    def det_A(q, X):
+        rows = []
+        for i in range(6):
+            (ux, uy), w, dRu = parts(i, X)
+            c, s = cos_sin(q[i])
+            d = [w[0] + RUS_ARM * c * uy, w[1] - RUS_ARM * c * ux, w[2] + RUS_ARM * s]
+            rows.append(d + [sum(d[k] * v[k] for k in range(3)) for v in dRu])
+        return det(rows)
+
+    legs = tuple(revolute_leg(f"th{i + 1}", abc(i), -PI, PI) for i in range(6))
+    return Oracle("6-rus", ("x", "y", "z", "psi", "theta", "phi"), legs, det_A)
+
+
+# A planar 3-RRR (tests/data/robots/3-rrr.yaml): base revolutes at A_i = 2 u_i + J u_i
+# (J the quarter turn), arms 1, distal links 1 to the platform points p + R(φ) u_i.
+RRR_DIRECTIONS = ((1, 0), (Fraction(-3, 5), Fraction(4, 5)), (Fraction(-3, 5), Fraction(-4, 5)))
+RRR_ARM, RRR_LINK = 1, 1
+
+
+def three_rrr() -> Oracle:
+    """det A ∝ det[d_i, (R u_i) × d_i] (d_i = B_i - E_i: distal link i), zero where the
+    three distal links' lines meet in a point (or are parallel)."""
+
+    directions = [[exact(v) for v in u] for u in RRR_DIRECTIONS]
+    bases = [(2 * ux - uy, 2 * uy + ux) for ux, uy in directions]
+
+    def base(i):
+        return bases[i]
+
+    @last_pose_memo
+    def platform_points(X):
+        return [(rx, ry, X[0] + rx, X[1] + ry) for rx, ry in
+                (rotate2(X[2], u) for u in directions)]
+
+    def platform(i, X):
+        return platform_points(X)[i]
+
+    def abc(i):
+        def f(X):  # |B - A - la (cos θ, sin θ)|² - lb²
+            ax, ay = base(i)
+            _, _, bx, by = platform(i, X)
+            wx, wy = bx - ax, by - ay
+            return (-2 * RRR_ARM * wx, -2 * RRR_ARM * wy,
+                    wx * wx + wy * wy + RRR_ARM ** 2 - RRR_LINK ** 2)
+
+        return f
+
+    def det_A(q, X):
+        rows = []
+        for i in range(3):
+            ax, ay = base(i)
+            rx, ry, bx, by = platform(i, X)
+            c, s = cos_sin(q[i])
+            dx, dy = bx - ax - RRR_ARM * c, by - ay - RRR_ARM * s
+            rows.append([dx, dy, rx * dy - ry * dx])
+        return det3(rows)
+
+    legs = tuple(revolute_leg(f"th{i + 1}", abc(i), -PI, PI) for i in range(3))
+    return Oracle("3-rrr", ("x", "y", "phi"), legs, det_A)
 
 
 # --- the trajectories ----------------------------------------------------------------
@@ -429,3 +597,132 @@ def solve(path: Path, samples: int = 400) -> OracleAnswer:
                  for k in range(samples) if (values[k] > 0) != (values[k + 1] > 0)]
         feasible.append(OracleMode(mode, oracle.joints(mode, poses[0]), roots))
     return OracleAnswer(feasible)
+
+
+# --- a conservative judgement of any path (the campaign) --------------------------------
+
+#: |det A| below this, computed at 50 digits, is an exact zero (a singular pose)
+ZERO = mp.mpf(10) ** -40
+#: a joint's margin (to its limits, or between its two branches) under this is marginal
+MARGIN = mp.mpf(10) ** -3
+#: along a moving path, min |det A| / max |det A| over the samples above this is "bounded
+#: away from 0"; at a constant pose, |det A| above ABSOLUTE is
+RELATIVE = mp.mpf(10) ** -3
+ABSOLUTE = mp.mpf(10) ** -20
+
+OK, MARGINAL, BAD = 0, 1, 2
+
+
+def _branch_margins(leg: Leg, abc, both) -> list:
+    """Per branch: the smaller of its distance to the other branch and to the limits
+    (negative when not real, or outside a limit)."""
+    a, b, c = abc
+    if leg.revolute:
+        gap = 1 - abs(c / mp.sqrt(a * a + b * b))
+    else:
+        d = b * b - 4 * a * c
+        gap = mp.sign(d) * mp.sqrt(abs(d)) / abs(a)
+    if both is None:
+        return [gap, gap]
+    unlimited = leg.hi - leg.lo >= 2 * PI
+    return [gap if unlimited else min(gap, v - leg.lo, leg.hi - v) for v in both]
+
+
+def _grade(margin) -> int:
+    return OK if margin > MARGIN else BAD if margin < -MARGIN else MARGINAL
+
+
+@dataclass
+class ModeJudgement:
+    mode: tuple[int, ...]
+    feasibility: int  # OK, MARGINAL (close to a limit or to the other branch) or BAD
+    zeros: list  # times where det A vanishes (|det A| < ZERO at a sample) or changes sign
+    whole: bool  # det A vanishes at every sample
+    bounded: bool  # no zero, and |det A| bounded away from 0 (RELATIVE, ABSOLUTE)
+
+
+@dataclass
+class Judgement:
+    """The oracle's answer for one path, with its doubts."""
+
+    modes: list[ModeJudgement]
+
+    def _of(self, *grades):
+        return [m for m in self.modes if m.feasibility in grades]
+
+    @property
+    def feasible(self) -> list[ModeJudgement]:
+        return self._of(OK)
+
+    @property
+    def verdict(self) -> str | None:
+        """singular, singularity-free or infeasible when certain; None when a mode is
+        marginal or det A comes close to 0 without a sign change."""
+        sure, doubtful = self._of(OK), self._of(MARGINAL)
+        if any(m.zeros for m in sure):
+            return "singular"
+        if any(not m.bounded for m in sure + doubtful):
+            return None
+        if sure:
+            return "singularity-free"
+        return None if doubtful else "infeasible"
+
+    @property
+    def required_times(self) -> list:
+        return sorted(t for m in self.feasible for t in m.zeros)
+
+    @property
+    def allowed_times(self) -> list:
+        return sorted(t for m in self._of(OK, MARGINAL) for t in m.zeros)
+
+    @property
+    def whole(self) -> bool:
+        return any(m.whole for m in self._of(OK, MARGINAL))
+
+
+def judge(oracle: Oracle, pose: Callable[[object], list], start, end, samples: int = 400,
+          constant: bool = False) -> Judgement:
+    """Judge a path: grade each working mode's feasibility at every sample (constant: at
+    the one pose) and find det A's zeros and sign changes along the modes not proven
+    infeasible (bisected to far below 1e-6)."""
+    start, end = mp.mpf(start), mp.mpf(end)
+    n = 0 if constant else samples
+    ts = [start + (end - start) * k / samples for k in range(n + 1)]
+    poses = [pose(t) for t in ts]
+    branches = []
+    grades = [[OK, OK] for _ in oracle.legs]  # per leg and branch: the worst over the samples
+    for X in poses:
+        branches.append([leg.branches(X) for leg in oracle.legs])
+        for i, leg in enumerate(oracle.legs):
+            for k, margin in enumerate(_branch_margins(leg, leg.abc(X), branches[-1][i])):
+                grades[i][k] = max(grades[i][k], _grade(margin))
+    candidates = [mode for mode in itertools.product((0, 1), repeat=len(oracle.legs))
+                  if max(grades[i][k] for i, k in enumerate(mode)) != BAD]
+    values = {mode: [] for mode in candidates}
+    for X, b in zip(poses, branches, strict=True):  # each pose once, for every mode
+        for mode in candidates:
+            q = None if None in b else [b[i][k] for i, k in enumerate(mode)]
+            values[mode].append(None if q is None else oracle.det_A(q, X))
+    modes = []
+    for mode in itertools.product((0, 1), repeat=len(oracle.legs)):
+        if mode not in values:
+            modes.append(ModeJudgement(mode, BAD, [], False, False))
+            continue
+        if None in values[mode]:  # marginal, and not even real at some sample: no verdict
+            modes.append(ModeJudgement(mode, MARGINAL, [], False, False))
+            continue
+
+        def g(t, mode=mode):
+            X = pose(t)
+            return oracle.det_A(oracle.joints(mode, X), X)
+
+        v = values[mode]
+        zero = [abs(value) < ZERO for value in v]
+        zeros = [t for t, z in zip(ts, zero, strict=True) if z]
+        zeros += [_bisect(g, ts[k], ts[k + 1], v[k]) for k in range(n)
+                  if not zero[k] and not zero[k + 1] and (v[k] > 0) != (v[k + 1] > 0)]
+        smallest, largest = min(abs(value) for value in v), max(abs(value) for value in v)
+        bounded = not zeros and smallest > (ABSOLUTE if constant else RELATIVE * largest)
+        feasibility = max(grades[i][k] for i, k in enumerate(mode))
+        modes.append(ModeJudgement(mode, feasibility, sorted(zeros), all(zero), bounded))
+    return Judgement(modes)

@@ -13,6 +13,7 @@ from __future__ import annotations
 import itertools
 from fractions import Fraction as Q
 
+import mpmath as mp
 import pytest
 from flint import fmpq, fmpq_mpoly_ctx
 
@@ -170,3 +171,60 @@ def test_a_whole_range_singularity_is_reported_on_surface_in_json_and_table(tmp_
     render_tables(Console(file=out, width=200), robot_json(robot.projection), [doc])
     assert "all of [0, 1] (det A ≡ 0)" in out.getvalue()
     assert "singular along the whole path" in out.getvalue()
+
+
+# -- degenerate inverse kinematics: a leg that does not fix its joint, a joint at π ---------
+
+
+def test_a_leg_whose_ik_degenerates_is_never_proven_free(tmp_path):
+    """The five-bar's end effector on its base joint A1 = (-1, 0) with l1 = l2 = 2: leg 1
+    reads 4cos²θ + 4sin²θ - 4 = 0, true for every θ (a = b = d = 0, W = 0), so its
+    branches are not separated anywhere (exactly: the oracle's discriminant is 0).  The
+    answer must not be `singularity-free` in any engine; it is infeasible (serial
+    singularity), and so is a line leaving that pose."""
+    for k in range(7):  # leg 1 at P = A1 holds for every θ: no branch is singled out
+        theta = mp.mpf(k)
+        with mp.workdps(50):
+            assert abs((-1 + 1 - 2 * mp.cos(theta)) ** 2 + (2 * mp.sin(theta)) ** 2 - 4) \
+                < mp.mpf(10) ** -45
+    robot = api.load_robot(ROBOTS / "five-bar.yaml", backend="flint", cache=False)
+    still = tmp_path / "still.yaml"
+    still.write_text("name: still\nparameter: t\nrange: [0, 1]\npose: {x: -1, y: 0}\n")
+    leaving = tmp_path / "leaving.yaml"
+    leaving.write_text("name: leaving\nparameter: t\nrange: [0, 1]\n"
+                       "pose: {x: -1 + t/10, y: t/10}\n")
+    for f in (still, leaving):
+        for engine in ("auto", "exact", "interval"):
+            report = api.check(robot, api.load_trajectory(f, robot), regions=False,
+                               engine=engine)
+            assert report.verdict == "infeasible", (f.name, engine, report.reason)
+            assert "th1" in report.reason
+
+
+def test_a_constant_pose_with_a_joint_at_pi_agrees_with_the_oracle(tmp_path):
+    """P = (-7/5, 6/5): |P - A1 - 2·(cos π, sin π)| = |(8/5, 6/5)| = 2, so one branch of
+    θ1 is π exactly, on its closed upper limit.  The verdict and the feasible modes'
+    joints at the start agree with the 50-digit oracle (θ1 shown as π, not 0 or -π)."""
+    from tests import robot_oracles as oracles
+
+    oracle = oracles.five_bar()
+    X = [mp.mpf(-7) / 5, mp.mpf(6) / 5]
+    truth = {}
+    for mode in itertools.product((0, 1), repeat=2):
+        q = oracle.joints(mode, X)
+        if q is None or not all(leg.lo - mp.mpf(10) ** -30 <= v <= leg.hi + mp.mpf(10) ** -30
+                                for leg, v in zip(oracle.legs, q, strict=True)):
+            continue
+        truth[tuple(float(v) for v in q)] = oracle.det_A(q, X)
+    assert any(abs(q[0] - float(mp.pi)) < 1e-12 for q in truth)  # the θ1 = π branch
+    robot = api.load_robot(ROBOTS / "five-bar.yaml", backend="flint", cache=False)
+    f = tmp_path / "pi.yaml"
+    f.write_text("name: pi\nparameter: t\nrange: [0, 1]\npose: {x: -7/5, y: 6/5}\n")
+    report = api.check(robot, api.load_trajectory(f, robot), regions=False)
+    feasible = [m for m in report.working_modes if m.feasible]
+    shown = sorted(tuple(m.joints_at_start[j] for j in ("th1", "th2")) for m in feasible)
+    assert len(shown) == len(truth)
+    for ours, expected in zip(shown, sorted(truth), strict=True):
+        assert ours == pytest.approx(expected, abs=1e-9)
+    singular = any(abs(v) < mp.mpf(10) ** -30 for v in truth.values())
+    assert report.verdict == ("singular" if singular else "singularity-free")

@@ -398,8 +398,16 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
     from singcheck.certify.path import with_mu
 
     feasible = [m for m in modes if m.status == FEASIBLE]
-    searches = search_det_a(path, feasible, budget=first_pass_budget(path, feasible))
-    decided = all(w.crossing for s in searches.values() for w in s.windows)
+    left = remaining()
+    try:
+        with deadline(FIRST_PASS_SECONDS):
+            searches = search_det_a(path, feasible, budget=first_pass_budget(path, feasible))
+    except TimeLimitExceeded:
+        if left is not None and left <= FIRST_PASS_SECONDS:
+            raise  # the trajectory's own time limit
+        searches = None  # (many modes, each piece costly): the exact engine first
+    decided = searches is not None and all(w.crossing for s in searches.values()
+                                           for w in s.windows)
     if not decided:
         exact = with_mu(path)
         if exact.mu is None:
@@ -420,6 +428,9 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
     return _certify_by_intervals(exact, modes, searches)
 
 
+#: seconds the interval engine's first pass may take before the exact engine goes first
+#: (a hexapod's 64 modes on a path lying on the singularity: every piece is a window)
+FIRST_PASS_SECONDS = 2.0
 #: ball evaluations (of every feasible mode at once) the interval engine's first pass
 #: may spend per 2π of range, divided among the modes: what it leaves goes to the exact
 #: engine, which decides a path lying on the singularity (every piece a window) at once

@@ -1103,3 +1103,47 @@ def test_an_angle_with_a_huge_multiple_of_t_is_refused(tmp_path, monkeypatch, ca
     assert doc["verdict"] == "error"
     assert "multiple of t above 256" in doc["reason"] and "pose.phi" in doc["reason"]
     assert "OverflowError" not in out + err
+
+
+# -- second round (issue 31) ---------------------------------------------------------------
+
+RPR3 = str(ROBOTS / "3-rpr.yaml")
+
+
+@pytest.mark.parametrize("form", ["csv-linear", "csv-cubic", "segments"])
+def test_a_3rpr_path_of_pieces_crossing_at_its_join_is_decided(tmp_path, monkeypatch, capsys,
+                                                               cache_env, form):
+    """E1: the join test of the region statement got a surface in the 3-RPR's path ring
+    (t, s, c and phi's cos and sin) and unpacked its exponents as three (exit 70).  Both
+    pieces meet r1 = 1/2 exactly at the join t = 1 (x, y = 1/2, 0): one crossing."""
+    if form == "segments":
+        path = tmp_path / "e1.yaml"
+        path.write_text("name: e1\nparameter: t\nsegments:\n"
+                        "  - range: [0, 1]\n    pose: {x: 1 - t/2, y: 1 - t, phi: t/10}\n"
+                        "  - range: [1, 2]\n    pose: {x: t/2, y: t - 1, phi: t/10}\n")
+        extra = []
+    else:
+        path = tmp_path / "e1.csv"
+        path.write_text("t,x,y,phi\n0,1,1,0\n1,0.5,0,0.1\n2,1,1,0.2\n")
+        extra = ["--interpolation", form.split("-")[1]]
+    code, out, err = run_cli(monkeypatch, capsys, "run", RPR3, str(path), "-q", "--backend",
+                             "flint", "--format", "json", *extra)
+    assert code == 0, err
+    (doc,) = json.loads(out)["trajectories"]
+    assert doc["verdict"] == "singularity-free", doc
+    crossings = doc["workspace"]["crossings"]
+    assert [c["surfaces"] for c in crossings] == [["r1 = 1/2 (min)"]], crossings
+    assert crossings[0]["t_interval"] == [1.0, 1.0]
+
+
+def test_the_join_test_is_undecided_outside_the_trig_ring():
+    """sum_is_zero is exact on Q[t, sin t, cos t] only: a polynomial of a path ring with an
+    angle's variables is undecided (None), not an unpacking error."""
+    from singcheck.algebra.radicals import path_ring
+    from singcheck.algebra.trig import LinearInPi
+    from singcheck.algebra.trig_values import sum_is_zero
+
+    ring = path_ring([], [("cos(phi)", "sin(phi)")])
+    t, s, c, cphi, sphi = ring.gens()
+    assert sum_is_zero([(cphi ** 2 + sphi ** 2 - 1, LinearInPi(Fraction(1)))]) is None
+    assert sum_is_zero([(t * 0, LinearInPi(Fraction(1)))]) is None

@@ -105,6 +105,46 @@ def write_output(path: str | os.PathLike, text: str) -> None:
         f.write(text)
 
 
+#: the longest file-name stem made from input, in bytes of UTF-8: room for what follows
+#: it (``-jointspace.png``, a counter) under the usual limit of 255 bytes a name
+MAX_STEM_BYTES = 160
+
+
+def safe_file_name(text: str, taken: set[str] | None = None) -> str:
+    """``text`` (a name from a spec: input) as a file-name stem that stays inside the
+    directory it is joined to: letters and digits (any script), ``.``, ``_``, ``-``,
+    ``+``, ``=`` are kept, ``/`` becomes ``_``, parentheses become ``-`` (tan(phi/2) ->
+    tan-phi_2), anything else (NUL, a space, a control character) ``_``; leading dots
+    are dropped (no ``..``, no hidden file), and a stem longer than
+    :data:`MAX_STEM_BYTES` is cut, with a hash of the whole text so that long names
+    stay apart.  With ``taken`` (the stems already used in one directory by this run), a
+    stem already there gets ``-2``, ``-3``, … and the one returned is added to it, so two
+    names that map to the same stem never write the same file.
+
+    >>> safe_file_name("../escape"), safe_file_name("/etc/passwd"), safe_file_name("..")
+    ('_escape', '_etc_passwd', '_')
+    >>> taken = set()
+    >>> safe_file_name("a/b", taken), safe_file_name("a_b", taken)
+    ('a_b', 'a_b-2')
+    """
+    import hashlib
+
+    out = str(text).replace("/", "_").replace("(", "-").replace(")", "")
+    out = "".join(c if c.isalnum() or c in "._-+=" else "_" for c in out).lstrip(".") or "_"
+    if len(out.encode("utf-8")) > MAX_STEM_BYTES:
+        digest = hashlib.sha256(str(text).encode("utf-8", "surrogatepass")).hexdigest()[:12]
+        cut = out.encode("utf-8")[:MAX_STEM_BYTES - 13].decode("utf-8", "ignore")
+        out = f"{cut}-{digest}"
+    if taken is None:
+        return out
+    stem, n = out, 1
+    while stem.casefold() in taken:
+        n += 1
+        stem = f"{out}-{n}"
+    taken.add(stem.casefold())
+    return stem
+
+
 def _mode_for(target: Path) -> int:
     """Keep an existing file's mode; give a new one the usual 0666 less the umask
     (mkstemp creates 0600)."""

@@ -1147,3 +1147,64 @@ def test_the_join_test_is_undecided_outside_the_trig_ring():
     t, s, c, cphi, sphi = ring.gens()
     assert sum_is_zero([(cphi ** 2 + sphi ** 2 - 1, LinearInPi(Fraction(1)))]) is None
     assert sum_is_zero([(t * 0, LinearInPi(Fraction(1)))]) is None
+
+
+HOSTILE_NAMES = ["../escape", "/tmp/abs", "..", ".hidden", "a\0b", "L" * 3000,
+                 "héllo δ/ψ", "\u202e", "a/b", "a_b", "A_B", "$^$"]
+
+
+def test_every_hostile_name_becomes_a_file_name_inside_its_directory(tmp_path):
+    """S1: one helper makes every file name derived from input; each stays in its
+    directory, is a name the file system takes, and two names never share a stem."""
+    from singcheck.atomic import MAX_STEM_BYTES, safe_file_name
+
+    taken: set[str] = set()
+    stems = [safe_file_name(name, taken) for name in HOSTILE_NAMES]
+    assert len({s.casefold() for s in stems}) == len(stems), stems
+    for stem in stems:
+        assert "/" not in stem and "\0" not in stem and not stem.startswith("."), stem
+        assert len(stem.encode("utf-8")) <= MAX_STEM_BYTES + 4
+        target = (tmp_path / f"{stem}-jointspace.svg")
+        assert target.resolve().parent == tmp_path.resolve()
+        target.write_text("x")  # the file system takes it
+    assert safe_file_name("héllo δ") == "héllo_δ"
+    long_a, long_b = safe_file_name("L" * 3000), safe_file_name("L" * 2999 + "M")
+    assert long_a != long_b
+    assert safe_file_name("a/b", set()) == safe_file_name("a/b", set())  # stable
+
+
+@pytest.mark.slow
+def test_figures_of_hostile_names_stay_in_the_figure_directory(tmp_path, monkeypatch, capsys,
+                                                               cache_env):
+    """S1: ``run --plot DIR`` and ``plot --out DIR`` wrote ``name: ../escape`` beside DIR
+    and an absolute name at that path; '$^$' in a title stopped matplotlib (exit 70).
+    Now every figure is in DIR, and a/b and a_b both keep their figures."""
+    names = ["../escape", str(tmp_path / "abs"), "a/b", "a_b", "$^$"]
+    docs = [f'name: {json.dumps(n)}\nparameter: t\nrange: [0, 1]\npose: {{x: t, y: 1}}\n'
+            for n in names]
+    spec = tmp_path / "hostile.yaml"
+    spec.write_text("---\n".join(docs))
+    figures = tmp_path / "deep" / "figs"
+    code, _, err = run_cli(monkeypatch, capsys, "run", BIGLIDE, str(spec), "-q", "--backend",
+                           "flint", "--plot", str(figures))
+    assert code == 0, err
+    outside = [p for p in tmp_path.rglob("*") if p.is_file()
+               and figures not in p.parents and p != spec and cache_env not in p.parents
+               and "config" not in p.parts]
+    assert outside == []
+    stems = {p.name.rsplit("-", 1)[0] for p in figures.iterdir()}
+    assert len(stems) == len(names) and {"a_b", "a_b-2", "_escape"} <= stems, stems
+    assert len(list(figures.iterdir())) == 10 * len(names)
+    # plot --out alike, one file per trajectory
+    files = [tmp_path / f"p{i}.yaml" for i in range(3)]
+    for file, doc in zip(files, docs, strict=False):
+        file.write_text(doc)
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "singcheck", "plot", BIGLIDE, *map(str, files),
+                           "--out", str(out), "-q", "--backend", "flint"],
+                          env={**os.environ, "PYTHONPATH": str(ROOT)}, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert len(lines) == 30 and all(Path(line).parent == out for line in lines), lines
+    assert len(list(out.iterdir())) == 30

@@ -409,9 +409,10 @@ def _plot_all(certificates, out_dir: str, progress) -> list:
     except ImportError as e:
         raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
                         "missing): pip install 'singcheck[plot]'") from None
-    written = []
+    written: list = []
+    taken: set[str] = set()  # two names with one safe file name must not overwrite
     for certificate in certificates:
-        written += write_figures(certificate, out_dir)
+        written += write_figures(certificate, out_dir, taken=taken)
     progress.note(f"wrote {len(written)} figure files to {out_dir}")
     return written
 

@@ -333,9 +333,15 @@ def _limit_box(ax, limits) -> None:
 
 
 def write_figures(report: TrajectoryReport, out_dir: str | Path,
-                  formats: tuple[str, ...] = ("png", "svg"), dpi: int = 120) -> list[Path]:
-    """Write the figures for one trajectory; returns the files written."""
+                  formats: tuple[str, ...] = ("png", "svg"), dpi: int = 120,
+                  taken: set[str] | None = None) -> list[Path]:
+    """Write the figures for one trajectory into ``out_dir``, named after it
+    (:func:`~singcheck.atomic.safe_file_name`: a name from the spec never leaves
+    ``out_dir``; ``taken``: the names already written there by this run, kept apart);
+    returns the files written."""
     import matplotlib
+
+    from singcheck.atomic import safe_file_name
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -343,8 +349,9 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     d = figure_data(report)
-    robot = report.path.projection.model.name
-    name = report.name
+    # names from the specs, as plain text in the titles ('$' would start mathtext)
+    robot = report.path.projection.model.name.replace("$", r"\$")
+    name = report.name.replace("$", r"\$")
     makers = {
         "mu": lambda: _mu_figure(plt, d, f"{robot} · {name}: μ(t) and its certified roots"),
         "detA": lambda: _det_figure(plt, d, f"{robot} · {name}: det A along feasible modes"),
@@ -360,13 +367,14 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
             " and at its singular times" if any(m.singular_times for m in report.modes
                                                 if m.feasible) else
             " (no singular time on a feasible mode)"))
+    stem = safe_file_name(report.name, taken)
     written = []
     for key in makers:
         fig = makers[key]()
         if fig is None:  # no drawing in the robot spec
             continue
         for fmt in formats:
-            target = out / f"{name}-{key}.{fmt}"
+            target = out / f"{stem}-{key}.{fmt}"
             fig.savefig(target, dpi=dpi, bbox_inches="tight")
             written.append(target)
         plt.close(fig)

@@ -1208,3 +1208,24 @@ def test_figures_of_hostile_names_stay_in_the_figure_directory(tmp_path, monkeyp
     lines = done.stdout.splitlines()
     assert len(lines) == 30 and all(Path(line).parent == out for line in lines), lines
     assert len(list(out.iterdir())) == 30
+
+
+@pytest.mark.parametrize("row, phrase", [
+    ("9" * 308 + ",0.9,1.1,1", "t: the number 9999999999…999999 (308 characters) is too "
+                               "large (at most 512 bits)"),
+    ("1,0.9,1.1," + "1" * 200, "z: the number"),
+    ("1,1/" + "7" * 200 + ",1.1,1", "x: the number"),
+    ("1,1e-400,1.1,1", "x: the number 1e-400 is too large"),
+    ("1/0,0.9,1.1,1", "t: '1/0' divides by zero"),
+])
+def test_csv_cells_obey_the_bounds_of_spec_numbers(tmp_path, monkeypatch, capsys, cache_env,
+                                                   row, phrase):
+    """E2: a CSV time cell of 308 digits overflowed a float in the cover of one period
+    (exit 70); the same number as a YAML range end was a clean exit 2.  A cell now goes
+    through the spec grammar's number bound, before its value is built."""
+    path = tmp_path / "e2.csv"
+    path.write_text(f"t,x,y,z\n0,0.25,0.6,1\n{row}\n")
+    code, _, err = run_cli(monkeypatch, capsys, "run", ORTHO, str(path), "-q", "--backend",
+                           "flint")
+    one_line_error(code, err, 2, phrase)
+    assert "e2.csv:3:" in err

@@ -31,6 +31,7 @@ from singcheck.algebra.trig import TRIG, LinearInPi, T, TimeRange, evaluate_trig
 from singcheck.algebra.trig_values import sum_is_zero
 from singcheck.budget import checkpoint
 from singcheck.errors import SpecError
+from singcheck.spec.grammar import ExprError, _exact_number, _short
 from singcheck.spec.plainyaml import kind
 from singcheck.spec.trajectory import TrajectorySpec, pose_nodes, time_range, trajectory_piece
 
@@ -43,7 +44,6 @@ def _line(node) -> int:
 
 MAX_WAYPOINTS = 5000
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE](?P<exponent>[+-]?\d+))?(?:/\d+)?\Z")
-MAX_EXPONENT = 300  # of a decimal in a CSV cell (10^300 is far beyond any robot)
 
 
 def multi_piece(doc, root, top, name: str, parameter: str, robot,
@@ -225,13 +225,12 @@ def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec
             number = _NUMBER.match(cell)
             if not number:
                 raise SpecError(f"{name}: {cell!r} is not a number", path=path, line=n)
-            if number.group("exponent") and abs(int(number.group("exponent"))) > MAX_EXPONENT:
-                raise SpecError(f"{name}: {cell!r} has an exponent beyond ±{MAX_EXPONENT}",
-                                path=path, line=n)
             try:
-                exact.append(Fraction(cell))
+                exact.append(_cell_value(cell))
+            except ExprError as e:
+                raise SpecError(f"{name}: {e.message}", path=path, line=n) from None
             except ZeroDivisionError:
-                raise SpecError(f"{name}: {cell!r} divides by zero", path=path,
+                raise SpecError(f"{name}: {_short(cell)!r} divides by zero", path=path,
                                 line=n) from None
         times.append(exact[0])
         for name, value in zip(names[1:], exact[1:], strict=True):
@@ -241,6 +240,16 @@ def parse_csv(text: str, path: str, robot, interpolation: str) -> TrajectorySpec
     stem = csv_name(path)
     pieces = interpolated_pieces(path, stem, parameter, times, values, interpolation, lines)
     return _whole(path, stem, parameter, pieces, {"interpolation": interpolation})
+
+
+def _cell_value(cell: str) -> Fraction:
+    """A CSV cell's exact value (a decimal, or a fraction of two), with the bounds of a
+    number in a spec: each literal of at most MAX_LITERAL_BITS bits, refused before it
+    is built (a 308-digit time once overflowed a float further on)."""
+    sign = -1 if cell.startswith("-") else 1
+    numerator, _, denominator = cell.lstrip("+-").partition("/")
+    value = _exact_number(numerator, 1)
+    return sign * (value / _exact_number(denominator, 1) if denominator else value)
 
 
 def interpolated_pieces(path: str, name: str, parameter: str, times: list[Fraction],

@@ -222,21 +222,24 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
 DEFAULT_TIME_LIMIT = 300.0
 
 
-def check_safely(robot: Robot, trajectory: TrajectorySpec, **options) -> dict[str, Any]:
+def check_safely(robot: Robot, trajectory: TrajectorySpec, *, spent: float = 0.0,
+                 **options) -> dict[str, Any]:
     """:func:`check` as one trajectory of a batch: its JSON trajectory object (with
     ``time_s``, the seconds it took), whatever happens.  A failure of this trajectory
     alone (a backend failure, a bug, the time limit) becomes its result — verdict
     ``unknown`` past the time limit, ``error`` with the reason otherwise — so that the
-    other trajectories of the batch still complete.
+    other trajectories of the batch still complete.  ``spent``: the seconds its parsing
+    took, which count against its time limit (and its ``time_s``).
     Ctrl-C (KeyboardInterrupt) still stops the batch."""
     import time
 
     from singcheck.errors import BackendError, SpecError
     from singcheck.report.trajectory import error_json, time_limited_json
 
-    start = time.perf_counter()
+    start = time.perf_counter() - spent
     try:
-        with hard_time_limit(options.get("time_limit")):
+        with deadline(options.get("time_limit"), spent), \
+                hard_time_limit(options.get("time_limit"), spent):
             doc = check(robot, trajectory, **options).to_dict()
     except TimeLimitExceeded as e:
         doc = time_limited_json(trajectory, f"unknown: {e}")
@@ -251,10 +254,11 @@ def check_safely(robot: Robot, trajectory: TrajectorySpec, **options) -> dict[st
 
 
 @contextmanager
-def hard_time_limit(seconds: float | None):
+def hard_time_limit(seconds: float | None, spent: float = 0.0):
     """A backstop behind the cooperative :func:`~singcheck.budget.checkpoint`: in a
     process's main thread, a timer raises :class:`TimeLimitExceeded` a little after the
-    limit (10 % and a second), should some loop not reach a checkpoint in time."""
+    limit (10 % and a second; ``spent`` of it gone already), should some loop not reach
+    a checkpoint in time."""
     import signal
     import threading
 
@@ -267,7 +271,7 @@ def hard_time_limit(seconds: float | None):
         raise TimeLimitExceeded(f"time limit ({seconds:g} s) reached")
 
     previous = signal.signal(signal.SIGALRM, expire)
-    signal.setitimer(signal.ITIMER_REAL, seconds * 1.1 + 1)
+    signal.setitimer(signal.ITIMER_REAL, max(seconds * 1.1 + 1 - spent, 1e-3))
     try:
         yield
     finally:
@@ -300,19 +304,61 @@ def _check_chunk(chunk: list) -> list[dict]:
     return [check_item(robot, item, **options) for item in chunk]
 
 
-def check_item(robot: Robot, item: TrajectorySpec | Document, **options) -> dict[str, Any]:
+@dataclass
+class Parsed:
+    """A document parsed within its time limit (:func:`parse_within`): the spec, or None
+    when the limit stopped the parsing (``reason``), and the seconds it took — they
+    count against the trajectory's time limit."""
+
+    document: Document
+    spec: TrajectorySpec | None
+    seconds: float
+    reason: str = ""
+
+
+def parse_within(document: Document, robot_spec: RobotSpec,
+                 time_limit: float | None) -> Parsed:
+    """Parse ``document`` as the first stage of its trajectory's check: under its time
+    limit (a 5,000-row CSV's exact cubic spline is solved here).  A bad document raises
+    :class:`~singcheck.errors.SpecError`."""
+    import time
+
+    start = time.perf_counter()
+    try:
+        with deadline(time_limit), hard_time_limit(time_limit):
+            spec = document.parse(robot_spec)
+    except TimeLimitExceeded as e:
+        return Parsed(document, None, time.perf_counter() - start, f"{e} (while reading it)")
+    return Parsed(document, spec, time.perf_counter() - start)
+
+
+def spec_of(item: TrajectorySpec | Document | Parsed) -> TrajectorySpec | Document | None:
+    """The trajectory spec of a batch's item when it is parsed (None when its parsing ran
+    out of time), else the document."""
+    return item.spec if isinstance(item, Parsed) else item
+
+
+def check_item(robot: Robot, item: TrajectorySpec | Document | Parsed,
+               **options) -> dict[str, Any]:
     """:func:`check_safely` of a trajectory spec, or of a :class:`Document` read but not
-    parsed yet: it is parsed here, and one that is wrong is its own result (verdict
-    ``error``, ``error.kind`` ``spec``, the located message) like any failure of one
-    trajectory of a batch."""
+    parsed yet: it is parsed here, within the trajectory's time limit (past it: verdict
+    ``unknown``), and one that is wrong is its own result (verdict ``error``,
+    ``error.kind`` ``spec``, the located message) like any failure of one trajectory of
+    a batch."""
+    from singcheck.report.trajectory import error_json, time_limited_json
+
     if isinstance(item, Document):
         from singcheck.errors import SpecError
-        from singcheck.report.trajectory import error_json
 
         try:
-            item = item.parse(robot.spec)
+            item = parse_within(item, robot.spec, options.get("time_limit"))
         except SpecError as e:
             return {**error_json(item, "spec", str(e)), "time_s": 0.0}
+    if isinstance(item, Parsed):
+        if item.spec is None:
+            return {**time_limited_json(item.document, f"unknown: {item.reason}"),
+                    "time_s": round(item.seconds, 6)}
+        return check_safely(robot, item.spec, spent=item.seconds, **options)
     return check_safely(robot, item, **options)
 
 
@@ -346,7 +392,7 @@ def shared_regions(robot: Robot, head: list, options: dict, notify: Notify = _qu
     """Before a batch's workers start: the region maps that its first trajectories
     share, computed once (:func:`prepare_regions`); ``options["regions"]`` is turned off
     when that ran out of time."""
-    specs = [t for t in head if isinstance(t, TrajectorySpec)]
+    specs = [t for t in map(spec_of, head) if isinstance(t, TrajectorySpec)]
     if options["regions"] and specs and not prepare_regions(
             robot, specs, options["time_limit"], notify):
         options["regions"] = False

@@ -1229,3 +1229,50 @@ def test_csv_cells_obey_the_bounds_of_spec_numbers(tmp_path, monkeypatch, capsys
                            "flint")
     one_line_error(code, err, 2, phrase)
     assert "e2.csv:3:" in err
+
+
+def _long_csv(path: Path, rows: int = 5000) -> Path:
+    lines = ["t,x,y,z"] + [f"{i},{0.5 + 0.3 * math.cos(i / 50):.4f},"
+                           f"{0.5 + 0.3 * math.sin(i / 50):.4f},1" for i in range(rows)]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_the_time_limit_counts_from_reading_the_document(tmp_path, monkeypatch, capsys,
+                                                          cache_env):
+    """H1: a 5,000-row CSV's exact cubic spline was solved while the document was parsed,
+    before any limit applied (11 s under --time-limit 2).  Parsing is now the first stage
+    of the trajectory's check: unknown at the limit, within a second."""
+    path = _long_csv(tmp_path / "long.csv")
+    run_cli(monkeypatch, capsys, "run", ORTHO, str(TRAJECTORIES / "heart1.yaml"), "-q",
+            "--backend", "flint", "--no-regions")  # the projection, cached: not timed
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, "run", ORTHO, str(path), "-q", "--backend",
+                             "flint", "--time-limit", "2", "--format", "json")
+    elapsed = time.monotonic() - start
+    assert code == 3, err
+    (doc,) = json.loads(out)["trajectories"]
+    assert doc["verdict"] == "unknown" and "time limit (2 s)" in doc["reason"], doc
+    assert elapsed < 3.0, elapsed
+
+
+def test_a_document_parsed_by_a_worker_counts_its_parsing(tmp_path, orthoglide_projection):
+    """The same for a document parsed by a batch's worker (check_item), and the parsing's
+    seconds count against the check that follows it."""
+    from singcheck import api
+    from singcheck.spec.files import read_documents
+
+    model = orthoglide_projection.model
+    orthoglide_robot = api.Robot(model.spec, model, orthoglide_projection)
+    (document,) = read_documents([str(_long_csv(tmp_path / "long.csv"))], "cubic")
+    start = time.monotonic()
+    doc = api.check_item(orthoglide_robot, document, time_limit=1.0, regions=False)
+    assert time.monotonic() - start < 2.0
+    assert doc["verdict"] == "unknown" and "while reading it" in doc["reason"], doc
+    (short,) = read_documents([str(_long_csv(tmp_path / "short.csv", 300))], "cubic")
+    parsed = api.parse_within(short, orthoglide_robot.spec, 100)
+    assert parsed.spec is not None
+    parsed.seconds = 100.0  # as if its parsing had taken the whole limit
+    doc = api.check_item(orthoglide_robot, parsed, time_limit=100.0, regions=False)
+    assert doc["verdict"] == "unknown" and doc["time_s"] >= 100, doc
+    assert "time limit (100 s) reached" in doc["reason"], doc

@@ -192,7 +192,9 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     # the first documents (all of a small batch) are parsed here, before any work: a bad
     # one stops the run at once (exit 2, one line); past them, the documents are parsed
     # by the workers, and a bad one is that trajectory's result
-    first = [document.parse(spec) for document in islice(documents, api.LOOKAHEAD)]
+    # (each within its trajectory's time limit: parsing is the first stage of its check)
+    first = [api.parse_within(document, spec, time_limit)
+             for document in islice(documents, api.LOOKAHEAD)]
     total = len(first) if len(first) < api.LOOKAHEAD else None  # None: not known yet
     items = chain(first, documents)
     kept: list = []
@@ -239,16 +241,17 @@ def _keeping(items, kept: list):
 def _parsed(items: list, robot_spec) -> list:
     """The trajectory specs among ``items`` (documents parsed; a bad one left out: the
     batch has reported it)."""
+    from singcheck.api import spec_of
     from singcheck.errors import SpecError
     from singcheck.spec.files import Document
 
     specs = []
-    for item in items:
+    for item in map(spec_of, items):
         try:
             specs.append(item.parse(robot_spec) if isinstance(item, Document) else item)
         except SpecError:
             pass
-    return specs
+    return [spec for spec in specs if spec is not None]  # None: its time limit
 
 
 class _Sink:

@@ -303,10 +303,12 @@ def natural_cubic_spline(ts: list[Fraction], ys: list[Fraction]) -> list[fmpq_mp
             diag.append(d)
             rhs.append(r)
         for i in range(n - 1, 0, -1):
+            checkpoint()  # the exact Mᵢ grow with the rows: each step costs more
             m[i] = (rhs[i - 1] - h[i] * m[i + 1]) / diag[i - 1]
     one = TRIG.from_dict({(0, 0, 0): 1})
     out = []
     for i in range(n):
+        checkpoint()
         a, b = one * h[i] - T, T
         out.append(a ** 3 * (m[i] / (6 * h[i])) + b ** 3 * (m[i + 1] / (6 * h[i]))
                    + a * (y[i] / h[i] - m[i] * h[i] / 6)

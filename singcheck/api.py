@@ -18,6 +18,7 @@ same :class:`Robot` runs no CAS and reads no cache entry.
 
 from __future__ import annotations
 
+import signal
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -296,6 +297,11 @@ def _worker_signals() -> None:
     die_with_parent(_WORKER["parent"])  # SIGTERM: the default action
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)  # held while it was forked
+
+
+#: the signals held while workers are forked (:func:`_held_signals`)
+_HELD = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
 
 
 def _check_chunk(chunk: list) -> list[dict]:
@@ -430,9 +436,16 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
     """The batch in ``jobs`` forked workers, CHUNK trajectories per task and
     TASKS_PER_WORKER tasks per worker in flight: a finished task is replaced by the next
     one read (before its results are yielded), so at most that many trajectories are
-    held here at once, whatever the length of the batch."""
+    held here at once, whatever the length of the batch.
+
+    A worker that dies (killed, out of memory) breaks the pool and every task in flight
+    with it: each of those tasks is run again, alone in a new pool (no other task in
+    flight, so that a second death is its own); if it dies again, its trajectories are
+    run one by one, alone, and one whose worker dies then is that trajectory's
+    ``error`` (it killed its worker twice).  The others' results are kept."""
     import multiprocessing
     import os
+    from collections import deque
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
     from itertools import islice
@@ -449,39 +462,68 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
 
     pool = start()
     in_flight: dict = {}  # future -> (index of its first trajectory, its trajectories)
+    lost: deque = deque()  # (first index, trajectories) of tasks whose worker died
     read = 0
 
+    def send(chunk: list):
+        nonlocal pool
+        if getattr(pool, "_broken", False):
+            _stop(pool)
+            pool = start()
+        with _held_signals():  # a worker forked here sets its own handlers first (J1)
+            try:
+                return pool.submit(_check_chunk, chunk)
+            except BrokenProcessPool:  # broken since: the batch goes on in a new pool
+                _stop(pool)
+                pool = start()
+                return pool.submit(_check_chunk, chunk)
+
     def submit() -> bool:
-        nonlocal read, pool
+        nonlocal read
         chunk = list(islice(items, CHUNK))
         if chunk:
-            try:
-                future = pool.submit(_check_chunk, chunk)
-            except BrokenProcessPool:  # a worker died: the tasks it broke are errors, and
-                _stop(pool)  # the batch goes on in a new pool
-                pool = start()
-                future = pool.submit(_check_chunk, chunk)
-            in_flight[future] = (read, chunk)
+            in_flight[send(chunk)] = (read, chunk)
             read += len(chunk)
         return bool(chunk)
+
+    def alone(chunk: list) -> list[dict] | Exception:
+        try:
+            return send(chunk).result()
+        except Exception as e:  # noqa: BLE001 - its worker died, or it could not run
+            return e
+
+    def rerun(first: int, chunk: list) -> list[tuple[int, dict]]:
+        docs = alone(chunk) if len(chunk) > 1 else None
+        if isinstance(docs, list):
+            return list(enumerate(docs, first))
+        out = []
+        for index, item in enumerate(chunk, first):
+            result = alone([item])
+            if isinstance(result, Exception):
+                reason = (f"its worker process died twice (killed, or out of memory): "
+                          f"{type(result).__name__}: {result}")
+                result = [{**error_json(_head(item), "internal", reason), "time_s": 0.0}]
+            out.append((index, result[0]))
+        return out
 
     try:
         while len(in_flight) < jobs * TASKS_PER_WORKER and submit():
             pass
         done_early: dict[int, dict] = {}
         next_out = 0
-        while in_flight:
-            finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
+        while in_flight or lost:
             results: list[tuple[int, dict]] = []
-            for future in finished:
-                first, chunk = in_flight.pop(future)  # a done future holds its results
-                try:
-                    docs = future.result()
-                except Exception as e:  # the worker process died (killed, out of memory)
-                    reason = f"the worker process failed: {type(e).__name__}: {e}"
-                    docs = [error_json(item, "internal", reason) for item in chunk]
-                results += enumerate(docs, first)
-            while len(in_flight) < jobs * TASKS_PER_WORKER and submit():
+            if in_flight:
+                finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
+                for future in finished:
+                    first, chunk = in_flight.pop(future)  # a done future holds its results
+                    try:
+                        results += enumerate(future.result(), first)
+                    except Exception:  # noqa: BLE001 - its worker died: run it again
+                        lost.append((first, chunk))
+            if lost and not in_flight:  # the tasks the death broke, one at a time
+                results += rerun(*lost.popleft())
+            while not lost and len(in_flight) < jobs * TASKS_PER_WORKER and submit():
                 pass
             if not ordered:
                 for _, doc in results:
@@ -494,6 +536,32 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
     finally:
         _WORKER.clear()
         _stop(pool)
+
+
+def _head(item):
+    """What names a batch's item in its result: the spec, else the document."""
+    return item.document if isinstance(item, Parsed) and item.spec is None else \
+        spec_of(item)
+
+
+def _held_signals():
+    """Ctrl-C, SIGTERM and SIGHUP held in this thread for the duration of the block:
+    a worker forked inside it starts with them held, and :func:`_worker_signals`
+    releases them once its own handlers are set (one signalled while starting no
+    longer prints 'Exception in initializer … KeyboardInterrupt'); this process gets
+    them just after the block."""
+    import signal
+    from contextlib import contextmanager
+
+    @contextmanager
+    def block():
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+        try:
+            yield
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+    return block()
 
 
 def _stop(pool) -> None:

@@ -1276,3 +1276,37 @@ def test_a_document_parsed_by_a_worker_counts_its_parsing(tmp_path, orthoglide_p
     doc = api.check_item(orthoglide_robot, parsed, time_limit=100.0, regions=False)
     assert doc["verdict"] == "unknown" and doc["time_s"] >= 100, doc
     assert "time limit (100 s) reached" in doc["reason"], doc
+
+
+@pytest.mark.parametrize("sig, status", [(signal.SIGINT, 0), (signal.SIGHUP, 0),
+                                         (signal.SIGTERM, -signal.SIGTERM)])
+def test_a_worker_signalled_while_starting_is_silent(tmp_path, sig, status):
+    """J1: a worker signalled between its fork and its initializer (which sets its own
+    handlers) ran the parent's handlers and printed 'Exception in initializer …
+    KeyboardInterrupt'.  Workers are forked with the signals held, and the initializer
+    releases them once its handlers are set: Ctrl-C and a hangup are ignored, SIGTERM
+    ends the worker, silently."""
+    from singcheck import api
+
+    err = tmp_path / "stderr"
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)  # as singcheck's
+    try:
+        with api._held_signals():
+            pid = os.fork()
+            if pid == 0:  # the worker, signalled before its initializer runs
+                try:
+                    fd = os.open(err, os.O_WRONLY | os.O_CREAT)
+                    os.dup2(fd, 2)
+                    os.kill(os.getpid(), sig)
+                    api._WORKER["parent"] = os.getppid()
+                    api._worker_signals()
+                    os._exit(0)
+                except BaseException as e:  # the test fails: say why
+                    os.write(2, f"{type(e).__name__}\n".encode())
+                    os._exit(3)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    _, wait_status = os.waitpid(pid, 0)
+    code = os.waitstatus_to_exitcode(wait_status)
+    assert code == status, err.read_text()
+    assert err.read_text() == ""

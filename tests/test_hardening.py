@@ -1310,3 +1310,22 @@ def test_a_worker_signalled_while_starting_is_silent(tmp_path, sig, status):
     code = os.waitstatus_to_exitcode(wait_status)
     assert code == status, err.read_text()
     assert err.read_text() == ""
+
+
+@pytest.mark.parametrize("address, phrase", [
+    ("foo", "missing port number"),
+    ("tcp://127.0.0.1", "missing port number"),
+    ("http://x:y", "unknown address scheme 'http'"),
+    ("tcp://h:0", "no port in 1-65535"),
+])
+def test_a_malformed_scheduler_address_is_a_usage_error_at_once(tmp_path, monkeypatch, capsys,
+                                                                cache_env, address, phrase):
+    """D1: a malformed --scheduler address gave exit 70, a ``Client.__del__`` traceback
+    and a 60 s stall; it is refused before any work: exit 2, one line."""
+    pytest.importorskip("distributed")
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, "run", ORTHO, str(TRAJECTORIES / "heart1.yaml"),
+                             "-q", "--backend", "flint", "--scheduler", address)
+    one_line_error(code, err, 2, phrase)
+    assert f"--scheduler {address}: not a scheduler address" in err and out == ""
+    assert time.monotonic() - start < 5

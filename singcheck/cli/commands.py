@@ -187,6 +187,13 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     from singcheck import api
     from singcheck.spec.files import load_robot, read_documents
 
+    if scheduler:
+        from singcheck.cluster import check_address
+
+        try:  # a malformed address: exit 2 now, not after the work
+            check_address(scheduler)
+        except SpecError as e:
+            fail(e.message, ExitCode.USAGE)
     spec = load_robot(robot)
     documents = read_documents(trajectories, interpolation)
     # the first documents (all of a small batch) are parsed here, before any work: a bad

@@ -1329,3 +1329,45 @@ def test_a_malformed_scheduler_address_is_a_usage_error_at_once(tmp_path, monkey
     one_line_error(code, err, 2, phrase)
     assert f"--scheduler {address}: not a scheduler address" in err and out == ""
     assert time.monotonic() - start < 5
+
+
+def _address_space_of(limit: int):
+    """A preexec_fn: the child (singcheck) runs under a hard RLIMIT_AS of ``limit``."""
+    def set_limit():
+        import resource
+
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    return set_limit
+
+
+def test_a_hard_ulimit_v_bounds_the_cas_under_it(tmp_path):
+    """F1: under ``ulimit -v`` below the default bound (half the machine's memory), the
+    CAS's setrlimit could not raise the hard limit: Singular did not start ('not allowed
+    to raise maximum limit'), flint's child 'exited with status 1'.  The bound is now
+    set under the inherited limit, and a CAS over it says to raise ``ulimit -v``."""
+    env = _fake_env(tmp_path, hang=False)
+    env.pop("SINGCHECK_MEMORY_LIMIT", None)
+    fake_cas(tmp_path, GREEDY_CAS)
+    out = subprocess.run([sys.executable, "-m", "singcheck", "run", ORTHO,
+                          str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular", "-q"],
+                         env=env, cwd=ROOT, capture_output=True, text=True, timeout=120,
+                         preexec_fn=_address_space_of(2 * 2**30))
+    one_line_error(out.returncode, out.stderr, 4,
+                   "Singular ran out of memory under the bound of 2 GiB (ulimit -v) per CAS "
+                   "process; raise the address-space limit singcheck runs under (ulimit -v)")
+
+
+def test_the_memory_bound_stays_under_the_inherited_limit(monkeypatch):
+    from singcheck.elimination.cas import limits
+
+    monkeypatch.setattr(limits, "inherited_limit", lambda: 3 * 2**30)
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "8G")
+    assert limits.memory_limit() == 3 * 2**30
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "1G")
+    assert limits.memory_limit() == 2**30
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "none")
+    assert limits.memory_limit() == 3 * 2**30  # none of ours: the inherited one holds
+    assert "ulimit -v" in limits.raise_hint(3 * 2**30)
+    monkeypatch.setattr(limits, "inherited_limit", lambda: 0)
+    assert limits.memory_limit() == 0
+    assert "SINGCHECK_MEMORY_LIMIT" in limits.raise_hint(2**30)

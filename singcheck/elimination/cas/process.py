@@ -151,8 +151,11 @@ def _terminate_as_interrupt() -> Iterator[None]:
 
 
 def _read(f, limit: int) -> str:
+    """Up to ``limit`` bytes of the file, as text; a buffer of its size, not of ``limit``
+    (256 MiB at once was a MemoryError under a small ``ulimit -v``)."""
     f.seek(0)
-    return f.read(limit).decode("utf-8", errors="replace")
+    size = os.fstat(f.fileno()).st_size
+    return f.read(min(limit, size)).decode("utf-8", errors="replace")
 
 
 def run_program(argv: list[str] | tuple[str, ...], timeout: float, *,

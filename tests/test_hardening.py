@@ -531,7 +531,8 @@ def _marked(marker: str) -> list[int]:
 @pytest.mark.parametrize("caller", ["cli", "thread"])
 def test_a_sigkilled_singcheck_leaves_no_cas_process(tmp_path, caller):
     """SIGKILL of singcheck cannot be handled; the guard the kernel signals
-    (PR_SET_PDEATHSIG) kills the CAS, its helper and its setsid'd grandchild."""
+    (PR_SET_PDEATHSIG) kills the CAS, its helper and its setsid'd grandchild, and (L1)
+    removes the CAS's $TMPDIR/singcheck-* directory, which singcheck no longer can."""
     marker = str(tmp_path)  # in the guard's, the fake's and its children's command lines
     env = {**_fake_env(tmp_path, hang=True), "FAKE_MARKER": marker}
     fake_cas(tmp_path, MARKED_CAS)
@@ -555,6 +556,10 @@ def test_a_sigkilled_singcheck_leaves_no_cas_process(tmp_path, caller):
         while _marked(marker):
             assert time.monotonic() < deadline, f"survived SIGKILL: {_marked(marker)}"
             time.sleep(0.05)
+        if caller == "cli":
+            while list((tmp_path / "tmp").iterdir()):
+                assert time.monotonic() < deadline, list((tmp_path / "tmp").iterdir())
+                time.sleep(0.05)
     finally:  # never leave a process behind, even when the test fails
         proc.kill()
         proc.wait()

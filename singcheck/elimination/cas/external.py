@@ -212,7 +212,8 @@ class ExternalBackend:
             path = os.path.join(tmp, f"{request.label}.{suffix}")
             with open(path, "w", encoding="utf-8") as f:
                 f.write(script)
-            run = run_program(self.cas.argv(self.executable, path), self.timeout, cwd=tmp)
+            run = run_program(self.cas.argv(self.executable, path), self.timeout, cwd=tmp,
+                              scratch=tmp)
         if run.returncode != 0 and run.memory_limit:
             memory = out_of_memory(run)
             if memory:

@@ -77,7 +77,8 @@ def output_file(path: str | os.PathLike) -> Iterator[_Output]:
     ends, not at all if it raises.  A symlink is followed and its target written (the
     link stays a link).  Anything else that exists — a character device such as
     ``/dev/null`` or ``/dev/stdout``, a FIFO, a socket — is opened and written in place,
-    as a shell redirection would, never replaced.  A missing parent directory is an
+    as a shell redirection would, never replaced (a FIFO that no process opens for
+    reading within :data:`FIFO_WAIT` seconds is an error).  A missing parent directory is an
     error, not created.  Every failure (``/dev/full``: no space left) is a
     :class:`~singcheck.errors.SpecError` naming the file and the reason (exit 2).
     """
@@ -94,9 +95,37 @@ def output_file(path: str | os.PathLike) -> Iterator[_Output]:
         parent = os.path.dirname(real) or "."
         if not in_place and not os.path.isdir(parent):
             raise FileNotFoundError(2, f"the directory {parent} does not exist")
-        opened = open(real, "w", encoding="utf-8") if in_place else atomic_file(real)
+        opened = _open_in_place(real) if in_place else atomic_file(real)
     with _reported(name), opened as f:
         yield _Output(f, name)
+
+
+#: how long ``-o FIFO`` waits for a process to open the FIFO for reading (seconds)
+FIFO_WAIT = 10.0
+
+
+def _open_in_place(path: str) -> TextIO:
+    """A device, FIFO or socket opened for writing without blocking on the open: a FIFO
+    that no process reads is retried for :data:`FIFO_WAIT` seconds, then an error
+    (a plain ``open`` waited for a reader for ever).  Writes then block as usual."""
+    import errno
+    import fcntl
+    import time
+
+    end = time.monotonic() + FIFO_WAIT
+    while True:
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK)
+            break
+        except OSError as e:
+            if e.errno != errno.ENXIO:
+                raise
+            if time.monotonic() >= end:
+                raise OSError(errno.ENXIO, f"no process reads this FIFO (waited "
+                                           f"{FIFO_WAIT:g} s for one)") from None
+            time.sleep(0.05)
+    fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) & ~os.O_NONBLOCK)
+    return open(fd, "w", encoding="utf-8")
 
 
 def write_output(path: str | os.PathLike, text: str) -> None:

@@ -1376,3 +1376,19 @@ def test_the_memory_bound_stays_under_the_inherited_limit(monkeypatch):
     monkeypatch.setattr(limits, "inherited_limit", lambda: 0)
     assert limits.memory_limit() == 0
     assert "SINGCHECK_MEMORY_LIMIT" in limits.raise_hint(2**30)
+
+
+def test_output_to_a_fifo_nobody_reads_is_an_error_not_a_hang(tmp_path, monkeypatch, capsys,
+                                                              cache_env):
+    """H2: ``-o`` onto a FIFO with no reader blocked in open() for ever.  It is opened
+    without blocking, retried for FIFO_WAIT seconds, then one line, exit 2."""
+    from singcheck import atomic
+
+    monkeypatch.setattr(atomic, "FIFO_WAIT", 0.5)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    start = time.monotonic()
+    code, _, err = _run_to(monkeypatch, capsys, str(fifo))
+    one_line_error(code, err, 2, "no process reads this FIFO (waited 0.5 s for one)")
+    assert time.monotonic() - start < 10
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)

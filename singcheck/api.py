@@ -415,8 +415,9 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
     ``trajectories`` is read lazily, a bounded window ahead of the results (specs, or
     :class:`~singcheck.spec.files.Document` from :func:`singcheck.spec.files.read_documents`,
     which the workers parse), so memory does not grow with their number.  One
-    trajectory's failure is its own result (:func:`check_item`); a worker process that
-    dies makes the trajectories it held ``error`` results.  ``time_limit`` bounds each
+    trajectory's failure is its own result (:func:`check_item`); the tasks a dying
+    worker process breaks are run again (:func:`_forked`), and only a trajectory whose
+    worker dies twice is an ``error`` result.  ``time_limit`` bounds each
     trajectory (and the shared region maps, once)."""
     from itertools import chain, islice
 

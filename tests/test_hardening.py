@@ -1431,3 +1431,19 @@ def test_the_crash_corpus(tmp_path, monkeypatch, capsys, cache_env, case):
     written = [p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file()
                and cache_env not in p.parents and tmp_path / "config" not in p.parents]
     assert all(p.parts[0] == "figures" for p in written), written  # only where told
+
+
+def test_plot_reads_a_trajectory_within_its_time_limit(tmp_path, cache_env):
+    """H1 for ``plot``: the 5,000-row CSV's spline is read under --time-limit too: no
+    figure for it, one line, exit 3, at the limit."""
+    path = _long_csv(tmp_path / "long.csv")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    start = time.monotonic()
+    done = subprocess.run([sys.executable, "-m", "singcheck", "plot", ORTHO, str(path),
+                           "--out", str(tmp_path / "out"), "-q", "--backend", "flint",
+                           "--time-limit", "1"], env=env, cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 3, done.stderr
+    assert "unknown: time limit (1 s) reached (while reading it" in done.stderr
+    assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
+    assert time.monotonic() - start < 1 + 4  # the start-up, the cached projection

@@ -488,10 +488,19 @@ def plot(robot, trajectories, out_dir, backend, fmt, spaces, slices, time_limit,
                 click.echo(str(path))
         if trajectories:
             from singcheck import api
+            from singcheck.budget import TimeLimitExceeded, deadline
             from singcheck.spec.files import load_trajectory
 
             machine = api.load_robot(robot, backend, notify=progress.note)
-            specs = [load_trajectory(p, machine.spec) for p in trajectories]
+            specs = []
+            for path in trajectories:  # reading one is bounded by its time limit too
+                try:
+                    with deadline(time_limit), api.hard_time_limit(time_limit):
+                        specs.append(load_trajectory(path, machine.spec))
+                except TimeLimitExceeded as e:
+                    click.echo(f"singcheck: {path}: unknown: {e} (while reading it; "
+                               "--time-limit): no figure", err=True)
+                    complete = False
             certificates = _certificates(machine, specs, time_limit)
             complete &= len(certificates) == len(specs)
             if fmt == "html":

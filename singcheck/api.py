@@ -18,6 +18,7 @@ same :class:`Robot` runs no CAS and reads no cache entry.
 
 from __future__ import annotations
 
+import signal
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -332,21 +333,24 @@ def region_budget() -> float:
 DEFAULT_TIME_LIMIT = 300.0
 
 
-def check_safely(robot: Robot, trajectory: TrajectorySpec, **options) -> dict[str, Any]:
+def check_safely(robot: Robot, trajectory: TrajectorySpec, *, spent: float = 0.0,
+                 **options) -> dict[str, Any]:
     """:func:`check` as one trajectory of a batch: its JSON trajectory object (with
     ``time_s``, the seconds it took), whatever happens.  A failure of this trajectory
     alone (a backend failure, a bug, the time limit) becomes its result — verdict
     ``unknown`` past the time limit, ``error`` with the reason otherwise — so that the
-    other trajectories of the batch still complete.
+    other trajectories of the batch still complete.  ``spent``: the seconds its parsing
+    took, which count against its time limit (and its ``time_s``).
     Ctrl-C (KeyboardInterrupt) still stops the batch."""
     import time
 
     from singcheck.errors import BackendError, SpecError
     from singcheck.report.trajectory import error_json, time_limited_json
 
-    start = time.perf_counter()
+    start = time.perf_counter() - spent
     try:
-        with hard_time_limit(options.get("time_limit")):
+        with deadline(options.get("time_limit"), spent), \
+                hard_time_limit(options.get("time_limit"), spent):
             doc = check(robot, trajectory, **options).to_dict()
     except TimeLimitExceeded as e:
         doc = time_limited_json(trajectory, str(e))
@@ -361,10 +365,11 @@ def check_safely(robot: Robot, trajectory: TrajectorySpec, **options) -> dict[st
 
 
 @contextmanager
-def hard_time_limit(seconds: float | None):
+def hard_time_limit(seconds: float | None, spent: float = 0.0):
     """A backstop behind the cooperative :func:`~singcheck.budget.checkpoint`: in a
     process's main thread, a timer raises :class:`TimeLimitExceeded` a little after the
-    limit (10 % and a second), should some loop not reach a checkpoint in time."""
+    limit (10 % and a second; ``spent`` of it gone already), should some loop not reach
+    a checkpoint in time."""
     import signal
     import threading
 
@@ -377,7 +382,7 @@ def hard_time_limit(seconds: float | None):
         raise TimeLimitExceeded(f"time limit ({seconds:g} s) reached")
 
     previous = signal.signal(signal.SIGALRM, expire)
-    signal.setitimer(signal.ITIMER_REAL, seconds * 1.1 + 1)
+    signal.setitimer(signal.ITIMER_REAL, max(seconds * 1.1 + 1 - spent, 1e-3))
     try:
         yield
     finally:
@@ -402,6 +407,11 @@ def _worker_signals() -> None:
     die_with_parent(_WORKER["parent"])  # SIGTERM: the default action
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)  # held while it was forked
+
+
+#: the signals held while workers are forked (:func:`_held_signals`)
+_HELD = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
 
 
 def _check_chunk(chunk: list) -> list[dict]:
@@ -410,19 +420,61 @@ def _check_chunk(chunk: list) -> list[dict]:
     return [check_item(robot, item, **options) for item in chunk]
 
 
-def check_item(robot: Robot, item: TrajectorySpec | Document, **options) -> dict[str, Any]:
+@dataclass
+class Parsed:
+    """A document parsed within its time limit (:func:`parse_within`): the spec, or None
+    when the limit stopped the parsing (``reason``), and the seconds it took — they
+    count against the trajectory's time limit."""
+
+    document: Document
+    spec: TrajectorySpec | None
+    seconds: float
+    reason: str = ""
+
+
+def parse_within(document: Document, robot_spec: RobotSpec,
+                 time_limit: float | None) -> Parsed:
+    """Parse ``document`` as the first stage of its trajectory's check: under its time
+    limit (a 5,000-row CSV's exact cubic spline is solved here).  A bad document raises
+    :class:`~singcheck.errors.SpecError`."""
+    import time
+
+    start = time.perf_counter()
+    try:
+        with deadline(time_limit), hard_time_limit(time_limit):
+            spec = document.parse(robot_spec)
+    except TimeLimitExceeded as e:
+        return Parsed(document, None, time.perf_counter() - start, f"{e} (while reading it)")
+    return Parsed(document, spec, time.perf_counter() - start)
+
+
+def spec_of(item: TrajectorySpec | Document | Parsed) -> TrajectorySpec | Document | None:
+    """The trajectory spec of a batch's item when it is parsed (None when its parsing ran
+    out of time), else the document."""
+    return item.spec if isinstance(item, Parsed) else item
+
+
+def check_item(robot: Robot, item: TrajectorySpec | Document | Parsed,
+               **options) -> dict[str, Any]:
     """:func:`check_safely` of a trajectory spec, or of a :class:`Document` read but not
-    parsed yet: it is parsed here, and one that is wrong is its own result (verdict
-    ``error``, ``error.kind`` ``spec``, the located message) like any failure of one
-    trajectory of a batch."""
+    parsed yet: it is parsed here, within the trajectory's time limit (past it: verdict
+    ``unknown``), and one that is wrong is its own result (verdict ``error``,
+    ``error.kind`` ``spec``, the located message) like any failure of one trajectory of
+    a batch."""
+    from singcheck.report.trajectory import error_json, time_limited_json
+
     if isinstance(item, Document):
         from singcheck.errors import SpecError
-        from singcheck.report.trajectory import error_json
 
         try:
-            item = item.parse(robot.spec)
+            item = parse_within(item, robot.spec, options.get("time_limit"))
         except SpecError as e:
             return {**error_json(item, "spec", str(e)), "time_s": 0.0}
+    if isinstance(item, Parsed):
+        if item.spec is None:
+            return {**time_limited_json(item.document, f"unknown: {item.reason}"),
+                    "time_s": round(item.seconds, 6)}
+        return check_safely(robot, item.spec, spent=item.seconds, **options)
     return check_safely(robot, item, **options)
 
 
@@ -456,7 +508,7 @@ def shared_regions(robot: Robot, head: list, options: dict, notify: Notify = _qu
     """Before a batch's workers start: the region maps that its first trajectories
     share, computed once (:func:`prepare_regions`); ``options["regions"]`` is turned off
     when that ran out of time."""
-    specs = [t for t in head if isinstance(t, TrajectorySpec)]
+    specs = [t for t in map(spec_of, head) if isinstance(t, TrajectorySpec)]
     if options["regions"] and specs and not prepare_regions(
             robot, specs, options["time_limit"], notify):
         options["regions"] = False
@@ -474,8 +526,9 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
     ``trajectories`` is read lazily, a bounded window ahead of the results (specs, or
     :class:`~singcheck.spec.files.Document` from :func:`singcheck.spec.files.read_documents`,
     which the workers parse), so memory does not grow with their number.  One
-    trajectory's failure is its own result (:func:`check_item`); a worker process that
-    dies makes the trajectories it held ``error`` results.  ``time_limit`` bounds each
+    trajectory's failure is its own result (:func:`check_item`); the tasks a dying
+    worker process breaks are run again (:func:`_forked`), and only a trajectory whose
+    worker dies twice is an ``error`` result.  ``time_limit`` bounds each
     trajectory (and the shared region maps, once).  ``selection``: :func:`check`'s
     ``mode``, ``start_joints``, ``clearance`` and ``min_clearance``, for each trajectory."""
     from itertools import chain, islice
@@ -496,9 +549,16 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
     """The batch in ``jobs`` forked workers, CHUNK trajectories per task and
     TASKS_PER_WORKER tasks per worker in flight: a finished task is replaced by the next
     one read (before its results are yielded), so at most that many trajectories are
-    held here at once, whatever the length of the batch."""
+    held here at once, whatever the length of the batch.
+
+    A worker that dies (killed, out of memory) breaks the pool and every task in flight
+    with it: each of those tasks is run again, alone in a new pool (no other task in
+    flight, so that a second death is its own); if it dies again, its trajectories are
+    run one by one, alone, and one whose worker dies then is that trajectory's
+    ``error`` (it killed its worker twice).  The others' results are kept."""
     import multiprocessing
     import os
+    from collections import deque
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
     from itertools import islice
@@ -515,39 +575,68 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
 
     pool = start()
     in_flight: dict = {}  # future -> (index of its first trajectory, its trajectories)
+    lost: deque = deque()  # (first index, trajectories) of tasks whose worker died
     read = 0
 
+    def send(chunk: list):
+        nonlocal pool
+        if getattr(pool, "_broken", False):
+            _stop(pool)
+            pool = start()
+        with _held_signals():  # a worker forked here sets its own handlers first (J1)
+            try:
+                return pool.submit(_check_chunk, chunk)
+            except BrokenProcessPool:  # broken since: the batch goes on in a new pool
+                _stop(pool)
+                pool = start()
+                return pool.submit(_check_chunk, chunk)
+
     def submit() -> bool:
-        nonlocal read, pool
+        nonlocal read
         chunk = list(islice(items, CHUNK))
         if chunk:
-            try:
-                future = pool.submit(_check_chunk, chunk)
-            except BrokenProcessPool:  # a worker died: the tasks it broke are errors, and
-                _stop(pool)  # the batch goes on in a new pool
-                pool = start()
-                future = pool.submit(_check_chunk, chunk)
-            in_flight[future] = (read, chunk)
+            in_flight[send(chunk)] = (read, chunk)
             read += len(chunk)
         return bool(chunk)
+
+    def alone(chunk: list) -> list[dict] | Exception:
+        try:
+            return send(chunk).result()
+        except Exception as e:  # noqa: BLE001 - its worker died, or it could not run
+            return e
+
+    def rerun(first: int, chunk: list) -> list[tuple[int, dict]]:
+        docs = alone(chunk) if len(chunk) > 1 else None
+        if isinstance(docs, list):
+            return list(enumerate(docs, first))
+        out = []
+        for index, item in enumerate(chunk, first):
+            result = alone([item])
+            if isinstance(result, Exception):
+                reason = (f"its worker process died twice (killed, or out of memory): "
+                          f"{type(result).__name__}: {result}")
+                result = [{**error_json(_head(item), "internal", reason), "time_s": 0.0}]
+            out.append((index, result[0]))
+        return out
 
     try:
         while len(in_flight) < jobs * TASKS_PER_WORKER and submit():
             pass
         done_early: dict[int, dict] = {}
         next_out = 0
-        while in_flight:
-            finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
+        while in_flight or lost:
             results: list[tuple[int, dict]] = []
-            for future in finished:
-                first, chunk = in_flight.pop(future)  # a done future holds its results
-                try:
-                    docs = future.result()
-                except Exception as e:  # the worker process died (killed, out of memory)
-                    reason = f"the worker process failed: {type(e).__name__}: {e}"
-                    docs = [error_json(item, "internal", reason) for item in chunk]
-                results += enumerate(docs, first)
-            while len(in_flight) < jobs * TASKS_PER_WORKER and submit():
+            if in_flight:
+                finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
+                for future in finished:
+                    first, chunk = in_flight.pop(future)  # a done future holds its results
+                    try:
+                        results += enumerate(future.result(), first)
+                    except Exception:  # noqa: BLE001 - its worker died: run it again
+                        lost.append((first, chunk))
+            if lost and not in_flight:  # the tasks the death broke, one at a time
+                results += rerun(*lost.popleft())
+            while not lost and len(in_flight) < jobs * TASKS_PER_WORKER and submit():
                 pass
             if not ordered:
                 for _, doc in results:
@@ -560,6 +649,32 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
     finally:
         _WORKER.clear()
         _stop(pool)
+
+
+def _head(item):
+    """What names a batch's item in its result: the spec, else the document."""
+    return item.document if isinstance(item, Parsed) and item.spec is None else \
+        spec_of(item)
+
+
+def _held_signals():
+    """Ctrl-C, SIGTERM and SIGHUP held in this thread for the duration of the block:
+    a worker forked inside it starts with them held, and :func:`_worker_signals`
+    releases them once its own handlers are set (one signalled while starting no
+    longer prints 'Exception in initializer … KeyboardInterrupt'); this process gets
+    them just after the block."""
+    import signal
+    from contextlib import contextmanager
+
+    @contextmanager
+    def block():
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+        try:
+            yield
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+    return block()
 
 
 def _stop(pool) -> None:

@@ -77,7 +77,8 @@ def output_file(path: str | os.PathLike) -> Iterator[_Output]:
     ends, not at all if it raises.  A symlink is followed and its target written (the
     link stays a link).  Anything else that exists — a character device such as
     ``/dev/null`` or ``/dev/stdout``, a FIFO, a socket — is opened and written in place,
-    as a shell redirection would, never replaced.  A missing parent directory is an
+    as a shell redirection would, never replaced (a FIFO that no process opens for
+    reading within :data:`FIFO_WAIT` seconds is an error).  A missing parent directory is an
     error, not created.  Every failure (``/dev/full``: no space left) is a
     :class:`~singcheck.errors.SpecError` naming the file and the reason (exit 2).
     """
@@ -94,15 +95,83 @@ def output_file(path: str | os.PathLike) -> Iterator[_Output]:
         parent = os.path.dirname(real) or "."
         if not in_place and not os.path.isdir(parent):
             raise FileNotFoundError(2, f"the directory {parent} does not exist")
-        opened = open(real, "w", encoding="utf-8") if in_place else atomic_file(real)
+        opened = _open_in_place(real) if in_place else atomic_file(real)
     with _reported(name), opened as f:
         yield _Output(f, name)
+
+
+#: how long ``-o FIFO`` waits for a process to open the FIFO for reading (seconds)
+FIFO_WAIT = 10.0
+
+
+def _open_in_place(path: str) -> TextIO:
+    """A device, FIFO or socket opened for writing without blocking on the open: a FIFO
+    that no process reads is retried for :data:`FIFO_WAIT` seconds, then an error
+    (a plain ``open`` waited for a reader for ever).  Writes then block as usual."""
+    import errno
+    import fcntl
+    import time
+
+    end = time.monotonic() + FIFO_WAIT
+    while True:
+        try:
+            fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK)
+            break
+        except OSError as e:
+            if e.errno != errno.ENXIO:
+                raise
+            if time.monotonic() >= end:
+                raise OSError(errno.ENXIO, f"no process reads this FIFO (waited "
+                                           f"{FIFO_WAIT:g} s for one)") from None
+            time.sleep(0.05)
+    fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) & ~os.O_NONBLOCK)
+    return open(fd, "w", encoding="utf-8")
 
 
 def write_output(path: str | os.PathLike, text: str) -> None:
     """Write a whole result to the user's ``-o`` target (see :func:`output_file`)."""
     with output_file(path) as f:
         f.write(text)
+
+
+#: the longest file-name stem made from input, in bytes of UTF-8: room for what follows
+#: it (``-jointspace.png``, a counter) under the usual limit of 255 bytes a name
+MAX_STEM_BYTES = 160
+
+
+def safe_file_name(text: str, taken: set[str] | None = None) -> str:
+    """``text`` (a name from a spec: input) as a file-name stem that stays inside the
+    directory it is joined to: letters and digits (any script), ``.``, ``_``, ``-``,
+    ``+``, ``=`` are kept, ``/`` becomes ``_``, parentheses become ``-`` (tan(phi/2) ->
+    tan-phi_2), anything else (NUL, a space, a control character) ``_``; leading dots
+    are dropped (no ``..``, no hidden file), and a stem longer than
+    :data:`MAX_STEM_BYTES` is cut, with a hash of the whole text so that long names
+    stay apart.  With ``taken`` (the stems already used in one directory by this run), a
+    stem already there gets ``-2``, ``-3``, … and the one returned is added to it, so two
+    names that map to the same stem never write the same file.
+
+    >>> safe_file_name("../escape"), safe_file_name("/etc/passwd"), safe_file_name("..")
+    ('_escape', '_etc_passwd', '_')
+    >>> taken = set()
+    >>> safe_file_name("a/b", taken), safe_file_name("a_b", taken)
+    ('a_b', 'a_b-2')
+    """
+    import hashlib
+
+    out = str(text).replace("/", "_").replace("(", "-").replace(")", "")
+    out = "".join(c if c.isalnum() or c in "._-+=" else "_" for c in out).lstrip(".") or "_"
+    if len(out.encode("utf-8")) > MAX_STEM_BYTES:
+        digest = hashlib.sha256(str(text).encode("utf-8", "surrogatepass")).hexdigest()[:12]
+        cut = out.encode("utf-8")[:MAX_STEM_BYTES - 13].decode("utf-8", "ignore")
+        out = f"{cut}-{digest}"
+    if taken is None:
+        return out
+    stem, n = out, 1
+    while stem.casefold() in taken:
+        n += 1
+        stem = f"{out}-{n}"
+    taken.add(stem.casefold())
+    return stem
 
 
 def _mode_for(target: Path) -> int:

@@ -26,13 +26,14 @@ class TimeLimitExceeded(SingcheckError):
 
 
 @contextmanager
-def deadline(seconds: float | None) -> Iterator[None]:
-    """Limit the work inside to ``seconds`` of wall-clock time (None: no limit; an outer,
-    earlier deadline still applies)."""
+def deadline(seconds: float | None, spent: float = 0.0) -> Iterator[None]:
+    """Limit the work inside to ``seconds`` of wall-clock time, ``spent`` of which have
+    already gone to an earlier stage of the same work (None: no limit; an outer, earlier
+    deadline still applies)."""
     if seconds is None:
         yield
         return
-    end = time.monotonic() + seconds
+    end = time.monotonic() + seconds - spent
     outer = _DEADLINE.get()
     if outer is not None and outer[0] < end:
         end, seconds = outer

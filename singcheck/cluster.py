@@ -33,12 +33,32 @@ from singcheck.spec.files import Document, TrajectorySpec
 CONNECT_TIMEOUT = 30  # seconds to reach the scheduler
 
 
-def _client(address: str):
+def check_address(address: str) -> None:
+    """Refuse (:class:`SpecError`, before any work) a ``--scheduler`` address that
+    dask.distributed cannot read: a scheme it does not know, no host, no port or a port
+    out of range.  Given one, ``Client`` raised from inside its constructor, printed a
+    ``Client.__del__`` traceback and stalled a minute on its way out."""
     try:
-        from distributed import Client
+        from distributed.comm.addressing import get_address_host_port, parse_address
+        from distributed.comm.registry import get_backend
     except ImportError:
         raise SpecError("--scheduler needs dask.distributed: pip install "
                         "'singcheck[dask]'") from None
+    try:
+        scheme, _ = parse_address(address)
+        get_backend(scheme)
+        host, port = get_address_host_port(address)
+        if not host or not 0 < port < 65536:
+            raise ValueError(f"no host, or no port in 1-65535, in {address!r}")
+    except (ValueError, TypeError) as e:
+        raise SpecError(f"--scheduler {address}: not a scheduler address ({e}); e.g. "
+                        "tcp://10.0.0.5:8786") from None
+
+
+def _client(address: str):
+    check_address(address)
+    from distributed import Client
+
     try:
         return Client(address, timeout=CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError) as e:

@@ -596,12 +596,11 @@ def test_memory_stays_flat_from_500_to_5000_paths_on_stdin(tmp_path):
     assert small < 200, small  # the command's own peak, not the launcher's parent's
 
 
-def test_a_dead_worker_fails_its_tasks_and_the_batch_goes_on(orthoglide_robot, tmp_path,
-                                                             monkeypatch):
-    """A worker killed mid-task (os._exit, as the OOM killer would): the trajectories
-    in flight then are errors saying so, and the ones read after it are certified by a
-    new pool of workers."""
+def _killing_batch(orthoglide_robot, tmp_path, monkeypatch, killer):
+    """A 12-path batch in 2 workers, one path a task, where ``killer(name)`` says whether
+    checking that path SIGKILLs its worker (as the OOM killer would)."""
     import os
+    import signal
 
     from singcheck import api
     from singcheck.spec.files import read_documents
@@ -609,35 +608,52 @@ def test_a_dead_worker_fails_its_tasks_and_the_batch_goes_on(orthoglide_robot, t
     real = api.check_safely
 
     def check_safely(robot, trajectory, **options):
-        if trajectory.name == "p1":
-            os._exit(1)
+        if killer(trajectory.name):
+            os.kill(os.getpid(), signal.SIGKILL)
         return real(robot, trajectory, **options)
 
     monkeypatch.setattr(api, "check_safely", check_safely)
-    monkeypatch.setattr(api, "CHUNK", 1)
-    monkeypatch.setattr(api, "TASKS_PER_WORKER", 1)
+    monkeypatch.setattr(api, "CHUNK", 2)
+    monkeypatch.setattr(api, "TASKS_PER_WORKER", 2)
     stream = tmp_path / "stream.yaml"
     stream.write_text("".join(f"---\nname: p{i}\nparameter: t\nrange: [0, 1]\npose:\n"
                               f"  x: {i}/20 + t/2\n  y: 1/4\n  z: 1\n" for i in range(12)))
     docs = list(api.check_batch(orthoglide_robot, read_documents([stream]), regions=False,
                                 jobs=2))
     assert [d["name"] for d in docs] == [f"p{i}" for i in range(12)]
-    assert docs[1]["verdict"] == "error"
-    assert docs[1]["error"]["message"].startswith("the worker process failed")
     expected = [api.check(orthoglide_robot, d.parse(orthoglide_robot.spec),
                           regions=False).verdict for d in read_documents([stream])]
-    # the trajectories in flight when p1's worker died fail with it (which ones depends on
-    # the scheduling: at most the window of tasks then submitted); every other one is
-    # certified, and those read after the renewal of the pool certainly are
-    failed = [i for i, d in enumerate(docs) if d["verdict"] == "error"]
-    assert all(docs[i]["error"]["message"].startswith("the worker process failed")
-               for i in failed)
-    assert 1 in failed
-    # the batch goes on in a new pool: the last trajectory, read long after the death, is
-    # certified (how many failed with p1 is the scheduler's: a bound on it, max < 8, was
-    # flaky on a loaded machine)
-    assert docs[-1]["verdict"] != "error" and len(failed) < len(docs) - 1
-    assert all(d["verdict"] == expected[i] for i, d in enumerate(docs) if i not in failed)
+    return docs, expected
+
+
+def test_a_path_that_kills_its_worker_twice_is_its_own_error(orthoglide_robot, tmp_path,
+                                                             monkeypatch):
+    """B1: a worker SIGKILLed mid-task broke the pool, and every task in flight became an
+    ``internal`` error (exit 70).  Each broken task is run again alone, then path by path:
+    only the path that kills its worker every time is an error; every other path,
+    whichever task it shared, is certified."""
+    docs, expected = _killing_batch(orthoglide_robot, tmp_path, monkeypatch,
+                                    lambda name: name == "p1")
+    assert docs[1]["verdict"] == "error"
+    assert docs[1]["error"]["message"].startswith("its worker process died twice"), docs[1]
+    assert [d["verdict"] for i, d in enumerate(docs) if i != 1] == \
+        [v for i, v in enumerate(expected) if i != 1]
+
+
+def test_a_worker_killed_once_loses_no_path(orthoglide_robot, tmp_path, monkeypatch):
+    """B1: a worker killed once (by someone else, while checking p3): its task and the
+    others in flight are run again, and every path is certified."""
+    flag = tmp_path / "killed-once"
+
+    def once(name: str) -> bool:
+        if name != "p3" or flag.exists():
+            return False
+        flag.write_text("")
+        return True
+
+    docs, expected = _killing_batch(orthoglide_robot, tmp_path, monkeypatch, once)
+    assert flag.exists()
+    assert [d["verdict"] for d in docs] == expected
 
 
 # -- JUnit against the schema CI tools check reports with -------------------------------

@@ -531,7 +531,8 @@ def _marked(marker: str) -> list[int]:
 @pytest.mark.parametrize("caller", ["cli", "thread"])
 def test_a_sigkilled_singcheck_leaves_no_cas_process(tmp_path, caller):
     """SIGKILL of singcheck cannot be handled; the guard the kernel signals
-    (PR_SET_PDEATHSIG) kills the CAS, its helper and its setsid'd grandchild."""
+    (PR_SET_PDEATHSIG) kills the CAS, its helper and its setsid'd grandchild, and (L1)
+    removes the CAS's $TMPDIR/singcheck-* directory, which singcheck no longer can."""
     marker = str(tmp_path)  # in the guard's, the fake's and its children's command lines
     env = {**_fake_env(tmp_path, hang=True), "FAKE_MARKER": marker}
     fake_cas(tmp_path, MARKED_CAS)
@@ -555,6 +556,10 @@ def test_a_sigkilled_singcheck_leaves_no_cas_process(tmp_path, caller):
         while _marked(marker):
             assert time.monotonic() < deadline, f"survived SIGKILL: {_marked(marker)}"
             time.sleep(0.05)
+        if caller == "cli":
+            while list((tmp_path / "tmp").iterdir()):
+                assert time.monotonic() < deadline, list((tmp_path / "tmp").iterdir())
+                time.sleep(0.05)
     finally:  # never leave a process behind, even when the test fails
         proc.kill()
         proc.wait()
@@ -1103,3 +1108,342 @@ def test_an_angle_with_a_huge_multiple_of_t_is_refused(tmp_path, monkeypatch, ca
     assert doc["verdict"] == "error"
     assert "multiple of t above 256" in doc["reason"] and "pose.phi" in doc["reason"]
     assert "OverflowError" not in out + err
+
+
+# -- second round (issue 31) ---------------------------------------------------------------
+
+RPR3 = str(ROBOTS / "3-rpr.yaml")
+
+
+@pytest.mark.parametrize("form", ["csv-linear", "csv-cubic", "segments"])
+def test_a_3rpr_path_of_pieces_crossing_at_its_join_is_decided(tmp_path, monkeypatch, capsys,
+                                                               cache_env, form):
+    """E1: the join test of the region statement got a surface in the 3-RPR's path ring
+    (t, s, c and phi's cos and sin) and unpacked its exponents as three (exit 70).  Both
+    pieces meet r1 = 1/2 exactly at the join t = 1 (x, y = 1/2, 0): one crossing."""
+    if form == "segments":
+        path = tmp_path / "e1.yaml"
+        path.write_text("name: e1\nparameter: t\nsegments:\n"
+                        "  - range: [0, 1]\n    pose: {x: 1 - t/2, y: 1 - t, phi: t/10}\n"
+                        "  - range: [1, 2]\n    pose: {x: t/2, y: t - 1, phi: t/10}\n")
+        extra = []
+    else:
+        path = tmp_path / "e1.csv"
+        path.write_text("t,x,y,phi\n0,1,1,0\n1,0.5,0,0.1\n2,1,1,0.2\n")
+        extra = ["--interpolation", form.split("-")[1]]
+    code, out, err = run_cli(monkeypatch, capsys, "run", RPR3, str(path), "-q", "--backend",
+                             "flint", "--format", "json", *extra)
+    assert code == 0, err
+    (doc,) = json.loads(out)["trajectories"]
+    assert doc["verdict"] == "singularity-free", doc
+    crossings = doc["workspace"]["crossings"]
+    assert [c["surfaces"] for c in crossings] == [["r1 = 1/2 (min)"]], crossings
+    assert crossings[0]["t_interval"] == [1.0, 1.0]
+
+
+def test_the_join_test_is_undecided_outside_the_trig_ring():
+    """sum_is_zero is exact on Q[t, sin t, cos t] only: a polynomial of a path ring with an
+    angle's variables is undecided (None), not an unpacking error."""
+    from singcheck.algebra.radicals import path_ring
+    from singcheck.algebra.trig import LinearInPi
+    from singcheck.algebra.trig_values import sum_is_zero
+
+    ring = path_ring([], [("cos(phi)", "sin(phi)")])
+    t, s, c, cphi, sphi = ring.gens()
+    assert sum_is_zero([(cphi ** 2 + sphi ** 2 - 1, LinearInPi(Fraction(1)))]) is None
+    assert sum_is_zero([(t * 0, LinearInPi(Fraction(1)))]) is None
+
+
+HOSTILE_NAMES = ["../escape", "/tmp/abs", "..", ".hidden", "a\0b", "L" * 3000,
+                 "héllo δ/ψ", "\u202e", "a/b", "a_b", "A_B", "$^$"]
+
+
+def test_every_hostile_name_becomes_a_file_name_inside_its_directory(tmp_path):
+    """S1: one helper makes every file name derived from input; each stays in its
+    directory, is a name the file system takes, and two names never share a stem."""
+    from singcheck.atomic import MAX_STEM_BYTES, safe_file_name
+
+    taken: set[str] = set()
+    stems = [safe_file_name(name, taken) for name in HOSTILE_NAMES]
+    assert len({s.casefold() for s in stems}) == len(stems), stems
+    for stem in stems:
+        assert "/" not in stem and "\0" not in stem and not stem.startswith("."), stem
+        assert len(stem.encode("utf-8")) <= MAX_STEM_BYTES + 4
+        target = (tmp_path / f"{stem}-jointspace.svg")
+        assert target.resolve().parent == tmp_path.resolve()
+        target.write_text("x")  # the file system takes it
+    assert safe_file_name("héllo δ") == "héllo_δ"
+    long_a, long_b = safe_file_name("L" * 3000), safe_file_name("L" * 2999 + "M")
+    assert long_a != long_b
+    assert safe_file_name("a/b", set()) == safe_file_name("a/b", set())  # stable
+
+
+@pytest.mark.slow
+def test_figures_of_hostile_names_stay_in_the_figure_directory(tmp_path, monkeypatch, capsys,
+                                                               cache_env):
+    """S1: ``run --plot DIR`` and ``plot --out DIR`` wrote ``name: ../escape`` beside DIR
+    and an absolute name at that path; '$^$' in a title stopped matplotlib (exit 70).
+    Now every figure is in DIR, and a/b and a_b both keep their figures."""
+    names = ["../escape", str(tmp_path / "abs"), "a/b", "a_b", "$^$"]
+    docs = [f'name: {json.dumps(n)}\nparameter: t\nrange: [0, 1]\npose: {{x: t, y: 1}}\n'
+            for n in names]
+    spec = tmp_path / "hostile.yaml"
+    spec.write_text("---\n".join(docs))
+    figures = tmp_path / "deep" / "figs"
+    code, _, err = run_cli(monkeypatch, capsys, "run", BIGLIDE, str(spec), "-q", "--backend",
+                           "flint", "--plot", str(figures))
+    assert code == 0, err
+    outside = [p for p in tmp_path.rglob("*") if p.is_file()
+               and figures not in p.parents and p != spec and cache_env not in p.parents
+               and "config" not in p.parts]
+    assert outside == []
+    stems = {p.name.rsplit("-", 1)[0] for p in figures.iterdir()}
+    assert len(stems) == len(names) and {"a_b", "a_b-2", "_escape"} <= stems, stems
+    assert len(list(figures.iterdir())) == 10 * len(names)
+    # plot --out alike, one file per trajectory
+    files = [tmp_path / f"p{i}.yaml" for i in range(3)]
+    for file, doc in zip(files, docs, strict=False):
+        file.write_text(doc)
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "singcheck", "plot", BIGLIDE, *map(str, files),
+                           "--out", str(out), "-q", "--backend", "flint"],
+                          env={**os.environ, "PYTHONPATH": str(ROOT)}, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert len(lines) == 30 and all(Path(line).parent == out for line in lines), lines
+    assert len(list(out.iterdir())) == 30
+
+
+@pytest.mark.parametrize("row, phrase", [
+    ("9" * 308 + ",0.9,1.1,1", "t: the number 9999999999…999999 (308 characters) is too "
+                               "large (at most 512 bits)"),
+    ("1,0.9,1.1," + "1" * 200, "z: the number"),
+    ("1,1/" + "7" * 200 + ",1.1,1", "x: the number"),
+    ("1,1e-400,1.1,1", "x: the number 1e-400 is too large"),
+    ("1/0,0.9,1.1,1", "t: '1/0' divides by zero"),
+])
+def test_csv_cells_obey_the_bounds_of_spec_numbers(tmp_path, monkeypatch, capsys, cache_env,
+                                                   row, phrase):
+    """E2: a CSV time cell of 308 digits overflowed a float in the cover of one period
+    (exit 70); the same number as a YAML range end was a clean exit 2.  A cell now goes
+    through the spec grammar's number bound, before its value is built."""
+    path = tmp_path / "e2.csv"
+    path.write_text(f"t,x,y,z\n0,0.25,0.6,1\n{row}\n")
+    code, _, err = run_cli(monkeypatch, capsys, "run", ORTHO, str(path), "-q", "--backend",
+                           "flint")
+    one_line_error(code, err, 2, phrase)
+    assert "e2.csv:3:" in err
+
+
+def _long_csv(path: Path, rows: int = 5000) -> Path:
+    lines = ["t,x,y,z"] + [f"{i},{0.5 + 0.3 * math.cos(i / 50):.4f},"
+                           f"{0.5 + 0.3 * math.sin(i / 50):.4f},1" for i in range(rows)]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_the_time_limit_counts_from_reading_the_document(tmp_path, monkeypatch, capsys,
+                                                          cache_env):
+    """H1: a 5,000-row CSV's exact cubic spline was solved while the document was parsed,
+    before any limit applied (11 s under --time-limit 2).  Parsing is now the first stage
+    of the trajectory's check: unknown at the limit, within a second."""
+    path = _long_csv(tmp_path / "long.csv")
+    run_cli(monkeypatch, capsys, "run", ORTHO, str(TRAJECTORIES / "heart1.yaml"), "-q",
+            "--backend", "flint", "--no-regions")  # the projection, cached: not timed
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, "run", ORTHO, str(path), "-q", "--backend",
+                             "flint", "--time-limit", "2", "--format", "json")
+    elapsed = time.monotonic() - start
+    assert code == 3, err
+    (doc,) = json.loads(out)["trajectories"]
+    assert doc["verdict"] == "unknown" and "time limit (2 s)" in doc["reason"], doc
+    assert elapsed < 3.0, elapsed
+
+
+def test_a_document_parsed_by_a_worker_counts_its_parsing(tmp_path, orthoglide_projection):
+    """The same for a document parsed by a batch's worker (check_item), and the parsing's
+    seconds count against the check that follows it."""
+    from singcheck import api
+    from singcheck.spec.files import read_documents
+
+    model = orthoglide_projection.model
+    orthoglide_robot = api.Robot(model.spec, model, orthoglide_projection)
+    (document,) = read_documents([str(_long_csv(tmp_path / "long.csv"))], "cubic")
+    start = time.monotonic()
+    doc = api.check_item(orthoglide_robot, document, time_limit=1.0, regions=False)
+    assert time.monotonic() - start < 2.0
+    assert doc["verdict"] == "unknown" and "while reading it" in doc["reason"], doc
+    (short,) = read_documents([str(_long_csv(tmp_path / "short.csv", 300))], "cubic")
+    parsed = api.parse_within(short, orthoglide_robot.spec, 100)
+    assert parsed.spec is not None
+    parsed.seconds = 100.0  # as if its parsing had taken the whole limit
+    doc = api.check_item(orthoglide_robot, parsed, time_limit=100.0, regions=False)
+    assert doc["verdict"] == "unknown" and doc["time_s"] >= 100, doc
+    assert "time limit (100 s) reached" in doc["reason"], doc
+
+
+@pytest.mark.parametrize("sig, status", [(signal.SIGINT, 0), (signal.SIGHUP, 0),
+                                         (signal.SIGTERM, -signal.SIGTERM)])
+def test_a_worker_signalled_while_starting_is_silent(tmp_path, sig, status):
+    """J1: a worker signalled between its fork and its initializer (which sets its own
+    handlers) ran the parent's handlers and printed 'Exception in initializer …
+    KeyboardInterrupt'.  Workers are forked with the signals held, and the initializer
+    releases them once its handlers are set: Ctrl-C and a hangup are ignored, SIGTERM
+    ends the worker, silently."""
+    from singcheck import api
+
+    err = tmp_path / "stderr"
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)  # as singcheck's
+    try:
+        with api._held_signals():
+            pid = os.fork()
+            if pid == 0:  # the worker, signalled before its initializer runs
+                try:
+                    fd = os.open(err, os.O_WRONLY | os.O_CREAT)
+                    os.dup2(fd, 2)
+                    os.kill(os.getpid(), sig)
+                    api._WORKER["parent"] = os.getppid()
+                    api._worker_signals()
+                    os._exit(0)
+                except BaseException as e:  # the test fails: say why
+                    os.write(2, f"{type(e).__name__}\n".encode())
+                    os._exit(3)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    _, wait_status = os.waitpid(pid, 0)
+    code = os.waitstatus_to_exitcode(wait_status)
+    assert code == status, err.read_text()
+    assert err.read_text() == ""
+
+
+@pytest.mark.parametrize("address, phrase", [
+    ("foo", "missing port number"),
+    ("tcp://127.0.0.1", "missing port number"),
+    ("http://x:y", "unknown address scheme 'http'"),
+    ("tcp://h:0", "no port in 1-65535"),
+])
+def test_a_malformed_scheduler_address_is_a_usage_error_at_once(tmp_path, monkeypatch, capsys,
+                                                                cache_env, address, phrase):
+    """D1: a malformed --scheduler address gave exit 70, a ``Client.__del__`` traceback
+    and a 60 s stall; it is refused before any work: exit 2, one line."""
+    pytest.importorskip("distributed")
+    start = time.monotonic()
+    code, out, err = run_cli(monkeypatch, capsys, "run", ORTHO, str(TRAJECTORIES / "heart1.yaml"),
+                             "-q", "--backend", "flint", "--scheduler", address)
+    one_line_error(code, err, 2, phrase)
+    assert f"--scheduler {address}: not a scheduler address" in err and out == ""
+    assert time.monotonic() - start < 5
+
+
+def _address_space_of(limit: int):
+    """A preexec_fn: the child (singcheck) runs under a hard RLIMIT_AS of ``limit``."""
+    def set_limit():
+        import resource
+
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    return set_limit
+
+
+def test_a_hard_ulimit_v_bounds_the_cas_under_it(tmp_path):
+    """F1: under ``ulimit -v`` below the default bound (half the machine's memory), the
+    CAS's setrlimit could not raise the hard limit: Singular did not start ('not allowed
+    to raise maximum limit'), flint's child 'exited with status 1'.  The bound is now
+    set under the inherited limit, and a CAS over it says to raise ``ulimit -v``."""
+    env = _fake_env(tmp_path, hang=False)
+    env.pop("SINGCHECK_MEMORY_LIMIT", None)
+    fake_cas(tmp_path, GREEDY_CAS)
+    out = subprocess.run([sys.executable, "-m", "singcheck", "run", ORTHO,
+                          str(TRAJECTORIES / "heart1.yaml"), "--backend", "singular", "-q"],
+                         env=env, cwd=ROOT, capture_output=True, text=True, timeout=120,
+                         preexec_fn=_address_space_of(2 * 2**30))
+    one_line_error(out.returncode, out.stderr, 4,
+                   "Singular ran out of memory under the bound of 2 GiB (ulimit -v) per CAS "
+                   "process; raise the address-space limit singcheck runs under (ulimit -v)")
+
+
+def test_the_memory_bound_stays_under_the_inherited_limit(monkeypatch):
+    from singcheck.elimination.cas import limits
+
+    monkeypatch.setattr(limits, "inherited_limit", lambda: 3 * 2**30)
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "8G")
+    assert limits.memory_limit() == 3 * 2**30
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "1G")
+    assert limits.memory_limit() == 2**30
+    monkeypatch.setenv("SINGCHECK_MEMORY_LIMIT", "none")
+    assert limits.memory_limit() == 3 * 2**30  # none of ours: the inherited one holds
+    assert "ulimit -v" in limits.raise_hint(3 * 2**30)
+    monkeypatch.setattr(limits, "inherited_limit", lambda: 0)
+    assert limits.memory_limit() == 0
+    assert "SINGCHECK_MEMORY_LIMIT" in limits.raise_hint(2**30)
+
+
+def test_output_to_a_fifo_nobody_reads_is_an_error_not_a_hang(tmp_path, monkeypatch, capsys,
+                                                              cache_env):
+    """H2: ``-o`` onto a FIFO with no reader blocked in open() for ever.  It is opened
+    without blocking, retried for FIFO_WAIT seconds, then one line, exit 2."""
+    from singcheck import atomic
+
+    monkeypatch.setattr(atomic, "FIFO_WAIT", 0.5)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    start = time.monotonic()
+    code, _, err = _run_to(monkeypatch, capsys, str(fifo))
+    one_line_error(code, err, 2, "no process reads this FIFO (waited 0.5 s for one)")
+    assert time.monotonic() - start < 10
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+
+
+CRASHES = sorted(p for p in (ROOT / "tests" / "data" / "crashes").iterdir()
+                 if p.suffix in (".yaml", ".csv"))
+
+
+def _replay_header(case: Path) -> dict[str, str]:
+    """The ``# key: value`` lines at the top of a corpus file."""
+    header = {}
+    for line in case.read_text().splitlines():
+        if not line.startswith("# "):
+            break
+        key, _, value = line[2:].partition(":")
+        header[key.strip()] = value.strip()
+    return header
+
+
+@pytest.mark.parametrize("case", CRASHES, ids=lambda p: p.name)
+def test_the_crash_corpus(tmp_path, monkeypatch, capsys, cache_env, case):
+    """Every input that once crashed singcheck or ran past its time limit (the fuzz
+    campaigns' and the hostile runs' findings, tests/data/crashes/) now ends with an
+    exit status 0-3, no traceback, within its time limit, writing only where told."""
+    header = _replay_header(case)
+    args = header.get("args", "").replace("{tmp}", str(tmp_path)).split()
+    limit = float(args[args.index("--time-limit") + 1]) if "--time-limit" in args else 60
+    robot = str(ROBOTS / f"{header['robot']}.yaml")
+    from singcheck import api
+
+    api.load_robot(robot, backend="flint")  # the projection, cached: not timed
+    start = time.monotonic()
+    code, _, err = run_cli(monkeypatch, capsys, "run", robot, str(case), "-q", "--backend",
+                           "flint", "--format", "json", *args)
+    elapsed = time.monotonic() - start
+    assert code in (0, 1, 2, 3), err
+    assert "Traceback" not in err and "internal error" not in err, err
+    assert elapsed < limit + 3, elapsed  # the region maps of a new subspace, at most
+    written = [p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file()
+               and cache_env not in p.parents and tmp_path / "config" not in p.parents]
+    assert all(p.parts[0] == "figures" for p in written), written  # only where told
+
+
+def test_plot_reads_a_trajectory_within_its_time_limit(tmp_path, cache_env):
+    """H1 for ``plot``: the 5,000-row CSV's spline is read under --time-limit too: no
+    figure for it, one line, exit 3, at the limit."""
+    path = _long_csv(tmp_path / "long.csv")
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    start = time.monotonic()
+    done = subprocess.run([sys.executable, "-m", "singcheck", "plot", ORTHO, str(path),
+                           "--out", str(tmp_path / "out"), "-q", "--backend", "flint",
+                           "--time-limit", "1"], env=env, cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 3, done.stderr
+    assert "unknown: time limit (1 s) reached (while reading it" in done.stderr
+    assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
+    assert time.monotonic() - start < 1 + 4  # the start-up, the cached projection

@@ -127,10 +127,13 @@ def _zero_at_angle(p: fmpq_mpoly, g: Fraction) -> bool:
 
 
 def sum_is_zero(terms: list[tuple[fmpq_mpoly, LinearInPi]]) -> bool | None:
-    """Exactly whether Σ pᵢ at τᵢ vanishes (see the module docstring); None if undecided."""
+    """Exactly whether Σ pᵢ at τᵢ vanishes (see the module docstring); None if undecided
+    (also for a polynomial outside ``TRIG``, with a pose angle's or a radical's variable)."""
     transcendental: dict[Fraction, fmpq_mpoly] = {}
     algebraic: list[tuple[Fraction, dict[int, fmpq_mpoly]]] = []
     for p, at in terms:
+        if p.context() is not TRIG:
+            return None  # a path ring's angle or radical variables: not handled here
         p = reduce_trig(p)
         if p.is_zero():
             continue

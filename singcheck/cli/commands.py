@@ -321,6 +321,13 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     from singcheck import api
     from singcheck.spec.files import load_robot, read_documents
 
+    if scheduler:
+        from singcheck.cluster import check_address
+
+        try:  # a malformed address: exit 2 now, not after the work
+            check_address(scheduler)
+        except SpecError as e:
+            fail(e.message, ExitCode.USAGE)
     spec = load_robot(robot)
     documents = read_documents(trajectories, interpolation, csv=table, all_csv=all_csv)
     # the first documents (all of a small batch) are parsed here, before any work: a bad
@@ -333,7 +340,9 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         if robot != "-":
             with open(robot, encoding="utf-8") as f:
                 robot_text = f.read()
-    first = [document.parse(spec) for document in islice(documents, api.LOOKAHEAD)]
+    # (each within its trajectory's time limit: parsing is the first stage of its check)
+    first = [api.parse_within(document, spec, time_limit)
+             for document in islice(documents, api.LOOKAHEAD)]
     total = len(first) if len(first) < api.LOOKAHEAD else None  # None: not known yet
     items = chain(first, documents)
     kept: list = []
@@ -431,16 +440,17 @@ def _keeping(items, kept: list):
 def _parsed(items: list, robot_spec) -> list:
     """The trajectory specs among ``items`` (documents parsed; a bad one left out: the
     batch has reported it)."""
+    from singcheck.api import spec_of
     from singcheck.errors import SpecError
     from singcheck.spec.files import Document
 
     specs = []
-    for item in items:
+    for item in map(spec_of, items):
         try:
             specs.append(item.parse(robot_spec) if isinstance(item, Document) else item)
         except SpecError:
             pass
-    return specs
+    return [spec for spec in specs if spec is not None]  # None: its time limit
 
 
 class _Sink:
@@ -616,11 +626,12 @@ def _plot_all(certificates, out_dir: str, progress, clearance: list | None = Non
     except ImportError as e:
         raise SpecError(f"plotting needs matplotlib, scikit-image and numpy ({e.name} is "
                         "missing): pip install 'singcheck[plot]'") from None
-    written = []
+    written: list = []
+    taken: set[str] = set()  # two names with one safe file name must not overwrite
     for i, certificate in enumerate(certificates):
         written += write_figures(certificate, out_dir,
                                  clearance=None if clearance is None else clearance[i],
-                                 gate=gate)
+                                 gate=gate, taken=taken)
     progress.note(f"wrote {len(written)} figure files to {out_dir}")
     return written
 
@@ -697,10 +708,19 @@ def plot(robot, trajectories, out_dir, backend, fmt, plotly_js, spaces, slices, 
                 click.echo(str(path))
         if trajectories:
             from singcheck import api
+            from singcheck.budget import TimeLimitExceeded, deadline
             from singcheck.spec.files import load_trajectory
 
             machine = api.load_robot(robot, backend, notify=progress.note)
-            specs = [load_trajectory(p, machine.spec) for p in trajectories]
+            specs = []
+            for path in trajectories:  # reading one is bounded by its time limit too
+                try:
+                    with deadline(time_limit), api.hard_time_limit(time_limit):
+                        specs.append(load_trajectory(path, machine.spec))
+                except TimeLimitExceeded as e:
+                    click.echo(f"singcheck: {path}: unknown: {e} (while reading it; "
+                               "--time-limit): no figure", err=True)
+                    complete = False
             certificates = _certificates(machine, specs, time_limit)
             complete &= len(certificates) == len(specs)
             kappa = _clearances(certificates, want_clearance, min_clearance)

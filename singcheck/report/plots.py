@@ -382,11 +382,17 @@ def _clearance_figure(plt, report: TrajectoryReport, clearance: dict, gate, titl
 
 def write_figures(report: TrajectoryReport, out_dir: str | Path,
                   formats: tuple[str, ...] = ("png", "svg"), dpi: int = 120,
-                  clearance: dict | None = None, gate: float | None = None) -> list[Path]:
-    """Write the figures for one trajectory; returns the files written.  With
-    ``clearance`` (label -> :class:`~singcheck.certify.clearance.Clearance`), also κ(t)
-    per mode with its certified minimum and the ``gate`` line."""
+                  clearance: dict | None = None, gate: float | None = None,
+                  taken: set[str] | None = None) -> list[Path]:
+    """Write the figures for one trajectory into ``out_dir``, named after it
+    (:func:`~singcheck.atomic.safe_file_name`: a name from the spec never leaves
+    ``out_dir``; ``taken``: the names already written there by this run, kept apart);
+    returns the files written.  With ``clearance`` (label ->
+    :class:`~singcheck.certify.clearance.Clearance`), also κ(t) per mode with its
+    certified minimum and the ``gate`` line."""
     import matplotlib
+
+    from singcheck.atomic import safe_file_name
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -394,8 +400,9 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     d = figure_data(report)
-    robot = report.path.projection.model.name
-    name = report.name
+    # names from the specs, as plain text in the titles ('$' would start mathtext)
+    robot = report.path.projection.model.name.replace("$", r"\$")
+    name = report.name.replace("$", r"\$")
     makers = {
         "mu": lambda: _mu_figure(plt, d, f"{robot} · {name}: μ(t) and its certified roots"),
         "detA": lambda: _det_figure(plt, d, f"{robot} · {name}: det A along feasible modes"),
@@ -414,13 +421,14 @@ def write_figures(report: TrajectoryReport, out_dir: str | Path,
     if clearance is not None:
         makers["clearance"] = lambda: _clearance_figure(
             plt, report, clearance, gate, f"{robot} · {name}: clearance κ(t)")
+    stem = safe_file_name(report.name, taken)
     written = []
     for key in makers:
         fig = makers[key]()
         if fig is None:  # no drawing in the robot spec
             continue
         for fmt in formats:
-            target = out / f"{name}-{key}.{fmt}"
+            target = out / f"{stem}-{key}.{fmt}"
             fig.savefig(target, dpi=dpi, bbox_inches="tight")
             written.append(target)
         plt.close(fig)

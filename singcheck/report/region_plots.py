@@ -19,6 +19,7 @@ from pathlib import Path
 
 from flint import fmpq
 
+from singcheck.atomic import safe_file_name
 from singcheck.spaces.analysis import LIMIT, PARALLEL, SERIAL, SpaceAnalysis
 from singcheck.spaces.cad import fiber
 
@@ -181,7 +182,8 @@ def write_region_figure(analysis: SpaceAnalysis, out_dir: str | Path,
                 thin.append(Line2D([], [], marker="x", color="black", ls="none",
                                    label=f"R{number} ({count}): thin, at ({x:.2f}, {y:.2f})"))
     where = ", ".join(f"{k} = {v}" for k, v in analysis.fixed.items())
-    ax.set_title(f"{analysis.robot} · {analysis.space}" + (f" at {where}" if where else "")
+    robot = analysis.robot.replace("$", r"\$")  # plain text, not mathtext
+    ax.set_title(f"{robot} · {analysis.space}" + (f" at {where}" if where else "")
                  + ": regions and the discriminant variety")
     ax.set_xlabel(analysis.axes[0])
     ax.set_ylabel(analysis.axes[1])
@@ -194,8 +196,8 @@ def write_region_figure(analysis: SpaceAnalysis, out_dir: str | Path,
               frameon=False)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    stem = f"{analysis.robot}-{analysis.space}" + "".join(
-        f"-{_file_safe(k)}={_file_safe(v)}" for k, v in analysis.fixed.items())
+    stem = safe_file_name(f"{analysis.robot}-{analysis.space}" + "".join(
+        f"-{k}={v}" for k, v in analysis.fixed.items()))
     written = []
     for fmt in formats:
         target = out / f"{stem}.{fmt}"
@@ -204,10 +206,3 @@ def write_region_figure(analysis: SpaceAnalysis, out_dir: str | Path,
         written.append(target)
     plt.close(fig)
     return written
-
-
-def _file_safe(text) -> str:
-    """An axis or value as a file-name part a shell takes unquoted: tan(phi/2) -> tan-phi_2,
-    1/2 -> 1_2 (letters, digits, '.', '_', '-' only)."""
-    out = str(text).replace("/", "_").replace("(", "-").replace(")", "")
-    return "".join(c if c.isalnum() or c in "._-" else "_" for c in out)

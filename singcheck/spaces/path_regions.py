@@ -266,11 +266,9 @@ def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
     a stretch ending one piece and a stretch starting the next are one stretch (the path
     between their points crosses nothing), and a crossing ending one piece and one
     starting the next are one crossing when every surface of both vanishes exactly at the
-    join (:func:`singcheck.algebra.trig_values.sum_is_zero`).  The region is named, for a
+    join (:func:`_vanishes_at_join`).  The region is named, for a
     path crossing nothing, in the smallest subspace holding the first piece when every
     piece lies in that same subspace."""
-    from singcheck.algebra.trig_values import sum_is_zero
-
     spec = report.trajectory
     items: list = []  # crossings and stretches in time order, in the user's parameter
     undecided: list[str] = []
@@ -293,7 +291,7 @@ def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
             elif isinstance(last, Crossing) and isinstance(first, Crossing):
                 surfaces = dict(path_surfaces(r.path))
                 if set(last.surfaces) == set(first.surfaces) and all(
-                        sum_is_zero([(surfaces[s], piece.local_time(at))]) is True
+                        _vanishes_at_join(surfaces[s], piece.local_time(at))
                         for s in first.surfaces):
                     own = own[1:]  # the same crossing, exactly at the join
         items += own
@@ -311,6 +309,25 @@ def pieces_in_workspace(report, tolerance: float = 1e-9, region_cache=None,
             else:
                 _name_region(result, report.pieces[0].path, region_cache, notify)
     return result
+
+
+def _vanishes_at_join(p, at) -> bool:
+    """Proven: the surface ``p`` (in the piece's path ring) vanishes at its local time
+    ``at``.  A polynomial in t, sin t, cos t alone is decided by
+    :func:`~singcheck.algebra.trig_values.sum_is_zero`; one with a pose angle's cos and
+    sin (a 3-RPR path whose phi is a polynomial in t) only at ``at`` = 0, where an angle
+    g(0) + qπ with 2q an integer is exact (else it must vanish whatever the angle's value).
+    False when not proven: the two crossings then stay two."""
+    from singcheck.algebra.trig import TRIG
+    from singcheck.algebra.trig_values import sum_is_zero
+    from singcheck.roots.branch_bound import vanishes_at_multiple_of_pi
+
+    terms = p.to_dict()
+    if p.context() is not TRIG and not any(any(e[3:]) for e in terms):
+        p = TRIG.from_dict({e[:3]: c for e, c in terms.items()})  # free of the others
+    if p.context() is TRIG:
+        return sum_is_zero([(p, at)]) is True
+    return at.rational == 0 and at.pi_coefficient == 0 and vanishes_at_multiple_of_pi(p, 0)
 
 
 # ---------------------------------------------------------------------------------

@@ -32,6 +32,7 @@ from singcheck.algebra.trig import TRIG, LinearInPi, T, TimeRange, evaluate_trig
 from singcheck.algebra.trig_values import sum_is_zero
 from singcheck.budget import checkpoint
 from singcheck.errors import SpecError
+from singcheck.spec.grammar import ExprError, _exact_number, _short
 from singcheck.spec.plainyaml import kind
 from singcheck.spec.trajectory import TrajectorySpec, pose_nodes, time_range, trajectory_piece
 
@@ -44,7 +45,6 @@ def _line(node) -> int:
 
 MAX_WAYPOINTS = 5000
 _NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE](?P<exponent>[+-]?\d+))?(?:/\d+)?\Z")
-MAX_EXPONENT = 300  # of a decimal in a CSV cell (10^300 is far beyond any robot)
 
 
 def multi_piece(doc, root, top, name: str, parameter: str, robot,
@@ -252,13 +252,12 @@ def parse_csv(text: str, path: str, robot, interpolation: str | CsvFormat,
             number = _NUMBER.match(cell)
             if not number:
                 raise SpecError(f"{name}: {cell!r} is not a number", path=path, line=n)
-            if number.group("exponent") and abs(int(number.group("exponent"))) > MAX_EXPONENT:
-                raise SpecError(f"{name}: {cell!r} has an exponent beyond ±{MAX_EXPONENT}",
-                                path=path, line=n)
             try:
-                exact.append(Fraction(cell))
+                exact.append(_cell_value(cell))
+            except ExprError as e:
+                raise SpecError(f"{name}: {e.message}", path=path, line=n) from None
             except ZeroDivisionError:
-                raise SpecError(f"{name}: {cell!r} divides by zero", path=path,
+                raise SpecError(f"{name}: {_short(cell)!r} divides by zero", path=path,
                                 line=n) from None
         exact = [value * factors.get(name, 1) for name, value in zip(names, exact,
                                                                       strict=True)]
@@ -299,6 +298,16 @@ def _mapped(table: CsvFormat, header: list[str], robot, path: str, line: int):
             raise SpecError(f"column {column!r} appears twice", path=path, line=line)
         index.append(header.index(column))
     return variables, (index, len(header))
+
+
+def _cell_value(cell: str) -> Fraction:
+    """A CSV cell's exact value (a decimal, or a fraction of two), with the bounds of a
+    number in a spec: each literal of at most MAX_LITERAL_BITS bits, refused before it
+    is built (a 308-digit time once overflowed a float further on)."""
+    sign = -1 if cell.startswith("-") else 1
+    numerator, _, denominator = cell.lstrip("+-").partition("/")
+    value = _exact_number(numerator, 1)
+    return sign * (value / _exact_number(denominator, 1) if denominator else value)
 
 
 def interpolated_pieces(path: str, name: str, parameter: str, times: list[Fraction],
@@ -352,10 +361,12 @@ def natural_cubic_spline(ts: list[Fraction], ys: list[Fraction]) -> list[fmpq_mp
             diag.append(d)
             rhs.append(r)
         for i in range(n - 1, 0, -1):
+            checkpoint()  # the exact Mᵢ grow with the rows: each step costs more
             m[i] = (rhs[i - 1] - h[i] * m[i + 1]) / diag[i - 1]
     one = TRIG.from_dict({(0, 0, 0): 1})
     out = []
     for i in range(n):
+        checkpoint()
         a, b = one * h[i] - T, T
         out.append(a ** 3 * (m[i] / (6 * h[i])) + b ** 3 * (m[i + 1] / (6 * h[i]))
                    + a * (y[i] / h[i] - m[i] * h[i] / 6)

@@ -199,7 +199,7 @@ class ExternalBackend:
     def eliminate(self, request: EliminationRequest) -> EliminationResult:
         import tempfile
 
-        from singcheck.elimination.cas.limits import describe_limit
+        from singcheck.elimination.cas.limits import bound_text, inherited_limit, raise_hint
         from singcheck.elimination.cas.process import run_program
 
         if self.name == "macaulay2":
@@ -212,14 +212,18 @@ class ExternalBackend:
             path = os.path.join(tmp, f"{request.label}.{suffix}")
             with open(path, "w", encoding="utf-8") as f:
                 f.write(script)
-            run = run_program(self.cas.argv(self.executable, path), self.timeout, cwd=tmp)
+            run = run_program(self.cas.argv(self.executable, path), self.timeout, cwd=tmp,
+                              scratch=tmp)
         if run.returncode != 0 and run.memory_limit:
             memory = out_of_memory(run)
             if memory:
                 raise BackendError(
-                    f"{self.cas.program} {memory} under the bound of "
-                    f"{describe_limit(run.memory_limit)} per CAS process; raise "
-                    "SINGCHECK_MEMORY_LIMIT (or set it to none) if the robot needs more")
+                    f"{self.cas.program} {memory} under {bound_text(run.memory_limit)} "
+                    f"per CAS process; {raise_hint(run.memory_limit)}")
+            if run.memory_limit == inherited_limit():  # it may not even start under it
+                raise BackendError(
+                    f"{self.cas.program} exited with status {run.returncode} under "
+                    f"{bound_text(run.memory_limit)}; {raise_hint(run.memory_limit)}")
         polys = parse_result(self.cas.program, run.stdout, run.stderr, request)
         if run.returncode != 0:
             raise BackendError(f"{self.cas.program} exited with status {run.returncode}")

@@ -2,8 +2,8 @@
 every descendant of the CAS with it, even when singcheck is SIGKILLed.
 
 :func:`singcheck.elimination.cas.process.run_program` does not start the CAS itself but
-this file, as a fresh interpreter (``python -I -S guard.py PARENT LIMIT -- argv…``:
-standard library only, a few milliseconds).  The guard
+this file, as a fresh interpreter (``python -I -S guard.py PARENT LIMIT SCRATCH --
+argv…``: standard library only, a few milliseconds).  The guard
 
 * asks the kernel for ``SIGTERM`` when its parent thread exits (``PR_SET_PDEATHSIG``;
   the thread of singcheck that starts it is the one that waits for it), and checks that
@@ -16,7 +16,9 @@ standard library only, a few milliseconds).  The guard
   (``PR_SET_PDEATHSIG``; so even a SIGKILLed guard leaves no CAS behind) and runs under
   an address-space bound (``RLIMIT_AS``, ``LIMIT`` bytes, 0 for none) before ``exec``;
 * on ``SIGTERM`` (its parent died) kills every process of its group, then, round by
-  round, every child it has (the re-parented descendants), reaps them and exits 143.
+  round, every child it has (the re-parented descendants), reaps them, removes the
+  CAS's scratch directory ``SCRATCH`` (its parent, killed, could not; "" for none) and
+  exits 143.
 
 When the CAS ends normally the guard exits with the same status (a CAS killed by a
 signal: the guard kills itself with that signal, without a core file), and whatever the
@@ -157,10 +159,18 @@ def _exec_cas(argv: list[str], limit: int, guard: int) -> None:
     os._exit(EXEC_FAILED)
 
 
+def _remove_scratch(path: str) -> None:
+    """Remove the CAS's scratch directory (only one of singcheck's: ``singcheck-*``)."""
+    if path and os.path.basename(os.path.normpath(path)).startswith("singcheck-"):
+        import shutil
+
+        shutil.rmtree(path, ignore_errors=True)
+
+
 def main(args: list[str]) -> int:
-    parent, limit, sep, *argv = args
+    parent, limit, scratch, sep, *argv = args
     if sep != "--" or not argv:
-        print("usage: guard.py PARENT LIMIT -- argv...", file=sys.stderr)
+        print("usage: guard.py PARENT LIMIT SCRATCH -- argv...", file=sys.stderr)
         return 2
     for sig in (signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, _stop)
@@ -182,6 +192,7 @@ def main(args: list[str]) -> int:
                 break
     except _ParentDied:
         _kill_everything()
+        _remove_scratch(scratch)
         return 143
     if os.WIFSIGNALED(status):
         sig = os.WTERMSIG(status)

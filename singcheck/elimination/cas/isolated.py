@@ -35,7 +35,13 @@ import time
 
 from singcheck.budget import TimeLimitExceeded
 from singcheck.elimination.cas.guard import die_with_parent
-from singcheck.elimination.cas.limits import describe_limit, memory_limit
+from singcheck.elimination.cas.limits import (
+    bound_text,
+    inherited_limit,
+    memory_limit,
+    raise_hint,
+    under_inherited,
+)
 from singcheck.elimination.requests import EliminationRequest, EliminationResult
 from singcheck.errors import BackendError
 
@@ -67,7 +73,7 @@ def _child(fn, argument, write: int, err: int, parent: int, limit: int) -> None:
 
         resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
         if limit:
-            bound = _address_space() + limit
+            bound = under_inherited(_address_space() + limit)
             resource.setrlimit(resource.RLIMIT_AS, (bound, bound))
         from singcheck.algebra.pickling import register
 
@@ -140,7 +146,8 @@ def run_forked(fn, argument, timeout: float, what: str):
 def _outcome(message: bytes, status: int, said: str, limit: int, what: str):
     import pickle
 
-    bound = f"the bound of {describe_limit(limit)} (SINGCHECK_MEMORY_LIMIT)"
+    bound = bound_text(limit) + ("" if limit == inherited_limit() else
+                                 " (SINGCHECK_MEMORY_LIMIT)")
     try:
         kind, value = pickle.loads(message) if message else (None, None)
     except Exception:  # noqa: BLE001 - a truncated message: the child died writing it
@@ -153,13 +160,14 @@ def _outcome(message: bytes, status: int, said: str, limit: int, what: str):
         if not limit:
             raise BackendError(f"{what} ran out of memory (no bound was set: "
                                "SINGCHECK_MEMORY_LIMIT=none)")
-        raise BackendError(f"{what} ran out of memory under {bound}; raise "
-                           "SINGCHECK_MEMORY_LIMIT (or set it to none) if the robot needs more")
+        raise BackendError(f"{what} ran out of memory under {bound}; {raise_hint(limit)}")
     how = (f"died of {signal.Signals(os.WTERMSIG(status)).name}" if os.WIFSIGNALED(status)
            else f"exited with status {os.WEXITSTATUS(status)}")
     first = said.splitlines()[0] if said else ""
     if limit and os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGABRT:
         how += f" under {bound}, most likely out of memory"
+    elif limit and limit == inherited_limit():
+        how += f" under {bound}: {raise_hint(limit)}"
     raise BackendError(f"{what} {how}" + (f": {first[:200]}" if first else ""))
 
 

@@ -105,15 +105,15 @@ def _reap_strays(known: set[int]) -> None:
         reap_children(keep)
 
 
-def _guarded(argv: list[str] | tuple[str, ...], limit: int) -> list[str]:
+def _guarded(argv: list[str] | tuple[str, ...], limit: int, scratch: str = "") -> list[str]:
     """``argv`` started through :mod:`~singcheck.elimination.cas.guard` (a fresh
-    interpreter that dies with this thread and takes the program's descendants with it);
-    ``argv`` itself where there is no interpreter or script file to run (a frozen or
-    zipped install)."""
+    interpreter that dies with this thread and takes the program's descendants with it,
+    and ``scratch``, a directory, too); ``argv`` itself where there is no interpreter or
+    script file to run (a frozen or zipped install)."""
     if not sys.executable or not os.path.isfile(SCRIPT):
         return list(argv)
-    return [sys.executable, "-I", "-S", SCRIPT, str(os.getpid()), str(limit), "--",
-            *argv]
+    return [sys.executable, "-I", "-S", SCRIPT, str(os.getpid()), str(limit), scratch,
+            "--", *argv]
 
 
 def _kill_group(proc: subprocess.Popen) -> None:
@@ -151,14 +151,20 @@ def _terminate_as_interrupt() -> Iterator[None]:
 
 
 def _read(f, limit: int) -> str:
+    """Up to ``limit`` bytes of the file, as text; a buffer of its size, not of ``limit``
+    (256 MiB at once was a MemoryError under a small ``ulimit -v``)."""
     f.seek(0)
-    return f.read(limit).decode("utf-8", errors="replace")
+    size = os.fstat(f.fileno()).st_size
+    return f.read(min(limit, size)).decode("utf-8", errors="replace")
 
 
 def run_program(argv: list[str] | tuple[str, ...], timeout: float, *,
-                cwd: str | None = None, env: dict[str, str] | None = None) -> ProgramRun:
+                cwd: str | None = None, env: dict[str, str] | None = None,
+                scratch: str = "") -> ProgramRun:
     """Run ``argv`` to completion (or kill its group after ``timeout`` seconds, or once
-    it has printed more than :data:`MAX_OUTPUT_BYTES` on stdout or stderr)."""
+    it has printed more than :data:`MAX_OUTPUT_BYTES` on stdout or stderr).
+    ``scratch``: the program's temporary directory (``singcheck-*``), which its guard
+    removes should this process be killed (SIGKILL) before it can."""
     start = time.monotonic()
     name = os.path.basename(argv[0])
     reaper = _become_subreaper()
@@ -168,7 +174,7 @@ def run_program(argv: list[str] | tuple[str, ...], timeout: float, *,
             tempfile.TemporaryFile() as err:
         try:
             with _STARTING:
-                proc = subprocess.Popen(_guarded(argv, limit), stdin=subprocess.DEVNULL,
+                proc = subprocess.Popen(_guarded(argv, limit, scratch), stdin=subprocess.DEVNULL,
                                         stdout=out, stderr=err, cwd=cwd, env=env,
                                         start_new_session=True)
                 _RUNNING.add(proc.pid)

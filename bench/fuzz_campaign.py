@@ -1,0 +1,131 @@
+"""An offline fuzz campaign: tests/test_fuzz.py's properties, run long, in parallel.
+
+Not part of CI (which runs the same properties at 30 examples each, in seconds).  Each
+worker is a pytest process running the fuzz properties with a large number of
+examples, ``SINGCHECK_FUZZ_KEEP_GOING=1`` (a failing case is recorded, not shrunk) and
+``SINGCHECK_FUZZ_SLACK=1`` (a case more than 1 s past its 2 s limit is a failure), in a
+sandbox of its own: its working directory, ``HOME``, ``TMPDIR`` and cache are in it, so
+that afterwards every file in the sandbox that is neither the cache nor a case file
+is something written outside the named outputs.  At the end (``--minutes``) the
+workers are interrupted and their counts merged::
+
+    python bench/fuzz_campaign.py --minutes 60 --jobs 2 --out /tmp/campaign
+
+writes ``/tmp/campaign/summary.json`` (cases, exit statuses, failures, the largest
+overrun of the time limit, stray files) and keeps each worker's failures
+(``worker-N.json.failures``: JSON lines, the specs and the error) for
+tests/data/crashes/.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+PROPERTIES = ["test_structured_and_grammar_trajectories_end_with_exit_0_to_3",
+              "test_byte_mutated_specs_end_with_exit_0_to_3",
+              "test_paths_of_pieces_end_with_exit_0_to_3"]
+
+
+def start_worker(n: int, run: int, out: Path, examples: int) -> subprocess.Popen:
+    """Worker slot ``n``'s ``run``-th pytest process: one property (round robin)."""
+    sandbox = out / f"sandbox-{n}"
+    for sub in ("home", "tmp", "cases", "cwd"):
+        (sandbox / sub).mkdir(parents=True, exist_ok=True)
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "HOME": str(sandbox / "home"),
+           "TMPDIR": str(sandbox / "tmp"), "SINGCHECK_FUZZ_DIR": str(sandbox / "cases"),
+           "SINGCHECK_FUZZ_EXAMPLES": str(examples), "SINGCHECK_FUZZ_KEEP_GOING": "1",
+           "SINGCHECK_FUZZ_SLACK": "1",
+           "SINGCHECK_FUZZ_REPORT": str(out / f"worker-{n}-{run}.json"),
+           "XDG_CONFIG_HOME": str(sandbox / "home" / ".config")}
+    env.pop("SINGCHECK_CACHE_DIR", None)
+    argv = [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider",
+            "--rootdir", str(ROOT), "-c", str(ROOT / "pyproject.toml"),
+            str(ROOT / "tests" / "test_fuzz.py"), "-k", PROPERTIES[run % len(PROPERTIES)]]
+    log = open(out / f"worker-{n}.log", "a")  # noqa: SIM115 - closed with the process
+    return subprocess.Popen(argv, cwd=sandbox / "cwd", env=env, stdout=log,
+                            stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def strays(sandbox: Path) -> list[str]:
+    """Files in a worker's sandbox that are not the cache, a case file, pytest's or
+    hypothesis' own: written outside the named outputs."""
+    allowed = [sandbox / "cases", sandbox / "home" / ".cache" / "singcheck",
+               sandbox / "cwd" / ".hypothesis",  # hypothesis' own constants
+               sandbox / "tmp"]  # tmp: pytest's tmp_path_factory (the fuzz cache) only
+    out = []
+    for path in sandbox.rglob("*"):
+        if path.is_file() and not any(a == path or a in path.parents for a in allowed):
+            out.append(str(path.relative_to(sandbox)))
+    for path in (sandbox / "tmp").iterdir():  # only pytest's own directory there
+        if not path.name.startswith("pytest-of-"):
+            out.append(str(path.relative_to(sandbox)))
+    return out
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--minutes", type=float, default=60)
+    parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--examples", type=int, default=300,
+                        help="examples per pytest run (each worker runs the properties "
+                             "in turn, a run each, until the time is up)")
+    parser.add_argument("--out", type=Path, default=Path("fuzz-campaign"))
+    args = parser.parse_args()
+    args.out.mkdir(parents=True, exist_ok=True)
+    started = time.monotonic()
+    runs = [0] * args.jobs
+    workers = [start_worker(n, 0, args.out, args.examples) for n in range(args.jobs)]
+    end = started + args.minutes * 60
+    while time.monotonic() < end:
+        time.sleep(2)
+        for n, w in enumerate(workers):
+            if w.poll() is not None:
+                runs[n] += 1
+                workers[n] = start_worker(n, runs[n], args.out, args.examples)
+    for w in workers:
+        if w.poll() is None:
+            os.killpg(w.pid, signal.SIGINT)  # pytest stops; the counts are written at exit
+    for w in workers:
+        try:
+            w.wait(timeout=60)
+        except subprocess.TimeoutExpired:
+            os.killpg(w.pid, signal.SIGKILL)
+            w.wait()
+    total: Counter = Counter()
+    total.pop("failures", None)
+    past = 0
+    failures = []
+    for report in sorted(args.out.glob("worker-*.json")):
+        if report.exists():
+            counts = json.loads(report.read_text())
+            past = max(past, counts.pop("max ms past the limit", 0))
+            total.update(counts)
+        failed = report.with_name(report.name + ".failures")
+        if failed.exists():
+            failures += [json.loads(line)["error"] for line in failed.read_text().splitlines()]
+    # the case each worker was in when the campaign stopped it (SIGINT: exit 130)
+    stopped = sum(1 for f in failures if f.startswith("AssertionError: 130\n"))
+    failures = [f for f in failures if not f.startswith("AssertionError: 130\n")]
+    total["exit 130"] -= stopped
+    total["cases"] -= stopped
+    summary = {"minutes": round((time.monotonic() - started) / 60, 1), "jobs": args.jobs,
+               **{k: v for k, v in sorted(total.items()) if v}, "stopped at the end": stopped,
+               "max ms past the 2 s limit": past,
+               "failures": Counter(failures).most_common(),
+               "stray files": {n: strays(args.out / f"sandbox-{n}") for n in range(args.jobs)}}
+    (args.out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+    print(json.dumps(summary, indent=1))
+    return 1 if failures or any(summary["stray files"].values()) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -331,7 +331,8 @@ def test_certificate_file_names_are_safe(tmp_path):
     used: set = set()
     for name in ["../../evil", "a/b", "x\x00y", "..", "heart1", "heart1"]:
         target = write_certificate(tmp_path, {"claim": {"trajectory": name}}, used)
-        assert target.parent == tmp_path and ".." not in target.name
+        assert target.parent == tmp_path and target.resolve().parent == tmp_path.resolve()
+        assert "/" not in target.name and "\x00" not in target.name
         assert target.name.endswith(".cert.json") and not target.name.startswith(".")
     assert len(list(tmp_path.iterdir())) == 6
 

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import json
 import os
-import re
 from fractions import Fraction
 from pathlib import Path
 
@@ -36,21 +35,6 @@ MAX_DEPTH = 60
 #: piece evaluations per certificate at most
 BUDGET = 200_000
 VERDICTS = ("singular", "singularity-free", "infeasible")
-
-
-def safe_file_name(name: str) -> str:
-    """A file name made of ``name``: letters, digits, '.', '_' and '-' kept, anything else
-    (a '/', NUL, a space) becomes '_', no '..' and no leading dot, at most 100 chars.
-
-    >>> safe_file_name("../etc/passwd")
-    '___etc_passwd'
-    >>> safe_file_name("")
-    'trajectory'
-    """
-    out = re.sub(r"[^A-Za-z0-9._-]", "_", name)[:100].replace("..", "._")
-    if out.startswith("."):
-        out = "_" + out[1:]
-    return out or "trajectory"
 
 
 def _text(q: Fraction) -> str:
@@ -235,19 +219,13 @@ def build_certificate(robot_text: str, trajectory_text: str, result: dict) -> di
 
 
 def write_certificate(directory: str | os.PathLike, cert: dict, used: set[str]) -> Path:
-    """``DIRECTORY/<trajectory name>.cert.json`` (its name made safe, made unique among
-    ``used``), written atomically."""
-    base = safe_file_name(cert["claim"]["trajectory"])
-    name, k = base, 1
-    while name in used:
-        k += 1
-        name = f"{base}-{k}"
-    used.add(name)
-    folder = Path(directory)
-    folder.mkdir(parents=True, exist_ok=True)
-    target = folder / f"{name}.cert.json"
-    tmp = folder / f".{name}.cert.json.tmp"
-    tmp.write_text(json.dumps(cert, ensure_ascii=False, separators=(",", ":")) + "\n",
-                   encoding="utf-8")
-    os.replace(tmp, target)
+    """``DIRECTORY/<trajectory name>.cert.json`` (its name made safe and unique among
+    ``used`` by :func:`~singcheck.atomic.safe_file_name`, the one helper for every file
+    name made from input), written atomically."""
+    from singcheck.atomic import safe_file_name, write_atomically
+
+    name = safe_file_name(cert["claim"]["trajectory"], used)
+    target = Path(directory) / f"{name}.cert.json"
+    write_atomically(target, json.dumps(cert, ensure_ascii=False, separators=(",", ":"))
+                     + "\n", make_parents=True)
     return target

@@ -410,7 +410,7 @@ def _worker_signals() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, _HELD)  # held while it was forked
 
 
-#: the signals held while workers are forked (:func:`_held_signals`)
+#: the signals held while workers are forked (:func:`held_signals`)
 _HELD = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
 
 
@@ -583,7 +583,7 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
         if getattr(pool, "_broken", False):
             _stop(pool)
             pool = start()
-        with _held_signals():  # a worker forked here sets its own handlers first (J1)
+        with held_signals():  # a worker forked here sets its own handlers first (J1)
             try:
                 return pool.submit(_check_chunk, chunk)
             except BrokenProcessPool:  # broken since: the batch goes on in a new pool
@@ -657,7 +657,7 @@ def _head(item):
         spec_of(item)
 
 
-def _held_signals():
+def held_signals():
     """Ctrl-C, SIGTERM and SIGHUP held in this thread for the duration of the block:
     a worker forked inside it starts with them held, and :func:`_worker_signals`
     releases them once its own handlers are set (one signalled while starting no

@@ -1296,7 +1296,7 @@ def test_a_worker_signalled_while_starting_is_silent(tmp_path, sig, status):
     err = tmp_path / "stderr"
     previous = signal.signal(signal.SIGTERM, signal.default_int_handler)  # as singcheck's
     try:
-        with api._held_signals():
+        with api.held_signals():
             pid = os.fork()
             if pid == 0:  # the worker, signalled before its initializer runs
                 try:

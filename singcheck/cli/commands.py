@@ -504,21 +504,11 @@ def _sink(fmt: str, output, projection):
 
 def _signals_held():
     """Hold Ctrl-C, SIGTERM and SIGHUP for the duration of the block (they are delivered
-    just after it), so that a streamed line is never cut in half."""
-    import signal
-    from contextlib import contextmanager
+    just after it), so that a streamed line is never cut in half
+    (:func:`singcheck.api.held_signals`)."""
+    from singcheck.api import held_signals
 
-    held = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
-
-    @contextmanager
-    def block():
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-        try:
-            yield
-        finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)
-
-    return block()
+    return held_signals()
 
 
 def _render(projection, results, tolerance, fmt, verbose, code, to_file: bool) -> str:

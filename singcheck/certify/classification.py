@@ -373,7 +373,7 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
     if path.mu is not None:  # --engine exact
         return _certify_exactly(path, modes, tolerance)
     if path.exact_refused:  # --engine interval
-        return _certify_by_intervals(path, modes)
+        return _certify_by_intervals(path, modes, tolerance=tolerance)
     return _interval_engine_first(path, modes, tolerance)
 
 
@@ -411,7 +411,7 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
     if not decided:
         exact = with_mu(path)
         if exact.mu is None:
-            return _certify_by_intervals(exact, modes, searches)
+            return _certify_by_intervals(exact, modes, searches, tolerance)
         return _certify_exactly(exact, modes, tolerance, searches)
     left = remaining()
     own = left is None or left > EXACT_CORROBORATION_BUDGET
@@ -425,7 +425,7 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
             raise
         exact = replace_path(path, f"the exact engine did not finish within its "
                                    f"{EXACT_CORROBORATION_BUDGET:g} s budget")
-    return _certify_by_intervals(exact, modes, searches)
+    return _certify_by_intervals(exact, modes, searches, tolerance)
 
 
 #: seconds the interval engine's first pass may take before the exact engine goes first
@@ -489,7 +489,8 @@ BY_INTERVAL_CROSSING = "sign change of det A along the mode (ball arithmetic)"
 
 
 def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
-                          searches: dict | None = None) -> TrajectoryReport:
+                          searches: dict | None = None,
+                          tolerance: float = 1e-9) -> TrajectoryReport:
     """The verdict of the interval engine alone, when the exact engine did not run
     (``path.exact_refused`` says why): a proven crossing along a feasible mode is
     ``singular`` (its window is the candidate), every feasible mode proven ≠ 0 on the
@@ -502,7 +503,7 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
     candidates = []
     for mode in feasible:
         for w in searches[mode.label].crossings:
-            candidates.append(_window_candidate(path, mode, w))
+            candidates.append(_window_candidate(path, mode, w, tolerance))
     candidates.sort(key=lambda c: float(c.t.mid()))
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
@@ -518,9 +519,27 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
                             undecided, False, corroboration=check)
 
 
-def _window_candidate(path: PathModel, mode: WorkingMode, w) -> Candidate:
-    """A crossing the interval engine proved along ``mode`` in the window ``w``."""
-    t = arb(w.lo).union(arb(w.hi))
+def _window_candidate(path: PathModel, mode: WorkingMode, w,
+                      tolerance: float = 1e-9) -> Candidate:
+    """A crossing the interval engine proved along ``mode`` in the window ``w``, the
+    window narrowed by bisection to ``tolerance``: det A is continuous along the feasible
+    mode and has proven opposite signs at the two ends of the window, so it keeps a zero
+    between the ends of whichever half has opposite proven signs at its ends (a point
+    where the sign is not proven stops the narrowing there)."""
+    lo, hi = arb(w.lo), arb(w.hi)
+    while float(hi.upper() - lo.lower()) > tolerance:
+        checkpoint()
+        mid = arb(((lo + hi) / 2).mid())
+        _, _, at = _mode_values(path, [mode], mid)
+        v = at[mode.label]
+        s = sign(v) if isinstance(v, arb) else None
+        if s is None or not (lo < mid < hi):
+            break
+        if s == w.left:
+            lo = mid
+        else:
+            hi = mid
+    t = lo.union(hi)
     pose, joints, _ = _mode_values(path, [mode], t)
     shown = {mode.label: {leg.leg.joint: joint_float(v)
                           for leg, v in zip(path.legs, joints[mode.label], strict=True)}}

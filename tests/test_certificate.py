@@ -484,15 +484,7 @@ def test_pose_angles_are_rechecked(tmp_path):
     assert failures(tampered(cert, "trajectory_spec", "phi: t", "phi: t/2"))
 
 
-SEGMENTS = """\
-name: pick-and-place
-parameter: t
-segments:
-  - range: [0, 1]
-    pose: {x: 1/4 + 13/20*t, y: 3/5 + 1/2*t, z: 1}
-  - range: [1, 2]
-    pose: {x: 3/5 + 3/10*t, y: 19/10 - 4/5*t, z: 1}
-"""
+from tests.test_paths import SEGMENTS_YAML as SEGMENTS  # noqa: E402 (the docs' example)
 
 
 def test_paths_of_segments_are_rechecked(tmp_path):

@@ -162,6 +162,16 @@ def _float_eigh(m0: list[list[arb]]) -> tuple[float, list[float]]:
     return float(values[0]), [float(x) for x in vectors[:, 0]]
 
 
+def _radius_norm(m: list[list]) -> arb:
+    """The Frobenius norm of the ball matrix's radii, rounded outward: a bound of
+    ‖M - M₀‖ (spectral ≤ Frobenius) for every member M of ``m`` around its midpoints M₀."""
+    total = arb(0)
+    for row in m:
+        for e in row:
+            total += arb(e.rad()) ** 2
+    return total.sqrt()
+
+
 def lambda_lower(m: list[list]) -> float:
     """A proven lower bound of λ_min(M(t)) for every member M(t) of the ball matrix
     ``m`` (Weyl around the midpoint matrix, whose own bound a ball Cholesky proves)."""
@@ -169,11 +179,7 @@ def lambda_lower(m: list[list]) -> float:
         return 0.0
     m0 = _mid_matrix(m)
     n = len(m)
-    radius = arb(0)
-    for row in m:
-        for e in row:
-            radius += arb(e.rad()) ** 2
-    radius = radius.sqrt()
+    radius = _radius_norm(m)
     estimate, _ = _float_eigh(m0)
     ell = 0.0
     for delta in (1e-13, 1e-10, 1e-7, 1e-4):
@@ -364,11 +370,7 @@ def piece_lower(m_centre, m_piece, dm_piece, half: arb) -> float:
         return best
     n = len(m_centre)
     g0 = _mid_matrix(dm_piece)
-    spread = arb(0)
-    for row in dm_piece:
-        for e in row:
-            spread += arb(e.rad()) ** 2
-    spread = spread.sqrt() * half
+    spread = _radius_norm(dm_piece) * half
     ends = [lambda_lower([[m_centre[i][j] + sign * half * g0[i][j] for j in range(n)]
                           for i in range(n)]) for sign in (1, -1)]
     centred = float((arb(min(ends)) - spread).lower())

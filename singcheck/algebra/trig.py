@@ -26,10 +26,10 @@ from functools import cached_property
 
 from flint import (
     arb,
-    arb_mat,
     arb_poly,
     ctx,
     fmpq,
+    fmpq_mat,
     fmpq_mpoly,
     fmpq_mpoly_ctx,
     fmpq_poly,
@@ -165,6 +165,8 @@ def evaluate_trig(p: fmpq_mpoly, t: arb, tight: bool = False) -> arb:
     split = _split(p)
     if isinstance(split, arb_poly):  # free of sin and cos: one polynomial in t
         return split(t)
+    if _high_harmonic(p):  # Horner's power coefficients cancel: the Fourier form alone
+        return _fourier_value(p, t)
     s, c = _sin_cos_multiple(t, 1)
     total = evaluate_split(split, t, s, c)
     if tight and t.rad() > _WIDE:
@@ -240,6 +242,17 @@ _WIDE = 1e-3
 _FOURIER_MIN_DEGREE = 4
 
 
+#: a polynomial of at least this degree in (s, c) is always enclosed in its Fourier form:
+#: its power coefficients (cos 64t = T₆₄(c): up to 2⁶³) cancel, and Horner on any ball —
+#: even a point — loses every bit at double precision
+FOURIER_ALWAYS = 24
+
+
+def _high_harmonic(p: fmpq_mpoly) -> bool:
+    d = p.degrees()
+    return len(d) == 3 and d[1] + d[2] >= FOURIER_ALWAYS
+
+
 _LAST_T: tuple = (None, 0, {})  # (t, precision, {k: (sin kt, cos kt)})
 
 
@@ -289,50 +302,73 @@ _FOURIERS: OrderedDict[tuple[int, int], tuple[fmpq_mpoly, object]] = OrderedDict
 
 def _fourier(p: fmpq_mpoly):
     """(terms, harmonics, degree in t) with terms (i, k, a, b) for tⁱ(a cos kt + b sin kt),
-    None when p's degree in (s, c) is low; memoised like the split.
+    balls at the current precision, None when p's degree in (s, c) is low; memoised like
+    the split (the exact form once per polynomial, its balls per precision).
 
     The power bases are changed to the Chebyshev ones (cᵐ = Σₖ Mₖₘ Tₖ(c) with
-    Tₖ(c) = cos kt, s·cᵐ = Σₖ Nₖₘ s·Uₖ(c) with s·Uₖ(c) = sin (k+1)t) by one ball
-    matrix product per part: the matrices are exact dyadic rationals, so each ball
-    coefficient encloses the exact one."""
+    Tₖ(c) = cos kt, s·cᵐ = Σₖ Nₖₘ s·Uₖ(c) with s·Uₖ(c) = sin (k+1)t) exactly, by one
+    rational matrix product per part (:func:`fourier_form`); each ball coefficient is
+    then the exact one rounded outward.  (A ball product would be useless for a high
+    harmonic: cos 256t = T₂₅₆(c) has power coefficients near 2²⁵⁵ that cancel.)"""
     key = (id(p), ctx.prec)
     hit = _FOURIERS.get(key)
     if hit is not None and hit[0] is p:
         _FOURIERS.move_to_end(key)
         return hit[1]
-    q = reduce_trig(p)
+    exact = fourier_form(p)
     form = None
-    if not q.is_zero() and q.degrees()[2] + q.degrees()[1] >= _FOURIER_MIN_DEGREE:
-        dt = q.degrees()[0]
-        parts: dict[tuple[int, int], dict[int, fmpq]] = {}
-        for (i, j, k), a in q.terms():
-            parts.setdefault((i, j), {})[k] = a
-        found: dict[tuple[int, int], list] = {}
-        for (i, j), part in parts.items():
-            n = max(part)
-            column = arb_mat(n + 1, 1, [arb(part.get(m, 0)) for m in range(n + 1)])
-            product = _chebyshev_change(n, j) * column
-            for k in range(n + 1):
-                value = product[k, 0]
-                if value != 0 or not value.is_exact():
-                    harmonic = k if j == 0 else k + 1
-                    found.setdefault((i, harmonic), [None, None])[j] = value
-        terms = [(i, k, a, b) for (i, k), (a, b) in sorted(found.items())]
-        form = (terms, sorted({k for _, k, _, _ in terms if k}), dt)
+    if exact is not None:
+        terms = [(i, k, None if a is None else arb(a), None if b is None else arb(b))
+                 for i, k, a, b in exact]
+        form = (terms, sorted({k for _, k, _, _ in terms if k}),
+                max((i for i, _, _, _ in terms), default=0))
     _FOURIERS[key] = (p, form)
     if len(_FOURIERS) > _SPLITS_KEPT:
         _FOURIERS.popitem(last=False)
     return form
 
 
-_CHEBYSHEV: dict[tuple[int, int, int], arb_mat] = {}
+_EXACT_FOURIERS: OrderedDict[int, tuple[fmpq_mpoly, object]] = OrderedDict()
 
 
-def _chebyshev_change(n: int, part: int) -> arb_mat:
-    """The (n+1)×(n+1) matrix taking power coefficients c⁰…cⁿ to Chebyshev ones:
-    T₀…Tₙ for ``part`` 0, U₀…Uₙ for ``part`` 1 (exact, from c·Tₖ = (Tₖ₊₁ + T|ₖ₋₁|)/2
-    and c·Uₖ = (Uₖ₊₁ + Uₖ₋₁)/2 with U₋₁ = 0), as balls at the current precision."""
-    key = (n, part, ctx.prec)
+def fourier_form(p: fmpq_mpoly) -> list | None:
+    """p(t, sin t, cos t) as Σ tⁱ (a cos kt + b sin kt) with exact rational a, b: the
+    terms (i, k, a, b) (a or b None where absent), None when p's degree in (s, c) is
+    below :data:`_FOURIER_MIN_DEGREE`; memoised per polynomial."""
+    hit = _EXACT_FOURIERS.get(id(p))
+    if hit is not None and hit[0] is p:
+        return hit[1]
+    q = reduce_trig(p)
+    form = None
+    if not q.is_zero() and q.degrees()[2] + q.degrees()[1] >= _FOURIER_MIN_DEGREE:
+        parts: dict[tuple[int, int], dict[int, fmpq]] = {}
+        for (i, j, k), a in q.terms():
+            parts.setdefault((i, j), {})[k] = a
+        found: dict[tuple[int, int], list] = {}
+        for (i, j), part in parts.items():
+            n = max(part)
+            column = fmpq_mat(n + 1, 1, [part.get(m, 0) for m in range(n + 1)])
+            product = _chebyshev_change(n, j) * column
+            for k in range(n + 1):
+                value = product[k, 0]
+                if value != 0:
+                    harmonic = k if j == 0 else k + 1
+                    found.setdefault((i, harmonic), [None, None])[j] = value
+        form = [(i, k, a, b) for (i, k), (a, b) in sorted(found.items())]
+    _EXACT_FOURIERS[id(p)] = (p, form)
+    if len(_EXACT_FOURIERS) > _SPLITS_KEPT:
+        _EXACT_FOURIERS.popitem(last=False)
+    return form
+
+
+_CHEBYSHEV: dict[tuple[int, int], fmpq_mat] = {}
+
+
+def _chebyshev_change(n: int, part: int) -> fmpq_mat:
+    """The (n+1)×(n+1) rational matrix taking power coefficients c⁰…cⁿ to Chebyshev
+    ones: T₀…Tₙ for ``part`` 0, U₀…Uₙ for ``part`` 1 (from c·Tₖ = (Tₖ₊₁ + T|ₖ₋₁|)/2 and
+    c·Uₖ = (Uₖ₊₁ + Uₖ₋₁)/2 with U₋₁ = 0)."""
+    key = (n, part)
     hit = _CHEBYSHEV.get(key)
     if hit is None:
         columns = [[fmpq(1)] + [fmpq(0)] * n]
@@ -348,7 +384,7 @@ def _chebyshev_change(n: int, part: int) -> arb_mat:
                 elif part == 0:  # c·T₀ = T₁
                     nxt[1] += a / 2
             columns.append(nxt)
-        hit = _CHEBYSHEV[key] = arb_mat(n + 1, n + 1, [arb(columns[m][k]) for k in range(n + 1)
+        hit = _CHEBYSHEV[key] = fmpq_mat(n + 1, n + 1, [columns[m][k] for k in range(n + 1)
                                                          for m in range(n + 1)])
     return hit
 

@@ -59,6 +59,7 @@ from singcheck.certify.engines import (
     corroborate,
     corroborated_verdict,
 )
+from singcheck.certify.exact import vanishes_at_root
 from singcheck.certify.interval_engine import mode_values as _mode_values
 from singcheck.certify.interval_engine import search_det_a
 from singcheck.certify.path import PathModel, joint_float
@@ -457,7 +458,8 @@ def _certify_exactly(path: PathModel, modes: list[WorkingMode], tolerance: float
     """The exact engine's verdict (μ's certified roots, classified per mode), held against
     the interval engine's (``searches`` when it has run already)."""
     try:
-        isolation = isolate_real_roots(path.mu, path.trajectory.range, tolerance)
+        isolation = isolate_real_roots(path.mu, path.trajectory.range, tolerance,
+                                       vanishes_at_root)
     except IdenticallyZeroError:
         return _certify_on_surface(path, modes, tolerance, searches)
     candidates = _classify_all(path, modes, isolation.roots, tolerance)

@@ -228,6 +228,7 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
     :class:`~singcheck.errors.SpecError`.
     """
     from singcheck.certify import modes as working
+    from singcheck.elimination.projection import transcendental_limits
 
     label = mode or trajectory.mode
     chosen_by = "--mode" if mode else "document" if label else None
@@ -255,7 +256,8 @@ def check(robot: Robot, trajectory: TrajectorySpec, *, tolerance: float = DEFAUL
         except TimeLimitExceeded as e:
             return Report(trajectory, certificate, time_limited=f"{e} while certifying the "
                           "clearance", extra=extra)
-        if not regions or any(r.path.exact_refused for r in full.pieces or [full]):
+        if not regions or any(r.path.exact_refused for r in full.pieces or [full]) or \
+                transcendental_limits(robot.projection.model):
             return Report(trajectory, certificate, extra=extra)  # no region statement
         from singcheck.spaces.path_regions import path_in_workspace, pieces_in_workspace
 

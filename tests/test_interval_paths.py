@@ -102,3 +102,129 @@ def test_five_bar_meets_the_singularity_at_a_conjugate_root(tmp_path, pose):
     report = _run("five-bar", doc)
     assert report.verdict == "singular"
     assert _singular_times(report) == [0.0]
+
+
+# -- paths that are not polynomials in (t, sin t, cos t): the interval engine alone ------
+
+@pytest.mark.parametrize(("name", "rng", "pose", "lo", "hi"), [
+    ("shift", "[-pi, pi]", {"x": "1 + cos(t - 1)/2", "y": "1/2", "z": 1}, -mp.pi, mp.pi),
+    ("drift", "[0, 2]", {"x": "1 + cos(2*pi*t)/2 + t/10", "y": "1 + sin(2*pi*t)/2", "z": 1},
+     0, 2),
+    ("half", "[-pi, pi]", {"x": "1 + cos(t/2)/2", "y": "1/2", "z": 1}, -mp.pi, mp.pi),
+])
+def test_expression_paths_match_the_oracle(tmp_path, name, rng, pose, lo, hi):
+    """cos(t − 1), a drifting circle in 2πt and cos(t/2) on the Orthoglide: each
+    singular time lies in a sign change of the oracle's det A (mode +++, the one inside
+    the limits here), and there are as many."""
+    doc = _doc(tmp_path, name, rng, pose)
+    report = _run("orthoglide", doc)
+    mp.mp.dps = 30
+
+    def coordinate(text):
+        return lambda t: mp.mpf(eval(str(text), {"cos": mp.cos, "sin": mp.sin, "pi": mp.pi,  # noqa: S307 - our own test strings
+                                                  "t": t}))
+
+    x, y, z = (coordinate(pose[v]) for v in ("x", "y", "z"))
+    changes = _sign_changes(lambda t: _orthoglide_det(x(t), y(t), z(t)), mp.mpf(lo),
+                            mp.mpf(hi), 4000)
+    times = _singular_times(report)
+    assert report.verdict == ("singular" if changes else "singularity-free")
+    assert len(times) == len(changes)
+    for t, (a, b) in zip(times, changes, strict=True):
+        assert a - 1e-6 <= t <= b + 1e-6
+    assert report.corroboration.status == "exact engine not run"
+    assert "not a polynomial in t, sin t and cos t" in report.corroboration.detail
+
+
+def _rrr_det(x, y, f, signs):
+    """det A of the planar 3-RRR of tests/data/robots/3-rrr.yaml, elbows chosen by
+    ``signs`` (closed-form: the elbow is where the circles about Aᵢ and Pᵢ meet)."""
+    bases = [(2, 1), (-2, 1), (mp.mpf(-2) / 5, mp.mpf(-11) / 5)]
+    c, s = mp.cos(f), mp.sin(f)
+    points = [((x + c, y + s), (-s, c)),
+              ((x - 3 * c / 5 - 4 * s / 5, y - 3 * s / 5 + 4 * c / 5),
+               (3 * s / 5 - 4 * c / 5, -3 * c / 5 - 4 * s / 5)),
+              ((x - 3 * c / 5 + 4 * s / 5, y - 3 * s / 5 - 4 * c / 5),
+               (3 * s / 5 + 4 * c / 5, -3 * c / 5 + 4 * s / 5))]
+    rows = []
+    for (ax, ay), ((px, py), (dx, dy)), sigma in zip(bases, points, signs, strict=True):
+        vx, vy = px - ax, py - ay
+        d2 = vx * vx + vy * vy
+        h = mp.sqrt(1 - d2 / 4)
+        n = mp.sqrt(d2)
+        bx = (ax + px) / 2 - sigma * h * vy / n
+        by = (ay + py) / 2 + sigma * h * vx / n
+        ux, uy = px - bx, py - by
+        rows.append([ux, uy, ux * dx + uy * dy])
+    return mp.det(mp.matrix(rows))
+
+
+def test_three_rrr_with_a_shifted_angle_matches_the_oracle(tmp_path):
+    """3-RRR with x = cos(t/2)/5, y = sin(t − 1)/5, φ = cos(t − 1)/10: every mode is
+    feasible (no limits), and the singular times per mode are the oracle's sign changes
+    of det A along each elbow choice (modes are matched by their sets of times)."""
+    import itertools
+
+    pose = {"x": "cos(t/2)/5", "y": "sin(t - 1)/5", "phi": "cos(t - 1)/10"}
+    doc = tmp_path / "rrr.yaml"
+    doc.write_text("name: rrr\nparameter: t\nrange: [-pi, pi]\npose:\n" +
+                   "".join(f"  {k}: {v}\n" for k, v in pose.items()))
+    robot = load_robot("tests/data/robots/3-rrr.yaml", backend="flint", cache=False)
+    report = check(robot, load_trajectory(str(doc), robot), regions=False).certificate
+    mp.mp.dps = 30
+    oracle = []
+    for signs in itertools.product((1, -1), repeat=3):
+        changes = _sign_changes(
+            lambda t, signs=signs: _rrr_det(mp.cos(t / 2) / 5, mp.sin(t - 1) / 5,
+                                            mp.cos(t - 1) / 10, signs), -mp.pi, mp.pi, 3000)
+        if changes:
+            oracle.append(changes)
+    found = [sorted(float(c.t.mid()) for c in m.singular_times) for m in report.modes
+             if m.singular_times]
+    assert report.verdict == "singular"
+    assert len(found) == len(oracle) == 3
+    for times in found:
+        match = [o for o in oracle if len(o) == len(times) and all(
+            a - 1e-6 <= t <= b + 1e-6 for t, (a, b) in zip(times, o, strict=True))]
+        assert len(match) == 1
+
+
+def test_real_angle_limits(tmp_path):
+    """The 5-bar with limits in plain radians ([1, 3.1] and [0.05, 2]): the path down
+    the symmetry axis meets the singularity at y = √3, t = (3 − √3)/2, with both
+    elbows (th1 = 2π/3, th2 = π/3 there) inside those limits."""
+    text = open("robots/five-bar.yaml").read().replace(
+        "joint_limits: {th1: [pi/3, pi], th2: [0, 2*pi/3]}",
+        "joint_limits: {th1: [1, 3.1], th2: [0.05, 2]}")
+    robot_file = tmp_path / "five-bar-radians.yaml"
+    robot_file.write_text(text)
+    robot = load_robot(str(robot_file), backend="flint", cache=False)
+    assert 1 < 2 * mp.pi / 3 < 3.1 and 0.05 < mp.pi / 3 < 2
+    report = check(robot, load_trajectory("trajectories/five-bar-cross.yaml", robot)
+                   ).certificate
+    assert report.verdict == "singular"
+    assert _singular_times(report) == pytest.approx([(3 - 3 ** 0.5) / 2], abs=1e-8)
+    free = check(robot, load_trajectory("trajectories/five-bar-free.yaml", robot)).certificate
+    assert free.verdict == "singularity-free"
+
+
+@pytest.mark.parametrize(("x", "message"), [
+    ("sqrt(t - 1/2)", "is not defined at t = 0"),
+    ("exp(t)", "unknown function 'exp'"),
+])
+def test_expression_paths_refused_up_front(tmp_path, x, message):
+    from singcheck.errors import SpecError
+
+    doc = _doc(tmp_path, "bad", "[0, 1]", {"x": x, "y": "1/2", "z": 1})
+    robot = load_robot("robots/orthoglide.yaml", backend="flint", cache=False)
+    with pytest.raises(SpecError, match=message):
+        load_trajectory(doc, robot)
+
+
+def test_exact_engine_refuses_an_expression_path_with_the_reason(tmp_path):
+    from singcheck.errors import SpecError
+
+    doc = _doc(tmp_path, "shift", "[0, 1]", {"x": "1 + cos(t - 1)/2", "y": "1/2", "z": 1})
+    robot = load_robot("robots/orthoglide.yaml", backend="flint", cache=False)
+    with pytest.raises(SpecError, match=r"x = 1 \+ cos\(t - 1\)/2\): only the interval"):
+        check(robot, load_trajectory(doc, robot), engine="exact", regions=False)

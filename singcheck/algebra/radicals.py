@@ -427,14 +427,15 @@ def angle_function_of(name: str) -> tuple[fmpq_mpoly, Fraction] | None:
     return _ANGLE_FUNCTIONS.get(name[4:-1]) if name.startswith(("cos(", "sin(")) else None
 
 
-def path_ring(primes, functions=()) -> fmpq_mpoly_ctx:
-    """Q[t, s, c] with a ``sqrt(p)`` variable per prime and the (cos, sin) variables of
-    each angle function (``TRIG`` itself for none)."""
+def path_ring(primes, functions=(), opaque=()) -> fmpq_mpoly_ctx:
+    """Q[t, s, c] with a ``sqrt(p)`` variable per prime, the (cos, sin) variables of
+    each angle function and the ``opaque`` variables (coordinates enclosed from their
+    expression trees), ``TRIG`` itself for none."""
     primes = sorted(set(primes))
-    if not primes and not functions:
+    if not primes and not functions and not opaque:
         return TRIG
     names = ("t", "s", "c", *(radical_name(p) for p in primes),
-             *(n for pair in functions for n in pair))
+             *(n for pair in functions for n in pair), *opaque)
     return fmpq_mpoly_ctx.get(names, "lex")
 
 
@@ -495,6 +496,25 @@ _DESCRIPTORS: dict[int, tuple[fmpq_mpoly_ctx, list]] = {}
 _LAST_EXTRA: tuple = (None, None, 0, None, [])  # (ctx, t, precision, signs, balls)
 
 
+def is_opaque(ctx: fmpq_mpoly_ctx) -> bool:
+    """Whether the ring has opaque variables (:mod:`~singcheck.spec.real_paths`)."""
+    from singcheck.spec.real_paths import is_opaque as _is_opaque
+
+    return _is_opaque(ctx)
+
+
+def opaque_of(name: str):
+    from singcheck.spec.real_paths import opaque_of as _opaque_of
+
+    return _opaque_of(name)
+
+
+def opaque_ball(name: str, t: arb) -> arb:
+    from singcheck.spec.real_paths import opaque_ball as _opaque_ball
+
+    return _opaque_ball(name, t)
+
+
 def _descriptors(ctx: fmpq_mpoly_ctx) -> list:
     """Per variable after t, s, c: ("sqrt", q) or ("angle", key, g, k, is_cos), once per
     ring (a ring lives as long as the process: FLINT keeps its contexts)."""
@@ -506,6 +526,9 @@ def _descriptors(ctx: fmpq_mpoly_ctx) -> list:
         q = radical_prime(name)
         if q is not None:
             out.append(("sqrt", q))
+            continue
+        if opaque_of(name) is not None:  # a coordinate enclosed from its expression tree
+            out.append(("opaque", name))
             continue
         g, k = angle_function_of(name)
         out.append(("angle", name[4:-1], g, k, name.startswith("cos(")))
@@ -528,6 +551,9 @@ def _extra_balls(ring: fmpq_mpoly_ctx, t: arb, signs) -> list:
     for d in _descriptors(ring):
         if d[0] == "sqrt":
             out.append(arb(d[1]).sqrt() * signs_.get(d[1], 1))
+            continue
+        if d[0] == "opaque":
+            out.append(opaque_ball(d[1], t))
             continue
         _, key, g, k, is_cos = d
         if key not in cache:
@@ -569,6 +595,9 @@ def path_derivative(p: fmpq_mpoly) -> fmpq_mpoly:
     ctx = p.context()
     if ctx is TRIG:
         return derivative(p)
+    if is_opaque(ctx):
+        raise ValueError("no derivative of a path given by an expression tree (not "
+                         "polynomial in t, sin t, cos t)")
     gens = dict(zip(ctx.names(), ctx.gens(), strict=True))
     out = p.derivative("t") + gens["c"] * p.derivative("s") - gens["s"] * p.derivative("c")
     for name in ctx.names()[3:]:
@@ -581,7 +610,9 @@ def path_derivative(p: fmpq_mpoly) -> fmpq_mpoly:
 
 
 def has_angle_functions(ctx: fmpq_mpoly_ctx) -> bool:
-    return any(angle_function_of(n) is not None for n in ctx.names()[3:])
+    """Whether the ring has variables that are functions of t other than t, sin t, cos t
+    (a pose angle's cos and sin, or an opaque coordinate: :mod:`~singcheck.spec.real_paths`)."""
+    return is_opaque(ctx) or any(angle_function_of(n) is not None for n in ctx.names()[3:])
 
 
 def conjugates(p: fmpq_mpoly) -> list[dict[int, int]]:

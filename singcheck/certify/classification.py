@@ -411,8 +411,8 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
                                            for w in s.windows)
     if not decided:
         exact = with_mu(path)
-        if exact.mu is None:
-            return _certify_by_intervals(exact, modes, searches, tolerance)
+        if exact.mu is None:  # the intervals alone, with their whole budget this time
+            return _certify_by_intervals(exact, modes, None, tolerance)
         return _certify_exactly(exact, modes, tolerance, searches)
     left = remaining()
     own = left is None or left > EXACT_CORROBORATION_BUDGET
@@ -635,6 +635,18 @@ def infeasibility(modes) -> str:
                      for why, labels in by_reason.items())
 
 
+#: a singular time known only to lie in a window wider than this is said as the window
+WIDE_WINDOW = 1e-4
+
+
+def _at(t: arb) -> str:
+    """Where a proven singular time lies: "at t ≈ τ", or "somewhere in t ∈ [a, b]" when
+    only a wide window was proven (ball enclosures too wide to narrow it)."""
+    if float(t.rad()) * 2 > WIDE_WINDOW:
+        return f"somewhere in t ∈ [{float(t.lower()):.6g}, {float(t.upper()):.6g}]"
+    return f"at t ≈ {float(t.mid()):.6g}"
+
+
 def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
     """The verdict and its one-sentence reason from the modes' feasibility, the
     classified candidates and what root isolation left undecided."""
@@ -648,8 +660,7 @@ def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
             return VERDICT_SINGULAR, (f"working mode {label} is singular along the whole "
                                       "path (det A ≡ 0: the path lies on its singularity "
                                       "surface)")
-        return VERDICT_SINGULAR, (f"working mode {label} is singular at t ≈ "
-                                  f"{float(c.t.mid()):.6g}")
+        return VERDICT_SINGULAR, f"working mode {label} is singular {_at(c.t)}"
     if not feasible and not unsure:
         return VERDICT_INFEASIBLE, "no working mode stays in the workspace and joint limits: " \
             + infeasibility(modes)

@@ -46,6 +46,8 @@ from singcheck.algebra.radicals import (
     cos_pi,
     evaluate_path,
     into_ring,
+    is_opaque,
+    opaque_of,
     path_ring,
     radical_balls,
     radical_prime,
@@ -60,6 +62,7 @@ from singcheck.elimination.projection import (
     RobotProjection,
     angle_limit_values,
     degenerate_set,
+    exact_angle_limit,
     limit_constraint,
     norm_legs,
 )
@@ -356,6 +359,9 @@ class LegAlongPath:
         revolute branch is the pair (cos θ, sin θ).  ``tight`` spends more on a wide
         ball (:func:`~singcheck.algebra.trig.evaluate_trig`); ``discriminant``, D's
         enclosure over the same ball (and ``tight``) when the caller has it already."""
+        if self._composer.opaque:  # enclosed from the pose's balls (no composition)
+            point = self._composer.point(t)
+            return _branches_at_point(self._composer.model, self.leg, point)
         if self.leg.kind != REVOLUTE and self.leg.degree == 2:
             # ρ = (-b ± √D)/(2a) needs a, b and D only: c is in D already
             coefficients = self.coefficients
@@ -367,6 +373,12 @@ class LegAlongPath:
         if d is None and self.discriminant is not None:
             d = evaluate_path(self.discriminant, t, None, tight)
         return branch_values(self.leg, values, d)
+
+    def discriminant_at(self, t: arb, tight: bool = False) -> arb:
+        """D's enclosure over the ball ``t`` (from the pose's balls on an opaque path)."""
+        if self._composer.opaque:
+            return evaluate(_model_discriminant(self.leg), self._composer.point(t))
+        return evaluate_path(self.discriminant, t, tight=tight)
 
     def inside(self, value, limits) -> bool | None:
         """Whether a branch value is strictly inside the limits (True), outside them
@@ -547,7 +559,7 @@ class PathModel:
     def leg_branches_at(self, t: arb, variables: list[arb] | None = None) -> list[dict]:
         """Per leg, its branches enclosed over the ball ``t`` (``variables``: the pose
         variables' balls there, when the caller has them)."""
-        if self.legs_from_pose:
+        if self.legs_from_pose or (self.legs and self.legs[0]._composer.opaque):
             return self.branches_at_pose(variables if variables is not None
                                          else self.pose_variables_at(t))
         return [leg.branches(t) for leg in self.legs]
@@ -673,6 +685,25 @@ def _angle_coordinates(p: fmpq_mpoly, q, ring) -> tuple[fmpq_mpoly, fmpq_mpoly]:
     ck, sk = into_ring(cos_multiple(k), ring), into_ring(sin_multiple(k), ring)
     cq, sq = surd_polynomial(cos_pi(q), ring), surd_polynomial(sin_pi(q), ring)
     return _reduce(ck * cq - sk * sq), _reduce(sk * cq + ck * sq)
+
+
+def _opaque_names(phi: tuple[fmpq_mpoly, ...]) -> list[str]:
+    """The opaque variables of a pose kept as expression trees (an angle's A with its C
+    and S), in order; [] for an exact pose."""
+    names: list[str] = []
+    for x in phi:
+        for n in x.context().names()[3:]:
+            if opaque_of(n) is not None and n not in names:
+                names.append(n)
+    return names
+
+
+def _opaque_angle(x: fmpq_mpoly, ring) -> tuple[fmpq_mpoly, fmpq_mpoly]:
+    """(cos, sin) of an angle kept as an expression tree: its C and S variables."""
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    (exps, _), = x.terms()
+    name = ring.names()[list(exps).index(1)]
+    return gens["C" + name[1:]], gens["S" + name[1:]]
 
 
 def _primes_of(*polys) -> set[int]:
@@ -870,6 +901,8 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec,
     for leg in model.legs:
         if leg.kind == REVOLUTE and leg.joint in spec.joint_limits:
             for value in spec.joint_limits[leg.joint]:
+                if not exact_angle_limit(value):
+                    continue  # compared by ball arithmetic alone (working_modes)
                 try:
                     cos_l, sin_l = angle_limit_values(leg.joint, value)
                 except UnsupportedRobotError as e:
@@ -878,7 +911,10 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec,
                         key=f"joint_limits.{leg.joint}") from None
                 primes |= cos_l.primes() | sin_l.primes()
     functions = []
+    opaque = _opaque_names(phi)
     for v, x in zip(model.pose, phi, strict=True):
+        if opaque:  # a pose kept as expression trees: no exact angle form to check
+            continue
         k = _angle_k(x, offsets.get(v, 0)) if v in model.angles else None
         if k is not None and abs(k) > MAX_DEGREE:
             raise SpecError(f"the angle {v} is {k:.3g}*t: cos and sin of a multiple of t "
@@ -897,11 +933,13 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec,
         functions += [(n, "sin(" + n[4:]) for n in names if n.startswith("cos(")
                       and angle_function_of(n) is not None
                       and (n, "sin(" + n[4:]) not in functions]
-    ring = path_ring(primes, functions)
+    ring = path_ring(primes, functions, opaque)
     phi = tuple(into_ring(x, ring) for x in phi)
     coordinates = []
     for v, x in zip(model.pose, phi, strict=True):
-        if v in model.angles:
+        if v in model.angles and opaque:
+            coordinates += _opaque_angle(x, ring)
+        elif v in model.angles:
             coordinates += _angle_coordinates(trajectory.pose[v], offsets.get(v, 0), ring)
         else:
             coordinates.append(x)
@@ -941,6 +979,9 @@ def _mu(projection: RobotProjection, trajectory: TrajectorySpec,
     """μ(t): ξ(φ(t)) when ξ was expanded, else eliminated along the path; refused (a
     :class:`SpecError` naming the pose) when it, or isolating its roots, is too costly."""
     model = projection.model
+    if trajectory.not_algebraic:
+        raise SpecError(f"{trajectory.not_algebraic}: only the interval engine takes it "
+                        "(--engine auto or interval)", **where)
     if projection.expanded:
         # ξ modulo the pose angles' circles: μ is the same (φ's cos, sin lie on them)
         mu = _compose_mu(projection.surface_on_circles, coordinates, model.pose_variables,
@@ -976,7 +1017,7 @@ def _legs_along(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
     use them at once, and they are composed now (the same refusal)."""
     composer = _LegComposer(model, coordinates)
     legs = tuple(LegAlongPath(leg, composer) for leg in model.legs)
-    if _legs_from_pose(model, coordinates):
+    if _legs_from_pose(model, coordinates) or composer.opaque:
         composer.check()
     else:
         for leg in legs:
@@ -996,6 +1037,19 @@ class _LegComposer:
         self.model = model
         self.coordinates = coordinates
         self._composed: list[tuple[fmpq_mpoly, fmpq_mpoly]] = []  # (coefficient, image)
+        #: a path given by expression trees: its legs are enclosed from the pose's balls
+        self.opaque = any(is_opaque(x.context()) for x in coordinates)
+        self._last: tuple = (None, 0, None)  # (t, precision, point)
+
+    def point(self, t: arb) -> list:
+        """The balls of the robot's variables over ``t`` (joints 0, the pose's, square
+        roots), remembered for the last ball."""
+        last = self._last
+        if last[0] is t and last[1] == ctx.prec:
+            return last[2]
+        point = _pose_point(self.model, [evaluate_path(x, t) for x in self.coordinates])
+        self._last = (t, ctx.prec, point)
+        return point
 
     def _limit_constraints(self, leg: Leg) -> dict:
         """A revolute joint's constraint at each of its limits (in the robot's ring),
@@ -1005,7 +1059,7 @@ class _LegComposer:
             return {}
         return memo_per_object(_LIMIT_CONSTRAINTS, leg, lambda leg: {
             value: limit_constraint(model, leg, value)
-            for value in model.spec.joint_limits[leg.joint]})
+            for value in model.spec.joint_limits[leg.joint] if exact_angle_limit(value)})
 
     def _sources(self) -> list[fmpq_mpoly]:
         polys = []

@@ -31,7 +31,7 @@ from itertools import product
 from flint import arb, ctx
 
 from singcheck.algebra.intervals import working_precision
-from singcheck.algebra.radicals import evaluate_path
+from singcheck.algebra.radicals import evaluate_path, is_opaque
 from singcheck.algebra.trig import TimeRange
 from singcheck.budget import checkpoint
 from singcheck.certify.covers import TIGHT_ABOVE, TIGHT_DEGREE, one_period
@@ -90,7 +90,23 @@ def gap_points(interval: TimeRange, events: list[arb]) -> list[arb]:
     return points
 
 
-def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | None:
+def _aperiodic_variables(ctx) -> list[int]:
+    """Indices of a path ring's variables that are functions of t with no known period
+    (angle functions, opaque coordinates)."""
+    from singcheck.algebra.radicals import angle_function_of, opaque_of
+
+    return [i for i, n in enumerate(ctx.names()) if i >= 3 and (
+        angle_function_of(n) is not None or opaque_of(n) is not None)]
+
+
+#: what :func:`_isolate` returns for a polynomial of an opaque path (no exact isolation:
+#: its feasibility is decided by :func:`_by_intervals` alone)
+OPAQUE = "opaque"
+
+
+def _isolate(poly, interval: TimeRange, tolerance: float) -> RootIsolation | None | str:
+    if is_opaque(poly.context()):
+        return OPAQUE
     try:
         return isolate_real_roots(poly, interval, tolerance, vanishes_at_root)
     except IdenticallyZeroError:
@@ -135,7 +151,17 @@ class _Cover:
 
     @cached_property
     def range(self) -> TimeRange:
-        return one_period(self.interval, (), periodic=all(d[0] <= 0 for d in self._degrees))
+        return one_period(self.interval, (), periodic=self.periodic)
+
+    @cached_property
+    def periodic(self) -> bool:
+        """Whether the leg's polynomials are 2π-periodic in t: free of the bare t and of
+        every variable that is a function of t other than sin t and cos t (a pose
+        angle's cos g(t), an opaque coordinate: neither need be periodic)."""
+        polys = [p for p in _leg_polys(self.leg) if p is not None]
+        return all(d[0] <= 0 for d in self._degrees) and not any(
+            d[i] > 0 for p in polys for d in [p.degrees()]
+            for i in _aperiodic_variables(p.context()))
 
     @cached_property
     def retry_tight(self) -> bool:
@@ -179,7 +205,7 @@ class _Cover:
         """The enclosure of D over the ball ``t``."""
         entry = self._entry(t, tight)
         if entry[1] is None:
-            entry[1] = evaluate_path(self.leg.discriminant, t, tight=tight)
+            entry[1] = self.leg.discriminant_at(t, tight)
         return entry[1]
 
     def branches(self, t: arb, tight: bool = False) -> dict:
@@ -229,6 +255,16 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when,
                              cover.range, cover.retry_tight, cover):
         return FEASIBLE, "", None
     iso = _isolate(leg.discriminant, interval, tolerance)
+    if iso == OPAQUE:
+        bad = _by_intervals(cover, lambda t: cover.discriminant(t) > 0,
+                            lambda t: cover.discriminant(t) < 0)
+        if bad is True:
+            return FEASIBLE, "", None
+        if bad is not None:
+            return INFEASIBLE, f"{joint} has no real solution at t ≈ {when(bad)} (the path " \
+                "leaves the workspace)", bad
+        return UNKNOWN, f"could not prove that the branches of {joint} stay real and apart " \
+            f"({_OPAQUE_WHY})", None
     if iso is None:
         return INFEASIBLE, f"the two branches of {joint} coincide along the whole path " \
             "(serial singularity)", None
@@ -265,6 +301,7 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
     the range start when the caller has them."""
     joint = leg.leg.joint
     cover = cover or _Cover(leg, interval)
+    opaque = _exact_limits_unavailable(leg, limits)
     start = at_start if at_start is not None else cover.branches(cover.start)
     if leg.inside(start[label], limits) is False:
         return BranchFeasibility(joint, label, INFEASIBLE,
@@ -273,6 +310,19 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
                                                           limits) is True,
                              cover.range, cover.retry_tight, cover):
         return BranchFeasibility(joint, label, FEASIBLE)
+    if opaque:
+        bad = _by_intervals(cover, lambda t: leg.inside(cover.branches(t)[label],
+                                                         limits) is True,
+                            lambda t: leg.inside(cover.branches(t)[label], limits) is False)
+        if bad is True:
+            return BranchFeasibility(joint, label, FEASIBLE)
+        if bad is not None:
+            return BranchFeasibility(joint, label, INFEASIBLE,
+                                     f"{joint} is outside {_bounds(limits)} at t ≈ "
+                                     f"{when(bad)}", bad)
+        return BranchFeasibility(joint, label, UNKNOWN,
+                                 f"could not prove that {joint} stays inside "
+                                 f"{_bounds(limits)} ({_OPAQUE_WHY})")
     events: list[arb] = []
     undecided = []
     exact: list[str] = []  # limits met where p and a conjugate both vanish: decided exactly
@@ -324,6 +374,51 @@ def _branch_limits(leg: LegAlongPath, label: str, interval: TimeRange, limits,
             return BranchFeasibility(joint, label, INFEASIBLE, reason, crossing,
                                      "; ".join(exact))
     return BranchFeasibility(joint, label, FEASIBLE, proof="; ".join(exact))
+
+
+#: how feasibility was tried where no exact isolation exists (a path kept as expression
+#: trees, an angle limit that is not a multiple of π/12)
+_OPAQUE_WHY = "by ball arithmetic alone"
+
+
+def _exact_limits_unavailable(leg: LegAlongPath, limits) -> bool:
+    """Whether the limits' crossings cannot be isolated exactly: the path is opaque, or
+    an angle limit is not a multiple of π/12 (its cos and sin are not algebraic)."""
+    from singcheck.elimination.projection import exact_angle_limit
+
+    if is_opaque(leg.coefficients[0].context()):
+        return True
+    return leg.revolute and not all(exact_angle_limit(v) for v in limits)
+
+
+#: evaluations per 2π an interval-only feasibility proof may spend (a leg's branch)
+INTERVAL_ONLY_BUDGET = 4000
+
+
+def _by_intervals(cover: _Cover, good, bad) -> bool | arb | None:
+    """An interval-only proof over the cover's range: True when ``good(piece)`` holds on
+    balls covering it; else the first exact point found where ``bad(point)`` is proven
+    (a ball of a time); None when the budget of evaluations ends first.  Each failing
+    piece is tried at its midpoint (an exact point), then halved."""
+    import math
+
+    todo = cover.pieces()
+    rng = cover.range
+    periods = max(1.0, (float(rng.end) - float(rng.start)) / (2 * math.pi))
+    spent, budget = 0, max(cover.budget, int(INTERVAL_ONLY_BUDGET * periods))
+    while todo:
+        piece = todo.pop()
+        checkpoint()
+        spent += 1
+        if good(piece):
+            continue
+        point = arb(piece.mid())
+        if bad(point):
+            return point
+        if spent + len(todo) + 2 > budget:
+            return None
+        todo += cover.halves(piece)
+    return True
 
 
 def _field(root) -> str:

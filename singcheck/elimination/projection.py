@@ -167,6 +167,21 @@ def workspace_boundary(model: RobotModel, pose_ctx: fmpq_mpoly_ctx) -> tuple[fmp
     return tuple(out)
 
 
+def transcendental_limits(model: RobotModel) -> str:
+    """Which angle limits have no algebraic cos and sin ("" when none): with them the
+    joint-limit surfaces are not algebraic, so no region statement is made."""
+    found = [f"{leg.joint} {value}" for leg in model.legs if leg.kind == REVOLUTE
+             for value in model.spec.joint_limits.get(leg.joint, ())
+             if not exact_angle_limit(value)]
+    return ", ".join(found)
+
+
+def exact_angle_limit(value) -> bool:
+    """Whether an angle joint's limit has exact (algebraic) cos and sin here: qπ with 12q
+    an integer.  Other limits (0.5 rad) are compared by ball arithmetic alone."""
+    return not value.rational and cos_pi(value.pi_coefficient) is not None
+
+
 def angle_limit_values(joint: str, value) -> tuple:
     """``(cos L, sin L)`` as exact surds for an angle joint's limit L = qπ, 12q an
     integer (the limits whose crossings are algebraic)."""
@@ -205,6 +220,8 @@ def joint_limit_surfaces(model: RobotModel, pose_ctx) -> tuple[JointLimitSurface
         if limits is None:
             continue
         for bound, value in zip(("min", "max"), limits, strict=True):
+            if leg.kind == REVOLUTE and not exact_angle_limit(value):
+                continue  # not algebraic: the region statement is refused for this robot
             try:
                 poly = norm_radicals(limit_constraint(model, leg, value))
             except UnsupportedRobotError as e:

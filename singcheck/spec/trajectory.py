@@ -54,6 +54,24 @@ class TrajectorySpec:
     #: the working mode the verdict is about (the document's ``mode`` key; None: all)
     mode: str | None = None
 
+    @property
+    def not_algebraic(self) -> str:
+        """Why the exact engine cannot take this piece ("" when it can): the coordinates
+        kept as expression trees (:mod:`~singcheck.spec.real_paths`)."""
+        from singcheck.spec.real_paths import opaque_of
+
+        found = []
+        for v, p in self.pose.items():
+            for name in p.context().names()[3:]:
+                hit = opaque_of(name)
+                if hit is not None and hit[1] in "XA" and not hit[0].algebraic and \
+                        p.degrees()[p.context().names().index(name)] > 0:
+                    found.append(f"{v} = {hit[0].text}")
+        if not found:
+            return ""
+        return ("the path is not a polynomial in t, sin t and cos t over Q (" +
+                "; ".join(found) + ")")
+
     def __repr__(self) -> str:  # short: the pose polynomials can run to kilobytes
         pieces = f", {len(self.segments)} pieces" if self.segments else ""
         rng = self.global_range
@@ -191,7 +209,74 @@ def trajectory_piece(doc, rng: TimeRange, rnode, nodes: dict, key: str, paramete
                      robot) -> tuple[TimeRange, dict, Fraction | None, dict]:
     """A piece's pose compiled exactly (with its angles' π offsets), its range in its own
     time: sin/cos of k·π·t (rational k) rescale the piece to τ = g·π·t (then the range
-    must be rational, and becomes [g·π·start, g·π·end])."""
+    must be rational, and becomes [g·π·start, g·π·end]).
+
+    A pose the exact compilers refuse (``cos(t - 1)``, ``cos(t/2)``, t beside
+    ``sin(pi*t)``, ``sqrt(1 + t^2)``) but that is a real function of t in the grammar
+    (:func:`~singcheck.spec.real_paths.real_function`) is kept as expression trees: each
+    coordinate becomes an opaque variable of the path ring, enclosed by ball arithmetic
+    (the interval engine alone certifies such a path; the exact engine's refusal names
+    the coordinate).  A pose that is not even that raises the exact compiler's error."""
+    from singcheck.errors import SpecError
+
+    try:
+        return _exact_piece(doc, rng, rnode, nodes, key, parameter, robot)
+    except (SpecError, ExprError) as e:
+        first = e
+    opaque = _opaque_piece(doc, nodes, key, parameter, robot, rng, rnode)
+    if opaque is None:
+        if isinstance(first, ExprError):
+            raise doc.error(rnode, key, first.message) from None
+        raise first
+    return rng, opaque, None, {}
+
+
+def _opaque_piece(doc, nodes: dict, key: str, parameter: str, robot, rng: TimeRange,
+                  rnode) -> dict | None:
+    """The pose as opaque variables, one ring for the piece (None when some coordinate
+    is not a real function of the parameter in the grammar).  A coordinate not proven
+    defined at the range's ends (√ of a negative number, a division by 0) is refused."""
+    from singcheck.spec.real_paths import opaque_name, real_function
+
+    functions = {}
+    for v, node in nodes.items():
+        text = doc.text(node, f"{key}.{v}")
+        tree = doc.expression(node, f"{key}.{v}", lambda n: n)
+        try:
+            functions[v] = real_function(tree, text, parameter, robot.parameters,
+                                         _algebraic(tree, parameter, robot))
+        except ExprError:
+            return None
+        for end in (rng.start, rng.end):
+            if not functions[v](end.ball()).is_finite():
+                raise doc.error(node, f"{key}.{v}", f"{text!r} is not defined at "
+                                f"{parameter} = {end} (or not provably: a square root of a "
+                                "negative number, a division by zero)")
+    names = {v: opaque_name("A" if v in robot.angles else "X", f)
+             for v, f in functions.items()}
+    extra = [opaque_name(k, functions[v]) for v in functions if v in robot.angles
+             for k in ("C", "S")]
+    ring = fmpq_mpoly_ctx.get(("t", "s", "c", *dict.fromkeys([*names.values(), *extra])),
+                              "lex")
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    return {v: gens[name] for v, name in names.items()}
+
+
+def _algebraic(tree: Node, parameter: str, robot) -> bool:
+    """Whether the coordinate alone compiles exactly (said in the exact engine's refusal
+    of a piece kept as expression trees: only the others are named)."""
+    primes = sorted(radical_primes(robot.parameters, [tree]))
+    ring = fmpq_mpoly_ctx.get(("t", "s", "c", *(radical_name(p) for p in primes)), "lex")
+    try:
+        compile_trajectory_coordinate(tree, parameter, robot.parameters, ring)
+    except ExprError:
+        return False
+    return True
+
+
+def _exact_piece(doc, rng: TimeRange, rnode, nodes: dict, key: str, parameter: str,
+                 robot) -> tuple[TimeRange, dict, Fraction | None, dict]:
+    """:func:`trajectory_piece` for a pose the exact compilers take."""
     trees = {v: doc.expression(node, f"{key}.{v}", lambda n: n) for v, node in nodes.items()}
     scale = _scale_of([k for tree in trees.values()
                        for k in pi_multiples(tree, parameter, robot.parameters)])

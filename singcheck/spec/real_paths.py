@@ -1,0 +1,165 @@
+"""Path coordinates that are real functions of t but not polynomials in (t, sin t, cos t).
+
+``cos(t - 1)``, ``cos(t/2)``, ``cos(2*pi*t) + t/10``, ``sqrt(1 + t^2)``: the grammar
+accepts them, but the exact engine cannot (μ would not be a polynomial over Q in t,
+sin t, cos t).  Such a coordinate is kept as its expression tree and enclosed by ball
+arithmetic: each operation of the tree is Arb's on balls (outward rounding), so the
+value returned for a ball T encloses the coordinate at every t in T (a ball holding a
+pole or a negative square root comes back infinite or NaN: nothing is proven there).
+
+In the path ring the coordinate is an *opaque* variable (``X[[…]]`` for a coordinate,
+``A[[…]]``/``C[[…]]``/``S[[…]]`` for an angle, its cosine and its sine) whose ball at T is
+this enclosure (:func:`opaque_of`, read by
+:func:`~singcheck.algebra.radicals.evaluate_path`).  Only the interval engine reads such
+a path; the exact engine refuses it and says why.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from fractions import Fraction
+
+from flint import arb, fmpq
+
+from singcheck.algebra.intervals import power
+from singcheck.spec.grammar import MAX_EXPONENT, Constant, ExprError, Node
+
+#: opaque ring variable name -> (function, what the variable is: X, A, C or S)
+_OPAQUE: dict[str, tuple[RealFunction, str]] = {}
+#: the bracket characters of an opaque name (never in a polynomial variable's name)
+OPEN, CLOSE = "[[", "]]"
+
+
+def _ball(value) -> arb:
+    if isinstance(value, Constant):
+        out = value.surd.ball()
+        if value.pi_coefficient:
+            q = value.pi_coefficient
+            out += arb.pi() * arb(fmpq(q.numerator, q.denominator))
+        return out
+    q = Fraction(value)
+    return arb(fmpq(q.numerator, q.denominator))
+
+
+@dataclass(frozen=True)
+class RealFunction:
+    """A coordinate t ↦ f(t) given by an expression tree (checked by :func:`real_function`)."""
+
+    text: str
+    tree: Node
+    parameter: str
+    constants: tuple[tuple[str, object], ...]  # the robot parameters it may name
+    algebraic: bool = False  # whether the exact compilers take it alone (display only)
+
+    def __call__(self, t: arb) -> arb:
+        """An enclosure of f over the ball ``t`` (non-finite where f is not proven
+        defined)."""
+        constants = dict(self.constants)
+        return _enclose(self.tree, t, self.parameter, constants)
+
+
+def _enclose(node: Node, t: arb, parameter: str, constants: dict) -> arb:
+    k = node.kind
+    if k == "num":
+        return _ball(node.value)
+    if k == "name":
+        if node.value == parameter:
+            return t
+        if node.value == "pi":
+            return arb.pi()
+        return _ball(constants[node.value])
+    args = [_enclose(a, t, parameter, constants) for a in node.args] if k != "pow" else None
+    if k == "neg":
+        return -args[0]
+    if k == "add":
+        return args[0] + args[1]
+    if k == "sub":
+        return args[0] - args[1]
+    if k == "mul":
+        return args[0] * args[1]
+    if k == "div":
+        return args[0] / args[1]
+    if k == "pow":
+        base = _enclose(node.args[0], t, parameter, constants)
+        e = _integer(node.args[1])
+        return arb(1) if e == 0 else power(base, e)
+    if k == "call":
+        x = args[0]
+        if node.value == "sin":
+            return x.sin()
+        if node.value == "cos":
+            return x.cos()
+        if x > 0:
+            return x.sqrt()
+        return arb("nan")  # √ of a ball reaching 0 or below: nothing proven
+    raise AssertionError(k)  # pragma: no cover
+
+
+def _integer(node: Node) -> int:
+    """An exponent: a non-negative integer literal (or a parenthesised one)."""
+    if node.kind == "num" and isinstance(node.value, Fraction) and node.value.denominator == 1 \
+            and 0 <= node.value <= MAX_EXPONENT:
+        return int(node.value)
+    raise ExprError(f"an exponent of a path's coordinate must be an integer from 0 to "
+                    f"{MAX_EXPONENT}", node.column)
+
+
+def real_function(node: Node, text: str, parameter: str, parameters: dict,
+                  algebraic: bool = False) -> RealFunction:
+    """The coordinate ``node`` (written ``text``) as a :class:`RealFunction` of the
+    parameter, checked: names are the parameter, ``pi`` and the robot's parameters;
+    functions sin, cos, sqrt; exponents integers (:class:`ExprError` otherwise)."""
+    used: dict[str, object] = {}
+
+    def walk(n: Node) -> None:
+        if n.kind == "name":
+            if n.value in (parameter, "pi"):
+                return
+            if n.value not in parameters:
+                declared = ", ".join([parameter, "pi", *sorted(parameters)])
+                raise ExprError(f"undeclared name {n.value!r} (declared: {declared})",
+                                n.column)
+            used[n.value] = parameters[n.value]
+            return
+        if n.kind == "call" and n.value not in ("sin", "cos", "sqrt"):
+            raise ExprError(f"unknown function {n.value!r} (only sin, cos and sqrt)", n.column)
+        if n.kind == "pow":
+            walk(n.args[0])
+            _integer(n.args[1])
+            return
+        for a in n.args:
+            walk(a)
+
+    walk(node)
+    return RealFunction(text, node, parameter, tuple(sorted(used.items())), algebraic)
+
+
+def opaque_name(kind: str, f: RealFunction) -> str:
+    """The path ring variable standing for f (``X``), or for the angle f, its cosine or
+    its sine (``A``, ``C``, ``S``); registered for :func:`opaque_of`."""
+    tag = f.text if not f.constants else f"{f.text} | " + ", ".join(
+        f"{k}={v}" for k, v in f.constants)
+    name = f"{kind}{OPEN}{tag}{CLOSE}"
+    _OPAQUE.setdefault(name, (f, kind))
+    return name
+
+
+def opaque_of(name: str) -> tuple[RealFunction, str] | None:
+    """(function, kind) of an opaque variable's name, None for any other name."""
+    return _OPAQUE.get(name) if name.endswith(CLOSE) else None
+
+
+def is_opaque(ctx) -> bool:
+    """Whether a ring has opaque variables (a path the exact engine cannot take)."""
+    return any(n.endswith(CLOSE) for n in ctx.names())
+
+
+def opaque_ball(name: str, t: arb) -> arb:
+    """The ball of an opaque variable over the ball ``t``."""
+    f, kind = _OPAQUE[name]
+    value = f(t)
+    if kind == "C":
+        return value.cos()
+    if kind == "S":
+        return value.sin()
+    return value

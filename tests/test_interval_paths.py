@@ -228,3 +228,42 @@ def test_exact_engine_refuses_an_expression_path_with_the_reason(tmp_path):
     robot = load_robot("robots/orthoglide.yaml", backend="flint", cache=False)
     with pytest.raises(SpecError, match=r"x = 1 \+ cos\(t - 1\)/2\): only the interval"):
         check(robot, load_trajectory(doc, robot), engine="exact", regions=False)
+
+
+def test_expression_path_derivative_encloses_the_true_rate():
+    """The forward-mode derivative of a tree, at points and over a ball, against
+    mpmath's numerical derivative at 30 digits."""
+    from flint import arb
+
+    from singcheck.spec.grammar import parse
+    from singcheck.spec.real_paths import real_function
+
+    text = "cos(t - 1)/2 + sqrt(1 + t^2)*sin(2*pi*t)/(3 + t)"
+    f = real_function(parse(text), text, "t", {})
+    mp.mp.dps = 30
+
+    def g(t):
+        return mp.cos(t - 1) / 2 + mp.sqrt(1 + t * t) * mp.sin(2 * mp.pi * t) / (3 + t)
+
+    for x in ("-0.7", "0.25", "1.5"):
+        value, rate = f.with_derivative(arb(x))
+        assert value.contains(arb(mp.nstr(g(mp.mpf(x)), 25)))
+        assert abs(float(rate.mid()) - float(mp.diff(g, mp.mpf(x)))) < 1e-12
+    _, wide = f.with_derivative(arb("0.5", "0.1"))
+    for k in range(21):  # every rate over [0.4, 0.6] is inside the ball's enclosure
+        assert wide.contains(arb(mp.nstr(mp.diff(g, mp.mpf("0.4") + mp.mpf(k) / 100), 20)))
+
+
+def test_expression_path_clearance_and_plot(tmp_path):
+    """A path kept as expression trees gets its clearance (the tree's derivative) and
+    its figures, where it used to end in an error."""
+    from singcheck.report.plots import _sample_piece
+
+    doc = _doc(tmp_path, "half", "[-pi, pi]", {"x": "1 + cos(t/2)/2", "y": "1/2", "z": 1})
+    robot = load_robot("robots/orthoglide.yaml", backend="flint", cache=False)
+    report = check(robot, load_trajectory(doc, robot), regions=False, clearance=True)
+    assert report.verdict == "singularity-free"
+    kappa = report.extra["clearance"]["+++"]
+    assert 0 < kappa["interval"][0] <= kappa["interval"][1]
+    t, pose, mu, _, _ = _sample_piece(report.certificate.path, 50)
+    assert abs(pose[0][0] - (1 + mp.cos(-mp.pi / 2) / 2)) < 1e-12

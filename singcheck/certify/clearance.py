@@ -313,26 +313,8 @@ def _mode_joints(path, mode, t: arb, with_rate: bool):
     pose, variables = path.pose_and_variables_at(t)
     per_leg = path.leg_branches_at(t, variables)
     joints = [leg[b.label] for leg, b in zip(per_leg, mode.branches, strict=True)]
-    rates = None
-    if with_rate:
-        from singcheck.algebra.radicals import evaluate_path, path_derivative
-
-        rates = [evaluate_path(_path_derivative(path, x, path_derivative), t)
-                 for x in path.coordinates]
+    rates = path.pose_rates_at(t) if with_rate else None
     return joints, variables, rates
-
-
-_PATH_DERIVATIVES: dict = {}
-
-
-def _path_derivative(path, x, derive):
-    key = id(x)
-    hit = _PATH_DERIVATIVES.get(key)
-    if hit is None or hit[0] is not x:
-        if len(_PATH_DERIVATIVES) > 4096:
-            _PATH_DERIVATIVES.clear()
-        hit = _PATH_DERIVATIVES[key] = (x, derive(x))
-    return hit[1]
 
 
 def gram_at(path, mode, t: arb, length, with_rate: bool = False):

@@ -255,23 +255,6 @@ def _derivative_parts(model):
     return memo_per_object(_DERIVATIVES, model, build)
 
 
-_PATH_DERIVATIVES: dict = {}
-
-
-def _pose_derivatives(path) -> list | None:
-    """d/dt of each pose variable along the path (None where the path ring has angle
-    functions of its own: no mean-value form there)."""
-    from singcheck.algebra.polynomials import memo_per_object
-    from singcheck.algebra.radicals import has_angle_functions, path_derivative
-
-    def build(path):
-        if any(has_angle_functions(x.context()) for x in path.coordinates):
-            return None
-        return [path_derivative(x) for x in path.coordinates]
-
-    return memo_per_object(_PATH_DERIVATIVES, path, build)
-
-
 def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
     """(det A, its derivative along the mode) per mode over the ball ``t``, det A in
     mean-value form (a mode where it could not be formed is left out): det A at the
@@ -284,18 +267,19 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
     det A over ``t`` (the mean value theorem, on a continuous branch of a feasible mode).
     ``joints``: each mode's joint balls over ``t`` (:func:`mode_values`)."""
     from singcheck.algebra.intervals import evaluate
-    from singcheck.algebra.radicals import evaluate_path, radical_balls
+    from singcheck.algebra.radicals import radical_balls
     from singcheck.model.robot import REVOLUTE
 
     model = path.projection.model
-    dpose = _pose_derivatives(path)
-    if dpose is None or len(model.det_A) > 5000:
+    if len(model.det_A) > 5000:
+        return {}
+    rates = path.pose_rates_at(t, angle_functions=False)
+    if rates is None:
         return {}
     n_joint, det_parts, legs = _derivative_parts(model)
     m = arb(t.mid())
     _, _, at_mid = mode_values(path, modes, m)
     variables = path.pose_variables_at(t)
-    rates = [evaluate_path(d, t) for d in dpose]
     radicals = [b for _, b in sorted(radical_balls(model.context).items())]
     out = {}
     for mode in modes:

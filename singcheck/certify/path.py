@@ -511,6 +511,27 @@ class PathModel:
             pose.append(ball)
         return pose, [value(x) for x in self.coordinates]
 
+    def pose_rates_at(self, t: arb, angle_functions: bool = True) -> list[arb] | None:
+        """d/dt of each pose variable over the ball ``t`` (None, without
+        ``angle_functions``, where the path ring has angle functions of its own: the
+        mean-value form does without them).  A path kept as
+        expression trees is differentiated on its trees
+        (:meth:`~singcheck.spec.real_paths.RealFunction.with_derivative`)."""
+        from singcheck.algebra.radicals import has_angle_functions
+        from singcheck.spec.real_paths import opaque_rate
+
+        if self.legs and self.legs[0]._composer.opaque:
+            out = []
+            for x in self.coordinates:
+                (exps, _), = x.terms()
+                out.append(opaque_rate(x.context().names()[list(exps).index(1)], t))
+            return out
+        if not angle_functions and any(has_angle_functions(x.context())
+                                       for x in self.coordinates):
+            return None
+        derivatives = _coordinate_derivatives(self)
+        return [evaluate_path(d, t) for d in derivatives]
+
     def det_A(self, joints: list, pose: list[arb], signs: dict[int, int] | None = None):
         """Enclosure of det A at the given joint values (a revolute joint's as a (cos,
         sin) pair) and pose-variable balls; ``signs`` picks conjugate square roots."""
@@ -578,6 +599,19 @@ class PathModel:
         as ``signs`` says), by ball evaluation of the leg's coefficients at the pose."""
         model = self.projection.model
         return [branches_at_pose(model, leg.leg, pose, signs) for leg in self.legs]
+
+
+_COORDINATE_DERIVATIVES: dict = {}
+
+
+def _coordinate_derivatives(path: PathModel) -> list | None:
+    """d/dt of each pose variable along the path, once per path."""
+    from singcheck.algebra.radicals import path_derivative
+
+    def build(path):
+        return [path_derivative(x) for x in path.coordinates]
+
+    return memo_per_object(_COORDINATE_DERIVATIVES, path, build)
 
 
 #: det A with more terms than this (a hexapod's: 10⁵) is enclosed per mode as the

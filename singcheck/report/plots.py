@@ -76,9 +76,29 @@ def named_arrays(ctx, table: dict) -> list:
 
 
 def _along(p, t: np.ndarray) -> np.ndarray:
-    """A path polynomial (in t, s = sin t, c = cos t and square roots) at the times t."""
-    return numpy_polynomial(p)(named_arrays(p.context(), {"t": t, "s": np.sin(t),
-                                                          "c": np.cos(t)}))
+    """A path polynomial (in t, s = sin t, c = cos t, square roots and the opaque
+    coordinates of a path kept as expression trees) at the times t."""
+    table = {"t": t, "s": np.sin(t), "c": np.cos(t)}
+    table.update(_opaque_samples(p.context(), t))
+    return numpy_polynomial(p)(named_arrays(p.context(), table))
+
+
+def _opaque_samples(ctx, t: np.ndarray) -> dict:
+    """The opaque variables' values at the times t (the midpoints of their balls:
+    drawing only)."""
+    from flint import arb
+
+    from singcheck.spec.real_paths import opaque_ball, opaque_of
+
+    out = {}
+    for name in ctx.names()[3:]:
+        if opaque_of(name) is not None:
+            values = []
+            for x in t:
+                ball = opaque_ball(name, arb(float(x)))
+                values.append(float(ball.mid()) if ball.is_finite() else np.nan)
+            out[name] = np.array(values)
+    return out
 
 
 @dataclass
@@ -109,7 +129,7 @@ def _sample_piece(path, n: int):
     pose = [_along(p, t) + np.pi * float(offsets.get(v, 0))
             for v, p in zip(model.pose, path.phi, strict=True)]
     variables = [_along(x, t) for x in path.coordinates] if path.coordinates else pose
-    mu = _along(path.mu, t)
+    mu = _along(path.mu, t) if path.mu is not None else np.full_like(t, np.nan)
     legs = []
     for leg in path.legs:
         values = [_along(c, t) for c in leg.coefficients]

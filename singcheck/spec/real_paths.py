@@ -58,6 +58,49 @@ class RealFunction:
         return _enclose(self.tree, t, self.parameter, constants)
 
 
+    def with_derivative(self, t: arb) -> tuple[arb, arb]:
+        """Enclosures of f and f' over the ball ``t`` (forward-mode differentiation of
+        the tree, every operation on balls: f' is enclosed wherever it is defined)."""
+        return _dual(self.tree, t, self.parameter, dict(self.constants))
+
+
+def _dual(node: Node, t: arb, parameter: str, constants: dict) -> tuple[arb, arb]:
+    """(value, derivative) of the tree over the ball t."""
+    k = node.kind
+    zero = arb(0)
+    if k in ("num", "name"):
+        if k == "name" and node.value == parameter:
+            return t, arb(1)
+        return _enclose(node, t, parameter, constants), zero
+    if k == "pow":
+        u, du = _dual(node.args[0], t, parameter, constants)
+        e = _integer(node.args[1])
+        if e == 0:
+            return arb(1), zero
+        return power(u, e), (e * power(u, e - 1) if e > 1 else arb(1)) * du
+    args = [_dual(a, t, parameter, constants) for a in node.args]
+    (u, du) = args[0]
+    if k == "neg":
+        return -u, -du
+    if k in ("add", "sub", "mul", "div"):
+        v, dv = args[1]
+        if k == "add":
+            return u + v, du + dv
+        if k == "sub":
+            return u - v, du - dv
+        if k == "mul":
+            return u * v, du * v + u * dv
+        return u / v, (du * v - u * dv) / (v * v)
+    if node.value == "sin":
+        return u.sin(), u.cos() * du
+    if node.value == "cos":
+        return u.cos(), -u.sin() * du
+    if u > 0:
+        root = u.sqrt()
+        return root, du / (2 * root)
+    return arb("nan"), arb("nan")
+
+
 def _enclose(node: Node, t: arb, parameter: str, constants: dict) -> arb:
     k = node.kind
     if k == "num":
@@ -152,6 +195,17 @@ def opaque_of(name: str) -> tuple[RealFunction, str] | None:
 def is_opaque(ctx) -> bool:
     """Whether a ring has opaque variables (a path the exact engine cannot take)."""
     return any(n.endswith(CLOSE) for n in ctx.names())
+
+
+def opaque_rate(name: str, t: arb) -> arb:
+    """d/dt of an opaque variable over the ball ``t`` (an angle's cos: −sin·A', ...)."""
+    f, kind = _OPAQUE[name]
+    value, rate = f.with_derivative(t)
+    if kind == "C":
+        return -value.sin() * rate
+    if kind == "S":
+        return value.cos() * rate
+    return rate
 
 
 def opaque_ball(name: str, t: arb) -> arb:

@@ -510,7 +510,11 @@ def shared_regions(robot: Robot, head: list, options: dict, notify: Notify = _qu
     """Before a batch's workers start: the region maps that its first trajectories
     share, computed once (:func:`prepare_regions`); ``options["regions"]`` is turned off
     when that ran out of time."""
+    from singcheck.elimination.projection import transcendental_limits
+
     specs = [t for t in map(spec_of, head) if isinstance(t, TrajectorySpec)]
+    if options["regions"] and transcendental_limits(robot.projection.model):
+        options["regions"] = False  # no algebraic limit surfaces: no region statement
     if options["regions"] and specs and not prepare_regions(
             robot, specs, options["time_limit"], notify):
         options["regions"] = False

@@ -37,7 +37,7 @@ from singcheck.elimination.projection import (
 )
 from singcheck.elimination.requests import EliminationRequest
 from singcheck.errors import SingcheckError, UnsupportedRobotError
-from singcheck.model.robot import RobotModel
+from singcheck.model.robot import REVOLUTE, RobotModel
 from singcheck.spaces.cad import Cell, OpenCAD, open_cad
 from singcheck.spaces.chart import Chart
 from singcheck.spaces.regions import Region, Regions, connect_regions, factor_signs
@@ -127,6 +127,7 @@ def workspace_variety(projection: RobotProjection,
     """Serial singularities, ξ (unless ``parallel`` is False) and joint limits in X (in
     the chart: an angle φ of the pose as tan(φ/2), :mod:`singcheck.spaces.chart`)."""
     model = projection.model
+    refuse_transcendental_limits(model)
     chart = space_chart(model, WORKSPACE)
     out = []
     for leg, disc in zip(model.legs, projection.workspace_boundary, strict=True):
@@ -140,6 +141,24 @@ def workspace_variety(projection: RobotProjection,
         out.append(VarietyComponent(LIMIT, f"{s.joint} = {s.value} ({s.bound})",
                                     chart.polynomial(s.polynomial)))
     return out
+
+
+def refuse_transcendental_limits(model: RobotModel) -> None:
+    """Regions need the joint-limit surfaces as polynomials: an angle limit whose cos
+    and sin are not algebraic (not a multiple of π/12) is refused with the reason (the
+    trajectory check takes it, by ball arithmetic)."""
+    from singcheck.elimination.projection import angle_limit_values, exact_angle_limit
+
+    for leg in model.legs:
+        for value in model.spec.joint_limits.get(leg.joint, ()):
+            if leg.kind == REVOLUTE and not exact_angle_limit(value):
+                try:
+                    angle_limit_values(leg.joint, value)
+                except UnsupportedRobotError as e:
+                    raise UnsupportedRobotError(
+                        f"{e.message} (needed for regions; `singcheck run` takes it)",
+                        path=model.spec.path, line=model.spec.lines.get("joint_limits"),
+                        key=f"joint_limits.{leg.joint}") from None
 
 
 def serial_singularities_request(model: RobotModel, leg) -> EliminationRequest:

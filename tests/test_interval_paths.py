@@ -267,3 +267,71 @@ def test_expression_path_clearance_and_plot(tmp_path):
     assert 0 < kappa["interval"][0] <= kappa["interval"][1]
     t, pose, mu, _, _ = _sample_piece(report.certificate.path, 50)
     assert abs(pose[0][0] - (1 + mp.cos(-mp.pi / 2) / 2)) < 1e-12
+
+
+# -- a path that starts on the singularity: det A = 0 exactly at a rational pose ---------
+
+def _modes_singular_at(oracle, X) -> int:
+    """How many elbow choices make det A vanish at X (50 digits: |det A| < 10⁻³⁰)."""
+    import itertools
+
+    mp.mp.dps = 50
+    count = 0
+    for mode in itertools.product((0, 1), repeat=len(oracle.legs)):
+        q = oracle.joints(mode, X)
+        if q is not None and abs(oracle.det_A(q, X)) < mp.mpf(10) ** -30:
+            count += 1
+    return count
+
+
+def test_a_path_leaving_the_home_pose_is_singular_at_its_start(tmp_path):
+    """The 3-RRR's home pose (0, 0, 0) is singular in some elbow choices (the distal
+    links meet at the centre).  The interval engine alone cannot prove a zero; the exact
+    test at the rational pose finds exactly the oracle's modes singular at t = 0."""
+    from singcheck.certify.classification import BY_RATIONAL_POSE
+    from tests.robot_oracles import three_rrr
+
+    expected = _modes_singular_at(three_rrr(), [mp.mpf(0)] * 3)
+    assert expected >= 1
+    doc = tmp_path / "home.yaml"
+    doc.write_text("name: home\nparameter: t\nrange: [0, 1]\npose:\n"
+                   "  x: t/10\n  y: t/20\n  phi: t/20\n")
+    robot = load_robot("tests/data/robots/3-rrr.yaml", backend="flint", cache=False)
+    report = check(robot, load_trajectory(str(doc), robot), regions=False).certificate
+    assert report.verdict == "singular"
+    first = report.candidates[0]
+    assert first.time == 0.0
+    assert len(first.singular_modes) == expected
+    assert all(m.proof == BY_RATIONAL_POSE for m in first.modes)
+    assert "at t = 0 (exactly" in report.reason
+
+
+@pytest.mark.slow
+def test_six_rus_leaving_home_is_singular_at_the_start_in_the_oracles_modes(tmp_path):
+    """x: t/4 from the 6-RUS home pose: the exact engine refuses it (too costly), and
+    it used to end unknown; 44 of the 64 modes are singular at t = 0 (oracle)."""
+    from tests.robot_oracles import six_rus
+
+    home = [mp.mpf(0), mp.mpf(0), mp.mpf(-2), mp.mpf(0), mp.mpf(0), mp.mpf(0)]
+    expected = _modes_singular_at(six_rus(), home)
+    assert expected == 44
+    doc = tmp_path / "x.yaml"
+    doc.write_text("name: x\nparameter: t\nrange: [0, 1]\npose:\n  x: t/4\n  y: 0\n  z: -2\n"
+                   "  psi: 0\n  theta: 0\n  phi: 0\n")
+    robot = load_robot("tests/data/robots/6-rus.yaml", backend="flint", cache=False)
+    report = check(robot, load_trajectory(str(doc), robot), regions=False).certificate
+    assert report.verdict == "singular"
+    assert report.candidates[0].time == 0.0
+    assert len(report.candidates[0].singular_modes) == expected
+
+
+def test_square_classes_decide_sums_of_square_roots():
+    """√2·√2 − 2 = 0 although its coefficients on the masks are not all 0; √2·√3 − 2 ≠ 0
+    (the checker's exact zero test at a rational pose)."""
+    from fractions import Fraction
+
+    from singcheck.verify.checker import _is_zero
+
+    assert _is_zero({0b11: Fraction(1), 0: Fraction(-2)}, [Fraction(2), Fraction(2)])
+    assert not _is_zero({0b11: Fraction(1), 0: Fraction(-2)}, [Fraction(2), Fraction(3)])
+    assert _is_zero({0b01: Fraction(1), 0b10: Fraction(-2)}, [Fraction(8), Fraction(2)])

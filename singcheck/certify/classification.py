@@ -60,8 +60,8 @@ from singcheck.certify.engines import (
     corroborated_verdict,
 )
 from singcheck.certify.exact import vanishes_at_root
+from singcheck.certify.interval_engine import inside_range, search_det_a
 from singcheck.certify.interval_engine import mode_values as _mode_values
-from singcheck.certify.interval_engine import search_det_a
 from singcheck.certify.path import PathModel, joint_float
 from singcheck.certify.working_modes import (
     FEASIBLE,
@@ -116,6 +116,15 @@ class Candidate:
     @property
     def t(self) -> arb:
         return self.root.t
+
+    @property
+    def time(self) -> float:
+        """The time shown: a range end where det A = 0 exactly there, else the middle
+        of the enclosure."""
+        exact = self.root.exact
+        if exact is not None and exact.end is not None:
+            return float(exact.end)
+        return float(self.t.mid())
 
     @property
     def singular_modes(self) -> list[str]:
@@ -500,25 +509,89 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
     bound.  A touch without a sign change cannot be proven by intervals: it stays a
     window."""
     feasible = [m for m in modes if m.status == FEASIBLE]
+    at_end = _end_zeros(path, feasible)
     if searches is None:
-        searches = search_det_a(path, feasible) if feasible else {}
+        # around a range end where det A = 0 exactly, windows need not be narrowed far
+        hints = {m.label: [end.ball() for end, zero in at_end.items() if zero.get(m.label)]
+                 for m in feasible}
+        searches = search_det_a(path, feasible, hints=hints) if feasible else {}
     candidates = []
     for mode in feasible:
         for w in searches[mode.label].crossings:
             candidates.append(_window_candidate(path, mode, w, tolerance))
+    at_ends, settled = _zeros_at_range_ends(path, feasible, searches, at_end)
+    candidates += at_ends
     candidates.sort(key=lambda c: float(c.t.mid()))
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
     undecided = [(arb(w.lo).union(arb(w.hi)),
                   f"the interval engine could not prove det A ≠ 0 along mode {m.label} "
                   f"there (|det A| ≤ {w.bound:.3g}), and {path.exact_refused}")
-                 for m in feasible for w in searches[m.label].windows if not w.crossing]
+                 for m in feasible for w in searches[m.label].windows
+                 if not w.crossing and (m.label, w) not in settled]
     verdict, reason = verdict_of(modes, candidates, undecided)
     if verdict == VERDICT_FREE:
         reason += f", by the interval engine alone ({path.exact_refused})"
     check = Corroboration(EXACT_NOT_RUN, path.exact_refused, searches)
     return TrajectoryReport(path, verdict, reason, candidates, modes, BY_INTERVALS_ONLY,
                             undecided, False, corroboration=check)
+
+
+BY_RATIONAL_POSE = "det A = 0 exactly (a rational pose: multilinear in the legs' √Δ)"
+
+
+def _end_zeros(path: PathModel, feasible: list[WorkingMode]) -> dict:
+    """{range end: {mode: det A = 0 there exactly}} for the ends where the pose is
+    rational and :mod:`.rational_pose` decides (cheap: a few hundred rational
+    determinants per mode)."""
+    from singcheck.certify.rational_pose import det_a_zero_modes, rational_pose
+
+    out = {}
+    rng = path.trajectory.range
+    for end in (rng.start, rng.end):
+        checkpoint()
+        pose = rational_pose(path, end) if feasible else None
+        if pose is None:
+            continue
+        zero = det_a_zero_modes(path.projection.model, pose, [m.label for m in feasible])
+        if zero and any(zero.values()):
+            out[end] = zero
+    return out
+
+
+def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches: dict,
+                         at_end: dict):
+    """Windows the interval engine left at a range end where det A = 0 exactly (a path
+    starting on the singularity: ``at_end``, from :func:`_end_zeros`).  Returns
+    (candidates at those ends, {(mode, window)} the zeros settle)."""
+    from singcheck.roots.enclosures import AT_POINT, ExactTime
+
+    candidates, settled = [], set()
+    for end, zero in at_end.items():
+        ball = end.ball()
+        touching = [(m, w) for m in feasible for w in searches[m.label].windows
+                    if not w.crossing and w.lo <= float(ball.upper()) and
+                    float(ball.lower()) <= w.hi]
+        if not touching:
+            continue
+        singular = [m for m in feasible if zero.get(m.label)]
+        mine = [(m, w) for m, w in touching if zero.get(m.label)]
+        settled |= {(m.label, w) for m, w in mine}
+        # the enclosure: the end, and the windows there (the certificate's checker skips
+        # them as the singular stretch, and re-proves det A = 0 at the end exactly)
+        for _, w in mine:
+            ball = ball.union(arb(w.lo).union(arb(w.hi)))
+        lo, hi = inside_range(path, ball)
+        root = RealRoot(lo.union(hi), None, exact=ExactTime(AT_POINT, end=end))
+        ball = end.ball()
+        pose_balls, joints, _ = _mode_values(path, singular, ball)
+        shown = {m.label: {leg.leg.joint: joint_float(v)
+                           for leg, v in zip(path.legs, joints[m.label], strict=True)}
+                 for m in singular}
+        candidates.append(Candidate(root, pose_balls, shown,
+                                    [ModeAtCandidate(m.label, SINGULAR, BY_RATIONAL_POSE)
+                                     for m in singular], "real"))
+    return candidates, settled
 
 
 def _window_candidate(path: PathModel, mode: WorkingMode, w,
@@ -528,7 +601,7 @@ def _window_candidate(path: PathModel, mode: WorkingMode, w,
     mode and has proven opposite signs at the two ends of the window, so it keeps a zero
     between the ends of whichever half has opposite proven signs at its ends (a point
     where the sign is not proven stops the narrowing there)."""
-    lo, hi = arb(w.lo), arb(w.hi)
+    lo, hi = inside_range(path, arb(w.lo).union(arb(w.hi)))
     while float(hi.upper() - lo.lower()) > tolerance:
         checkpoint()
         mid = arb(((lo + hi) / 2).mid())
@@ -639,9 +712,13 @@ def infeasibility(modes) -> str:
 WIDE_WINDOW = 1e-4
 
 
-def _at(t: arb) -> str:
-    """Where a proven singular time lies: "at t ≈ τ", or "somewhere in t ∈ [a, b]" when
-    only a wide window was proven (ball enclosures too wide to narrow it)."""
+def _at(c: Candidate) -> str:
+    """Where a proven singular time lies: "at t ≈ τ", "at the range end t = e" (det A = 0
+    exactly there), or "somewhere in t ∈ [a, b]" when only a wide window was proven
+    (ball enclosures too wide to narrow it)."""
+    t = c.t
+    if c.root.exact is not None and c.root.exact.end is not None:
+        return f"at t = {c.root.exact.end} (exactly: a range end)"
     if float(t.rad()) * 2 > WIDE_WINDOW:
         return f"somewhere in t ∈ [{float(t.lower()):.6g}, {float(t.upper()):.6g}]"
     return f"at t ≈ {float(t.mid()):.6g}"
@@ -660,7 +737,7 @@ def verdict_of(modes, candidates, undecided) -> tuple[str, str]:
             return VERDICT_SINGULAR, (f"working mode {label} is singular along the whole "
                                       "path (det A ≡ 0: the path lies on its singularity "
                                       "surface)")
-        return VERDICT_SINGULAR, f"working mode {label} is singular {_at(c.t)}"
+        return VERDICT_SINGULAR, f"working mode {label} is singular {_at(c)}"
     if not feasible and not unsure:
         return VERDICT_INFEASIBLE, "no working mode stays in the workspace and joint limits: " \
             + infeasibility(modes)

@@ -177,11 +177,28 @@ def search_det_a(path, modes: list, refine: set[str] | None = None,
     return {label: _summarise(label, pieces_found) for label, pieces_found in found.items()}
 
 
+def inside_range(path, piece: arb) -> tuple[arb, arb]:
+    """The piece's two ends as points of the closed range: a cover's first and last
+    balls may reach an ulp past the range (rounded radii), and a sign proven there would
+    place a zero outside it; such an end is replaced by the range end's own ball (exact,
+    or a tight ball about an irrational end such as π: a sign proven on it holds at the
+    end itself)."""
+    rng = path.trajectory.range
+    start, end = rng.start.ball(), rng.end.ball()
+    lo, hi = arb(piece.lower()), arb(piece.upper())
+    if not lo > start:
+        lo = start
+    if not hi < end:
+        hi = end
+    return lo, hi
+
+
 def _end_signs(path, modes: list, piece: arb) -> dict[str, tuple[int, int]]:
     """The proven signs of det A at the two ends of the piece (exact points) for each
     mode where both are proven."""
-    _, _, at_lo = mode_values(path, modes, arb(piece.lower()))
-    _, _, at_hi = mode_values(path, modes, arb(piece.upper()))
+    lo, hi = inside_range(path, piece)
+    _, _, at_lo = mode_values(path, modes, lo)
+    _, _, at_hi = mode_values(path, modes, hi)
     out = {}
     for mode in modes:
         a, b = at_lo[mode.label], at_hi[mode.label]

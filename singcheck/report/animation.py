@@ -37,7 +37,7 @@ def frame_times(report: TrajectoryReport, mode: str, samples: int = SAMPLES):
     times[-1] = (hi, rng.end.ball(), False, len(report.trajectory.pieces))
     for m in report.modes:
         if m.label == mode:
-            times += [(float(c.t.mid()), c.t, True, c.segment) for c in m.singular_times]
+            times += [(c.time, c.t, True, c.segment) for c in m.singular_times]
     return sorted(times, key=lambda x: x[0])
 
 

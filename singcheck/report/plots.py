@@ -203,11 +203,11 @@ def figure_data(report: TrajectoryReport, samples: int = 2000) -> FigureData:
             table.update(zip(leg.variables, _pair(legs[model.legs.index(leg)][ch]),
                              strict=True))
         det_a[label] = det(named_arrays(model.det_A.context(), table))
-    singular = {m.label: [float(c.t.mid()) for c in m.singular_times] for m in report.modes
+    singular = {m.label: [c.time for c in m.singular_times] for m in report.modes
                 if m.feasible}
     candidates = []
     for i, c in enumerate(report.candidates, 1):
-        candidates.append({"t": float(c.t.mid()), "status": c.status, "label": f"s{i}",
+        candidates.append({"t": c.time, "status": c.status, "label": f"s{i}",
                            "interval": (float(c.t.lower()), float(c.t.upper())),
                            "pose": [float(b.mid()) for b in c.pose]})
     limits = {j: (float(a), float(b)) for j, (a, b) in model.spec.joint_limits.items()}

@@ -38,7 +38,7 @@ def _interval(ball) -> list[float]:
 def candidate_json(report: TrajectoryReport, c) -> dict[str, Any]:
     pose_names = report.path.projection.model.pose
     return {
-        "t": float(c.t.mid()),
+        "t": c.time,
         "t_interval": _interval(c.t),
         "pose": {v: float(b.mid()) for v, b in zip(pose_names, c.pose, strict=True)},
         "joints": c.joints,
@@ -139,7 +139,7 @@ def trajectory_json(report: TrajectoryReport) -> dict[str, Any]:
                 "reason": m.reason,
                 "joints_at_start": m.joints_at_start,
                 "proof": m.proof,
-                "singular_times": [float(c.t.mid()) for c in m.singular_times],
+                "singular_times": [c.time for c in m.singular_times],
                 "on_surface": next((_on_surface(c) for c in m.singular_times
                                     if c.on_surface is not None), None),
             }

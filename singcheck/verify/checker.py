@@ -496,5 +496,39 @@ def singular_at(robot: Robot, path: Path, t: Fraction, mode: str) -> bool:
         else:
             return False
         ds.append(d)
-    return not det([[_mq_poly(p, values, ds) for p in leg[5]] for leg in robot.legs],
-                   lambda x, y: _mq_mul(x, y, ds), _mq_add)
+    total = det([[_mq_poly(p, values, ds) for p in leg[5]] for leg in robot.legs],
+                lambda x, y: _mq_mul(x, y, ds), _mq_add)
+    return _is_zero(total, ds)
+
+
+def _is_zero(value: dict, ds: list) -> bool:
+    """Whether Σ q·Π_{i in mask} √dᵢ is 0: each product is s·√k with k a squarefree
+    integer, and square roots of distinct squarefree integers are linearly independent
+    over Q, so it is 0 exactly when the coefficients of each √k sum to 0."""
+    sums: dict[int, Fraction] = {}
+    for mask, q in value.items():
+        product = Fraction(1)
+        for i, d in enumerate(ds):
+            if mask >> i & 1:
+                product *= d
+        if product == 0:
+            continue
+        root, kernel = _square_free(product.numerator * product.denominator)
+        sums[kernel] = sums.get(kernel, Fraction(0)) + q * Fraction(root, product.denominator)
+    return all(v == 0 for v in sums.values())
+
+
+def _square_free(m: int) -> tuple[int, int]:
+    """(s, k) with m = s²·k, k squarefree (m > 0), by trial division."""
+    if m.bit_length() > 48:
+        raise NotDecided("a discriminant too large to split into square and squarefree parts")
+    root, kernel, p = 1, 1, 2
+    while p * p <= m:
+        e = 0
+        while m % p == 0:
+            m //= p
+            e += 1
+        root *= p ** (e // 2)
+        kernel *= p if e % 2 else 1
+        p += 1 if p == 2 else 2
+    return root, kernel * m

@@ -1,0 +1,229 @@
+"""det A = 0 decided exactly at one time where the pose is rational (a range end).
+
+A path that starts or ends on the singularity (a hexapod's home pose, where det A = 0
+in many modes) leaves the interval engine a window at that end: balls never prove a
+zero.  When the pose variables are rational there (a polynomial path at a rational
+end; any trig path at t = 0, or at t = kπ when the bare t is absent), each leg's
+branch is rational + rational·√Δᵢ (Δᵢ its discriminant there), so row i of A (which
+involves joint i only) is uᵢ + vᵢ·rᵢ with rᵢ = ±√Δᵢ and u, v rational, and
+
+    det A = Σ_S c_S · Π_{i∈S} rᵢ,   c_S = det(M_S), row i of M_S = vᵢ if i ∈ S else uᵢ
+
+(the determinant is multilinear in its rows).  Each Π √Δᵢ is q·√k with q rational and
+k a squarefree integer; square roots of distinct squarefree integers are linearly
+independent over Q, so det A = 0 exactly when, for every k, the rational sum of the
+terms in √k is 0.  Everything is exact (FLINT's rational matrices and integer
+factoring).  Robots with square roots among their numbers are not handled (None).
+"""
+
+from __future__ import annotations
+
+from flint import fmpq, fmpq_mat, fmpz
+
+from singcheck.algebra.trig import TRIG, LinearInPi
+from singcheck.model.robot import REVOLUTE
+
+#: a pose whose legs' discriminant numerators and denominators exceed this many bits is
+#: not decided here (their squarefree parts need factoring)
+MAX_FACTOR_BITS = 200
+
+
+def rational_pose(path, end: LinearInPi) -> list[fmpq] | None:
+    """The model's pose variables at the piece time ``end``, when all are rational (None
+    otherwise)."""
+    if end.pi_coefficient:
+        if end.rational or end.pi_coefficient.denominator != 1:
+            return None
+        t, s, c = None, fmpq(0), fmpq(1 if end.pi_coefficient.numerator % 2 == 0 else -1)
+    else:
+        q = end.rational
+        t = fmpq(q.numerator, q.denominator)
+        s, c = (fmpq(0), fmpq(1)) if q == 0 else (None, None)
+    out = []
+    for x in path.coordinates:
+        if x.context() is not TRIG:
+            value = _exact_ball(x, end)
+            if value is None:
+                return None
+            out.append(value)
+            continue
+        dt, ds, dc = x.degrees()
+        if (dt > 0 and t is None) or ((ds > 0 or dc > 0) and s is None):
+            return None
+        value = fmpq(0)
+        for (i, j, k), coeff in x.terms():
+            term = coeff
+            if i:
+                term *= t ** i
+            if j:
+                term *= s ** j
+            if k:
+                term *= c ** k
+            value += term
+        out.append(value)
+    return out
+
+
+def _exact_ball(x, end: LinearInPi) -> fmpq | None:
+    """x at the end, when its enclosure there is an exact ball (radius 0: every operation
+    was exact, as sin 0 = 0 is): that ball *is* the value, a dyadic rational."""
+    from singcheck.algebra.radicals import evaluate_path
+
+    ball = evaluate_path(x, end.ball())
+    if not ball.is_finite() or not ball.is_exact():
+        return None
+    man, exp = ball.mid().man_exp()
+    return fmpq(man * fmpz(2) ** int(exp)) if exp >= 0 else fmpq(man, fmpz(2) ** int(-exp))
+
+
+def _legs_at(model, point: dict) -> list | None:
+    """Per leg (in constraint order): (joint variable names, {label: [(u, v) per
+    variable]}, Δ) with each joint variable u + v·√Δ on the branch, or None."""
+    from singcheck.certify.path import _leg_coefficients
+
+    out = {}
+    for leg in model.legs:
+        coeffs = [_value(p, point) for p in _leg_coefficients(leg)]
+        if any(v is None for v in coeffs):
+            return None
+        names = leg.variables
+        if leg.kind == REVOLUTE:
+            a, b, d = coeffs
+            w = a * a + b * b
+            if w == 0:
+                return None
+            delta = w - d * d
+            branches = {label: [(-a * d / w, sigma * b / w), (-b * d / w, -sigma * a / w)]
+                        for label, sigma in (("+", 1), ("-", -1))}
+        elif leg.degree == 1:
+            b, c = coeffs
+            if b == 0:
+                return None
+            delta, branches = fmpq(0), {"o": [(-c / b, fmpq(0))]}
+        else:
+            a, b, c = coeffs
+            if a == 0:
+                return None
+            delta = b * b - 4 * a * c
+            branches = {label: [(-b / (2 * a), sigma / (2 * a))]
+                        for label, sigma in (("+", 1), ("-", -1))}
+        if delta < 0:
+            return None
+        out[leg.constraint_index] = (names, branches, delta)
+    return [out[i] for i in sorted(out)]
+
+
+def _value(p, point: dict) -> fmpq | None:
+    """p at the point (a dict of every variable p uses), exactly."""
+    names = p.context().names()
+    total = fmpq(0)
+    for exps, coeff in p.terms():
+        term = coeff
+        for name, e in zip(names, exps, strict=True):
+            if e:
+                if name not in point:
+                    return None
+                term *= point[name] ** e
+        total += term
+    return total
+
+
+def _entry(p, point: dict, joint: dict, delta: fmpq) -> tuple[fmpq, fmpq] | None:
+    """An entry of A as u + v·r (r² = Δ) at the point, the leg's joint variables being
+    ``joint[name] = (u, v)``."""
+    names = p.context().names()
+    u_total, v_total = fmpq(0), fmpq(0)
+    for exps, coeff in p.terms():
+        u, v = coeff, fmpq(0)
+        for name, e in zip(names, exps, strict=True):
+            if not e:
+                continue
+            if name in point:
+                factor = (point[name] ** e, fmpq(0))
+            elif name in joint:
+                factor = (fmpq(1), fmpq(0))
+                for _ in range(e):
+                    a, b = factor
+                    c, d = joint[name]
+                    factor = (a * c + b * d * delta, a * d + b * c)
+            else:
+                return None
+            u, v = u * factor[0] + v * factor[1] * delta, u * factor[1] + v * factor[0]
+        u_total += u
+        v_total += v
+    return u_total, v_total
+
+
+def _square_class(q: fmpq) -> tuple[fmpq, int] | None:
+    """(s, k) with √q = s·√k, s rational and k a squarefree positive integer (q > 0)."""
+    n, d = int(q.p), int(q.q)
+    m = n * d  # √(n/d) = √(n·d)/d
+    if m.bit_length() > MAX_FACTOR_BITS:
+        return None
+    root, kernel = 1, 1
+    for prime, e in fmpz(m).factor():
+        root *= int(prime) ** (e // 2)
+        if e % 2:
+            kernel *= int(prime)
+    return fmpq(root, d), kernel
+
+
+def det_a_zero_modes(model, pose: list[fmpq], labels: list[str]) -> dict[str, bool] | None:
+    """For each mode label (one branch label per leg, in leg order), whether det A = 0
+    exactly at the rational pose; None when not decided here (square roots in the
+    robot, a branch not real or a degenerate leg there, numbers too large)."""
+    if model.spec.radical_variables or len(model.A) != len(model.legs):
+        return None
+    point = {name: value for name, value in zip(model.pose_variables, pose, strict=True)}
+    legs = _legs_at(model, point)
+    if legs is None:
+        return None
+    n = len(legs)
+    classes = []
+    for _, _, delta in legs:
+        if delta == 0:
+            classes.append((fmpq(0), 1))
+            continue
+        found = _square_class(delta)
+        if found is None:
+            return None
+        classes.append(found)
+    leg_labels = [leg.joint for leg in sorted(model.legs, key=lambda leg: leg.constraint_index)]
+    order = [next(k for k, leg in enumerate(model.legs) if leg.joint == j) for j in leg_labels]
+    out: dict[str, bool] = {}
+    for label in labels:
+        rows_u, rows_v = [], []
+        for i, (names, branches, delta) in enumerate(legs):
+            mark = label[order[i]]
+            if mark not in branches:
+                return None
+            joint = dict(zip(names, branches[mark], strict=True))
+            row = [_entry(p, point, joint, delta) for p in model.A[i]]
+            if any(e is None for e in row):
+                return None
+            rows_u.append([e[0] for e in row])
+            rows_v.append([e[1] for e in row])
+        sums: dict[int, fmpq] = {}
+        for subset in range(1 << n):
+            rows = [rows_v[i] if subset >> i & 1 else rows_u[i] for i in range(n)]
+            c = fmpq_mat(n, n, [x for row in rows for x in row]).det()
+            if c == 0:
+                continue
+            scale, kernel = fmpq(1), 1
+            for i in range(n):
+                if subset >> i & 1:
+                    s, k = classes[i]
+                    scale *= s
+                    common = _gcd(kernel, k)
+                    scale *= common
+                    kernel = kernel * k // (common * common)
+            sums[kernel] = sums.get(kernel, fmpq(0)) + c * scale
+        out[label] = all(v == 0 for v in sums.values())
+    return out
+
+
+def _gcd(a: int, b: int) -> int:
+    from math import gcd
+
+    return gcd(a, b)
+

@@ -511,10 +511,13 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
     feasible = [m for m in modes if m.status == FEASIBLE]
     at_end = _end_zeros(path, feasible)
     if searches is None:
-        # around a range end where det A = 0 exactly, windows need not be narrowed far
-        hints = {m.label: [end.ball() for end, zero in at_end.items() if zero.get(m.label)]
-                 for m in feasible}
-        searches = search_det_a(path, feasible, hints=hints) if feasible else {}
+        # a mode where det A = 0 exactly at a range end is singular: its other zeros do
+        # not change the verdict, and it is not refined (a hexapod's mode lying on its
+        # singularity all along would spend the whole budget)
+        known = {label for zero in at_end.values() for label, z in zero.items() if z}
+        searches = search_det_a(path, feasible, refine={m.label for m in feasible
+                                                         if m.label not in known}
+                                ) if feasible else {}
     candidates = []
     for mode in feasible:
         for w in searches[mode.label].crossings:
@@ -576,7 +579,8 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
             continue
         singular = [m for m in feasible if zero.get(m.label)]
         mine = [(m, w) for m, w in touching if zero.get(m.label)]
-        settled |= {(m.label, w) for m, w in mine}
+        # the mode is singular: its windows elsewhere (not refined) decide nothing more
+        settled |= {(m.label, w) for m in singular for w in searches[m.label].windows}
         # the enclosure: the end, and the windows there (the certificate's checker skips
         # them as the singular stretch, and re-proves det A = 0 at the end exactly)
         for _, w in mine:

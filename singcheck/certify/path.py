@@ -627,14 +627,50 @@ def _det_a_by_matrix(model: RobotModel, joints_by_mode: dict, pose: list[arb],
     square roots square to their radicands — true of every point the balls stand for —
     at a few hundred terms instead of det A's many thousands."""
     radicals = [b for _, b in sorted(radical_balls(model.context, signs).items())]
+    row_legs = _row_legs(model)
     out = {}
+    shared: dict = {}  # (row, id of its leg's joint ball) -> the row's balls
+    kept = []  # the joint balls keyed by id, alive for the whole call
     for label, joints in joints_by_mode.items():
-        point = _flat_joints(joints) + list(pose) + radicals
-        powers: dict = {}
-        rows = [[evaluate(e, point, powers) for e in row] for row in model.A]
+        point = None
+        rows = []
+        for i, row in enumerate(model.A):
+            k = row_legs[i]
+            key = None if k is None else (i, id(joints[k]))
+            hit = shared.get(key) if key is not None else None
+            if hit is None:
+                if point is None:
+                    point = _flat_joints(joints) + list(pose) + radicals
+                    powers: dict = {}
+                hit = [evaluate(e, point, powers) for e in row]
+                if key is not None:
+                    shared[key] = hit
+                    kept.append(joints[k])
+            rows.append(hit)
         real = all(isinstance(e, arb) for row in rows for e in row)
         out[label] = (arb_mat(rows) if real else acb_mat(rows)).det()
     return out
+
+
+_ROW_LEGS: dict = {}
+
+
+def _row_legs(model: RobotModel) -> list[int | None]:
+    """Per row of A, the one leg (index in ``model.legs``) whose joint variables it
+    involves (None: several, or none: such a row is enclosed per mode), once per model.
+    Rows of modes that share that leg's branch are then enclosed once."""
+    def build(model: RobotModel) -> list:
+        names = model.context.names()
+        owner = {names.index(v): k for k, leg in enumerate(model.legs)
+                 for v in leg.variables}
+        out = []
+        for row in model.A:
+            used = {owner[i] for e in row for i, d in enumerate(e.degrees())
+                    if d > 0 and i in owner}
+            out.append(used.pop() if len(used) == 1 else None)
+        return out
+
+    return memo_per_object(_ROW_LEGS, model, build)
 
 
 def _flat_joints(joints: list) -> list:
@@ -835,9 +871,7 @@ def pathwise_size_bound(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
         _, deg_t, deg_sc = composition_work(p, args)
         degrees = [max(0, int(d)) for d in p.degrees()]
         out = {v: d for v, d in zip(names, degrees, strict=True) if v not in pose}
-        for c, s in pairs:
-            ci, si = names.index(c), names.index(s)
-            out[c, s] = max((int(e[ci]) + int(e[si]) for e in p.monoms()), default=0)
+        out.update(zip(pairs, _pair_degrees(p, names, pairs), strict=True))
         out.update(t=deg_t, sc=deg_sc)
         return out
 
@@ -881,6 +915,27 @@ def pathwise_size_bound(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
         total_t += acc["t"]
         total_sc += acc["sc"]
     return total_t, total_sc, largest
+
+
+_PAIR_DEGREES: dict = {}
+
+
+def _pair_degrees(p: fmpq_mpoly, names, pairs: list) -> list[int]:
+    """Per revolute pair (cos, sin), p's largest total degree in the two: p with every
+    coefficient 1 (no cancellation) composed with cos, sin ↦ zₖ and every other
+    variable ↦ 1, read off the degrees of the image (FLINT; no Python loop over p's
+    terms after the first), once per polynomial."""
+    def compute(p: fmpq_mpoly) -> list[int]:
+        if not pairs or p.is_zero():
+            return [0] * len(pairs)
+        ring = fmpq_mpoly_ctx.get(tuple(f"z{k}" for k in range(len(pairs))), "lex")
+        one = ring.from_dict({(0,) * len(pairs): 1})
+        image = {names.index(v): ring.gens()[k] for k, pair in enumerate(pairs) for v in pair}
+        ones = p.context().from_dict({e: 1 for e in p.monoms()})
+        composed = ones.compose(*[image.get(i, one) for i in range(len(names))], ctx=ring)
+        return [max(0, int(d)) for d in composed.degrees()]
+
+    return memo_per_object(_PAIR_DEGREES, p, compute)
 
 
 def _on_circle(p: fmpq_mpoly) -> fmpq_mpoly:

@@ -386,7 +386,7 @@ def _exact_limits_unavailable(leg: LegAlongPath, limits) -> bool:
     an angle limit is not a multiple of π/12 (its cos and sin are not algebraic)."""
     from singcheck.elimination.projection import exact_angle_limit
 
-    if is_opaque(leg.coefficients[0].context()):
+    if leg._composer.opaque:  # (read from the path: composing nothing)
         return True
     return leg.revolute and not all(exact_angle_limit(v) for v in limits)
 

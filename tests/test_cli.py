@@ -157,12 +157,12 @@ def test_usage_and_input_errors_exit_2_with_one_line(args, phrase):
 def test_bad_trajectory_file_names_file_line_and_key(tmp_path):
     bad = tmp_path / "bad.yaml"
     bad.write_text("name: b\nparameter: t\nrange: [0, 1]\npose:\n  x: sin(t)\n  y: 1\n"
-                   "  z: sin(t + 1)\n")
+                   "  z: tan(t + 1)\n")
     out = singcheck("run", ORTHO, str(bad))
     assert out.returncode == 2
     (line,) = out.stderr.strip().splitlines()
     assert line.startswith(f"singcheck: error: {bad}:7: pose.z:")
-    assert "integer multiple of t" in line
+    assert "unknown function 'tan'" in line
 
 
 def test_forcing_a_missing_backend_exits_4_with_a_hint():

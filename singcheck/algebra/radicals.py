@@ -34,6 +34,7 @@ from fractions import Fraction
 from flint import arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
 
 from singcheck.algebra.intervals import power
+from singcheck.algebra.opaque import is_opaque, opaque_ball, opaque_of
 from singcheck.algebra.trig import TRIG, evaluate_trig, evaluate_trig_at
 
 MAX_RADICAND_BITS = 64
@@ -494,25 +495,6 @@ def _on_angle_circle(p: fmpq_mpoly) -> fmpq_mpoly | None:
 
 _DESCRIPTORS: dict[int, tuple[fmpq_mpoly_ctx, list]] = {}
 _LAST_EXTRA: tuple = (None, None, 0, None, [])  # (ctx, t, precision, signs, balls)
-
-
-def is_opaque(ctx: fmpq_mpoly_ctx) -> bool:
-    """Whether the ring has opaque variables (:mod:`~singcheck.spec.real_paths`)."""
-    from singcheck.spec.real_paths import is_opaque as _is_opaque
-
-    return _is_opaque(ctx)
-
-
-def opaque_of(name: str):
-    from singcheck.spec.real_paths import opaque_of as _opaque_of
-
-    return _opaque_of(name)
-
-
-def opaque_ball(name: str, t: arb) -> arb:
-    from singcheck.spec.real_paths import opaque_ball as _opaque_ball
-
-    return _opaque_ball(name, t)
 
 
 def _descriptors(ctx: fmpq_mpoly_ctx) -> list:

@@ -517,8 +517,8 @@ class PathModel:
         mean-value form does without them).  A path kept as
         expression trees is differentiated on its trees
         (:meth:`~singcheck.spec.real_paths.RealFunction.with_derivative`)."""
+        from singcheck.algebra.opaque import opaque_rate
         from singcheck.algebra.radicals import has_angle_functions
-        from singcheck.spec.real_paths import opaque_rate
 
         if self.legs and self.legs[0]._composer.opaque:
             out = []

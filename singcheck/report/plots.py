@@ -88,7 +88,7 @@ def _opaque_samples(ctx, t: np.ndarray) -> dict:
     drawing only)."""
     from flint import arb
 
-    from singcheck.spec.real_paths import opaque_ball, opaque_of
+    from singcheck.algebra.opaque import opaque_ball, opaque_of
 
     out = {}
     for name in ctx.names()[3:]:

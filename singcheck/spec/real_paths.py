@@ -7,10 +7,8 @@ arithmetic: each operation of the tree is Arb's on balls (outward rounding), so 
 value returned for a ball T encloses the coordinate at every t in T (a ball holding a
 pole or a negative square root comes back infinite or NaN: nothing is proven there).
 
-In the path ring the coordinate is an *opaque* variable (``X[[…]]`` for a coordinate,
-``A[[…]]``/``C[[…]]``/``S[[…]]`` for an angle, its cosine and its sine) whose ball at T is
-this enclosure (:func:`opaque_of`, read by
-:func:`~singcheck.algebra.radicals.evaluate_path`).  Only the interval engine reads such
+In the path ring the coordinate is an *opaque* variable whose ball at T is this
+enclosure (:mod:`singcheck.algebra.opaque`).  Only the interval engine reads such
 a path; the exact engine refuses it and says why.
 """
 
@@ -23,11 +21,6 @@ from flint import arb, fmpq
 
 from singcheck.algebra.intervals import power
 from singcheck.spec.grammar import MAX_EXPONENT, Constant, ExprError, Node
-
-#: opaque ring variable name -> (function, what the variable is: X, A, C or S)
-_OPAQUE: dict[str, tuple[RealFunction, str]] = {}
-#: the bracket characters of an opaque name (never in a polynomial variable's name)
-OPEN, CLOSE = "[[", "]]"
 
 
 def _ball(value) -> arb:
@@ -175,45 +168,3 @@ def real_function(node: Node, text: str, parameter: str, parameters: dict,
 
     walk(node)
     return RealFunction(text, node, parameter, tuple(sorted(used.items())), algebraic)
-
-
-def opaque_name(kind: str, f: RealFunction) -> str:
-    """The path ring variable standing for f (``X``), or for the angle f, its cosine or
-    its sine (``A``, ``C``, ``S``); registered for :func:`opaque_of`."""
-    tag = f.text if not f.constants else f"{f.text} | " + ", ".join(
-        f"{k}={v}" for k, v in f.constants)
-    name = f"{kind}{OPEN}{tag}{CLOSE}"
-    _OPAQUE.setdefault(name, (f, kind))
-    return name
-
-
-def opaque_of(name: str) -> tuple[RealFunction, str] | None:
-    """(function, kind) of an opaque variable's name, None for any other name."""
-    return _OPAQUE.get(name) if name.endswith(CLOSE) else None
-
-
-def is_opaque(ctx) -> bool:
-    """Whether a ring has opaque variables (a path the exact engine cannot take)."""
-    return any(n.endswith(CLOSE) for n in ctx.names())
-
-
-def opaque_rate(name: str, t: arb) -> arb:
-    """d/dt of an opaque variable over the ball ``t`` (an angle's cos: −sin·A', ...)."""
-    f, kind = _OPAQUE[name]
-    value, rate = f.with_derivative(t)
-    if kind == "C":
-        return -value.sin() * rate
-    if kind == "S":
-        return value.cos() * rate
-    return rate
-
-
-def opaque_ball(name: str, t: arb) -> arb:
-    """The ball of an opaque variable over the ball ``t``."""
-    f, kind = _OPAQUE[name]
-    value = f(t)
-    if kind == "C":
-        return value.cos()
-    if kind == "S":
-        return value.sin()
-    return value

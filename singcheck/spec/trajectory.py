@@ -58,7 +58,7 @@ class TrajectorySpec:
     def not_algebraic(self) -> str:
         """Why the exact engine cannot take this piece ("" when it can): the coordinates
         kept as expression trees (:mod:`~singcheck.spec.real_paths`)."""
-        from singcheck.spec.real_paths import opaque_of
+        from singcheck.algebra.opaque import opaque_of
 
         found = []
         for v, p in self.pose.items():
@@ -236,7 +236,8 @@ def _opaque_piece(doc, nodes: dict, key: str, parameter: str, robot, rng: TimeRa
     """The pose as opaque variables, one ring for the piece (None when some coordinate
     is not a real function of the parameter in the grammar).  A coordinate not proven
     defined at the range's ends (√ of a negative number, a division by 0) is refused."""
-    from singcheck.spec.real_paths import opaque_name, real_function
+    from singcheck.algebra.opaque import opaque_name
+    from singcheck.spec.real_paths import real_function
 
     functions = {}
     for v, node in nodes.items():

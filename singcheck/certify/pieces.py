@@ -83,9 +83,13 @@ def _same_root_at_join(report: TrajectoryReport, left: Candidate, right: Candida
 
 
 def _branch_values(report: TrajectoryReport, at) -> list[dict]:
+    """Per leg, its branches enclosed at the join ``at`` (from the pose's balls where the
+    robot allows it: :meth:`~singcheck.certify.path.PathModel.leg_branches_at`, no leg
+    composed along the piece — along a long spline, whose coefficients have thousands of
+    digits, composing them cost more than certifying the piece)."""
     t = report.path.trajectory.local_time(at).ball()
     with working_precision(128):
-        return [leg.branches(t) for leg in report.path.legs]
+        return report.path.leg_branches_at(t)
 
 
 def _continuous(label: str, left: list[dict], right: list[dict]) -> bool:

@@ -49,8 +49,7 @@ class TooCostly(ValueError):
 
 def _bits(p: fmpq_mpoly) -> int:
     """The most bits of a numerator or denominator of ``p``'s coefficients."""
-    return max((max(c.numer().bit_length(), c.denom().bit_length()) for c in p.coeffs()),
-               default=0)
+    return max((c.height_bits() for c in p.coeffs()), default=0)
 
 
 _WEIGHTS: dict = {}

@@ -25,18 +25,22 @@ answer is composed from them, in the user's parameter t:
 
 from __future__ import annotations
 
+import time
+
 from flint import arb
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.trig_values import sum_is_zero
 from singcheck.budget import checkpoint
 from singcheck.certify.classification import (
+    EXACT_CORROBORATION_BUDGET,
     REGULAR,
     SINGULAR,
     VERDICT_INFEASIBLE,
     Candidate,
     TrajectoryReport,
     certify_path,
+    corroborate_exactly,
     verdict_of,
 )
 from singcheck.certify.engines import combined, corroborated_verdict
@@ -53,11 +57,57 @@ def certify_trajectory(projection: RobotProjection, spec: TrajectorySpec,
     ``engine``: :data:`~singcheck.certify.path.ENGINES`."""
     if not spec.segments and spec.time_scale is None:
         return certify_path(build_path(projection, spec, engine), tolerance)
+    defer = engine == AUTO and len(spec.pieces) > 1
     reports = []
     for piece in spec.pieces:
         checkpoint()
-        reports.append(certify_path(build_path(projection, piece, engine), tolerance))
+        reports.append(certify_path(build_path(projection, piece, engine), tolerance,
+                                    defer_corroboration=defer))
+    if defer:
+        reports = corroborate_pieces(reports)
     return compose(spec, reports)
+
+
+#: seconds the exact engine may spend, over all the pieces of one path together,
+#: corroborating the pieces the interval engine decided on its own (a piece it left
+#: windows on is decided by the exact engine, within the trajectory's time limit)
+PATH_CORROBORATION_BUDGET = EXACT_CORROBORATION_BUDGET
+
+
+def corroborate_pieces(reports: list[TrajectoryReport],
+                       budget: float | None = None) -> list[TrajectoryReport]:
+    """The exact engine's corroboration of the pieces the interval engine decided
+    (``exact_pending``), within one ``budget`` (default
+    :data:`PATH_CORROBORATION_BUDGET`) for the whole path: the pieces with a proven
+    crossing first (the singular times the verdict names), then the others in order.
+    A piece left when the budget is spent keeps the interval engine's verdict, and its
+    corroboration says so (``exact engine not run``, with how many pieces the exact
+    engine did corroborate)."""
+    budget = PATH_CORROBORATION_BUDGET if budget is None else budget
+    pending = [i for i, r in enumerate(reports) if r.exact_pending is not None]
+    order = sorted(pending, key=lambda i: (not reports[i].candidates, i))
+    out = list(reports)
+    start = time.monotonic()
+    done: list[int] = []
+    for i in order:
+        checkpoint()
+        left = budget - (time.monotonic() - start)
+        if left <= 0:
+            break
+        report = corroborate_exactly(reports[i], left)
+        if report is None:  # out of budget: this piece and those after it stay pending
+            break
+        out[i] = report
+        done.append(i)
+    if len(done) < len(pending):
+        why = (f"the exact engine's budget of {budget:g} s for the whole path ran out "
+               f"after it corroborated {len(done)} of the {len(pending)} pieces the "
+               "interval engine decided on its own")
+        corroborated = set(done)
+        for i in pending:
+            if i not in corroborated:
+                out[i] = corroborate_exactly(reports[i], 0, why)
+    return out
 
 
 def joins(spec: TrajectorySpec) -> list:

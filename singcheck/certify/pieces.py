@@ -72,26 +72,38 @@ def certify_trajectory(projection: RobotProjection, spec: TrajectorySpec,
 #: corroborating the pieces the interval engine decided on its own (a piece it left
 #: windows on is decided by the exact engine, within the trajectory's time limit)
 PATH_CORROBORATION_BUDGET = EXACT_CORROBORATION_BUDGET
+#: of which at most this many seconds go to pieces without a proven crossing (det A
+#: proven ≠ 0 along them by the intervals already): the pieces holding the singular
+#: times the verdict names come first
+FREE_PIECES_BUDGET = 2.0
 
 
-def corroborate_pieces(reports: list[TrajectoryReport],
-                       budget: float | None = None) -> list[TrajectoryReport]:
+def corroborate_pieces(reports: list[TrajectoryReport], budget: float | None = None,
+                       free_budget: float | None = None) -> list[TrajectoryReport]:
     """The exact engine's corroboration of the pieces the interval engine decided
     (``exact_pending``), within one ``budget`` (default
     :data:`PATH_CORROBORATION_BUDGET`) for the whole path: the pieces with a proven
-    crossing first (the singular times the verdict names), then the others in order.
-    A piece left when the budget is spent keeps the interval engine's verdict, and its
+    crossing first (the singular times the verdict names), then the others in order,
+    these within ``free_budget`` (default :data:`FREE_PIECES_BUDGET`) of it.  A piece
+    left when the budget is spent keeps the interval engine's verdict, and its
     corroboration says so (``exact engine not run``, with how many pieces the exact
     engine did corroborate)."""
     budget = PATH_CORROBORATION_BUDGET if budget is None else budget
+    free_budget = FREE_PIECES_BUDGET if free_budget is None else free_budget
     pending = [i for i, r in enumerate(reports) if r.exact_pending is not None]
-    order = sorted(pending, key=lambda i: (not reports[i].candidates, i))
+    crossing = [i for i in pending if reports[i].candidates]
+    order = crossing + [i for i in pending if not reports[i].candidates]
     out = list(reports)
     start = time.monotonic()
+    free_start = None
     done: list[int] = []
     for i in order:
         checkpoint()
-        left = budget - (time.monotonic() - start)
+        now = time.monotonic()
+        left = budget - (now - start)
+        if not reports[i].candidates:
+            free_start = now if free_start is None else free_start
+            left = min(left, free_budget - (now - free_start))
         if left <= 0:
             break
         report = corroborate_exactly(reports[i], left)
@@ -100,9 +112,10 @@ def corroborate_pieces(reports: list[TrajectoryReport],
         out[i] = report
         done.append(i)
     if len(done) < len(pending):
-        why = (f"the exact engine's budget of {budget:g} s for the whole path ran out "
-               f"after it corroborated {len(done)} of the {len(pending)} pieces the "
-               "interval engine decided on its own")
+        why = (f"the exact engine's budget for the whole path ({budget:g} s, of which "
+               f"{free_budget:g} s for pieces without a proven crossing) ran out after "
+               f"it corroborated {len(done)} of the {len(pending)} pieces the interval "
+               "engine decided on its own")
         corroborated = set(done)
         for i in pending:
             if i not in corroborated:

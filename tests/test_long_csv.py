@@ -155,6 +155,24 @@ def test_crossing_pieces_are_corroborated_first(orthoglide_projection, heart_pat
     assert f"corroborated 2 of the {ROWS - 1} pieces" in report.corroboration.detail
 
 
+def test_a_free_path_says_which_pieces_rest_on_the_intervals_alone(
+        orthoglide, orthoglide_projection, tmp_path, monkeypatch):
+    rows = ["t,x,y,z"] + [f"{i / 100:.6f},{0.6 + 0.3 * math.cos(i / 100):.6f},"
+                          f"{0.6 + 0.3 * math.sin(i / 100):.6f},1" for i in range(40)]
+    text = "\n".join(rows) + "\n"
+    assert not oracle_singular_times(text)  # the oracle: no sign change of det A
+    path = tmp_path / "arc.csv"
+    path.write_text(text)
+    monkeypatch.setattr(pieces, "FREE_PIECES_BUDGET", 0.0)
+    report = certify_trajectory(orthoglide_projection, load_trajectory(path, orthoglide.spec))
+    assert report.verdict == "singularity-free"
+    assert report.reason.endswith("by the interval engine alone on 39 of the 39 segments "
+                                  "(segments 1–39: the exact engine's budget for the whole "
+                                  "path (5 s, of which 0 s for pieces without a proven "
+                                  "crossing) ran out after it corroborated 0 of the 39 "
+                                  "pieces the interval engine decided on its own)")
+
+
 def test_segment_lists_read_as_ranges():
     assert segment_list([4]) == "segment 4"
     assert segment_list([1, 2, 3, 5, 7, 8]) == "segments 1–3, 5, 7–8"

@@ -36,6 +36,7 @@ from singcheck.certify.classification import (
     EXACT_CORROBORATION_BUDGET,
     REGULAR,
     SINGULAR,
+    VERDICT_FREE,
     VERDICT_INFEASIBLE,
     Candidate,
     TrajectoryReport,
@@ -43,7 +44,7 @@ from singcheck.certify.classification import (
     corroborate_exactly,
     verdict_of,
 )
-from singcheck.certify.engines import combined, corroborated_verdict
+from singcheck.certify.engines import EXACT_NOT_RUN, combined, corroborated_verdict
 from singcheck.certify.path import AUTO, build_path
 from singcheck.certify.working_modes import FEASIBLE, INFEASIBLE, UNKNOWN, WorkingMode
 from singcheck.elimination.projection import RobotProjection
@@ -227,6 +228,11 @@ def compose(spec: TrajectorySpec, reports: list[TrajectoryReport]) -> Trajectory
         reason = _mode_change(spec, reports) or reason
     check = combined([r.corroboration for r in reports])
     verdict, reason = corroborated_verdict(verdict, reason, check)
+    if verdict == VERDICT_FREE and check.status == EXACT_NOT_RUN:
+        alone = sum(1 for r in reports if r.corroboration is not None
+                    and r.corroboration.status == EXACT_NOT_RUN)
+        reason += (f", by the interval engine alone on {alone} of the {len(reports)} "
+                   f"segments ({check.detail})")
     methods = list(dict.fromkeys(r.root_method for r in reports))
     return TrajectoryReport(reports[0].path, verdict, reason, candidates, modes,
                             methods[0] if len(methods) == 1 else " + ".join(methods),

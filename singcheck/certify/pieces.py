@@ -59,14 +59,19 @@ def certify_trajectory(projection: RobotProjection, spec: TrajectorySpec,
     if not spec.segments and spec.time_scale is None:
         return certify_path(build_path(projection, spec, engine), tolerance)
     defer = engine == AUTO and len(spec.pieces) > 1
-    reports = []
+    reports, ends = [], []
     for piece in spec.pieces:
         checkpoint()
-        reports.append(certify_path(build_path(projection, piece, engine), tolerance,
-                                    defer_corroboration=defer))
+        report = certify_path(build_path(projection, piece, engine), tolerance,
+                              defer_corroboration=defer)
+        reports.append(report)
+        # the branches at both ends now, while the piece's ball polynomials are at hand
+        # (made again from thousand-digit coefficients when the joins are composed)
+        ends.append((_branch_values(report, piece.global_range.start),
+                     _branch_values(report, piece.global_range.end)))
     if defer:
         reports = corroborate_pieces(reports)
-    return compose(spec, reports)
+    return compose(spec, reports, ends)
 
 
 #: seconds the exact engine may spend, over all the pieces of one path together,
@@ -170,9 +175,12 @@ def _piece(i: int, count: int) -> str:
     return f"segment {i + 1}: " if count > 1 else ""
 
 
-def _compose_modes(spec, reports) -> list[WorkingMode]:
-    at_joins = [(_branch_values(reports[i], j), _branch_values(reports[i + 1], j))
-                for i, j in enumerate(joins(spec))]
+def _compose_modes(spec, reports, ends=None) -> list[WorkingMode]:
+    if ends is not None:
+        at_joins = [(ends[i][1], ends[i + 1][0]) for i in range(len(reports) - 1)]
+    else:
+        at_joins = [(_branch_values(reports[i], j), _branch_values(reports[i + 1], j))
+                    for i, j in enumerate(joins(spec))]
     out = []
     for k, first in enumerate(reports[0].modes):
         per_piece = [r.modes[k] for r in reports]
@@ -205,9 +213,11 @@ def _restatus(c: Candidate, feasible: set[str]) -> Candidate:
     return c
 
 
-def compose(spec: TrajectorySpec, reports: list[TrajectoryReport]) -> TrajectoryReport:
-    """The whole path's report from its pieces' reports (in order)."""
-    modes = _compose_modes(spec, reports)
+def compose(spec: TrajectorySpec, reports: list[TrajectoryReport],
+            ends: list | None = None) -> TrajectoryReport:
+    """The whole path's report from its pieces' reports (in order); ``ends``: each
+    piece's leg branches at its start and end (:func:`_branch_values`), when known."""
+    modes = _compose_modes(spec, reports, ends)
     feasible = {m.label for m in modes if m.status == FEASIBLE}
     candidates: list[Candidate] = []
     at = joins(spec)

@@ -36,6 +36,8 @@ from flint import (
     fmpz_poly,
 )
 
+from singcheck.algebra.polynomials import exact_terms
+
 #: Q[t, s, c]; exponents are (t, s, c).
 TRIG = fmpq_mpoly_ctx.get(("t", "s", "c"), "lex")
 T, S, C = TRIG.gens()
@@ -418,7 +420,7 @@ def _exact_split(p: fmpq_mpoly):
     dt, ds, dc = q.degrees()
     if ds <= 0 and dc <= 0:
         by_t = [fmpq(0)] * (max(dt, 0) + 1)
-        for (i, _, _), a in q.terms():
+        for (i, _, _), a in exact_terms(q):
             by_t[i] = a
         return fmpq_poly(by_t)
     if dt <= 0 and dc >= 0:

@@ -81,7 +81,7 @@ PATH_CORROBORATION_BUDGET = EXACT_CORROBORATION_BUDGET
 #: of which at most this many seconds go to pieces without a proven crossing (det A
 #: proven ≠ 0 along them by the intervals already): the pieces holding the singular
 #: times the verdict names come first
-FREE_PIECES_BUDGET = 2.0
+FREE_PIECES_BUDGET = 1.0
 
 
 def corroborate_pieces(reports: list[TrajectoryReport], budget: float | None = None,

@@ -143,6 +143,18 @@ def test_no_budget_left_the_interval_verdict_stands_and_says_why(
     assert all(r.path.mu is None for r in report.pieces)
 
 
+def test_a_near_time_limit_cuts_the_budget_not_the_verdict(orthoglide_projection,
+                                                          heart_path, monkeypatch):
+    """With the trajectory's time limit almost spent after the interval pass, the exact
+    corroboration gets what is left (here nothing), not a time-limit verdict."""
+    spec, expected = heart_path
+    monkeypatch.setattr(pieces, "remaining", lambda: 0.5)
+    report = certify_trajectory(orthoglide_projection, spec)
+    _assert_singular_at(report, expected)
+    assert "(0 s: what the trajectory's time limit left, of which 1 s" in \
+        report.corroboration.detail
+
+
 def test_crossing_pieces_are_corroborated_first(orthoglide_projection, heart_path,
                                                 monkeypatch):
     spec, expected = heart_path

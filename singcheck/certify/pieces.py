@@ -31,7 +31,7 @@ from flint import arb
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.trig_values import sum_is_zero
-from singcheck.budget import checkpoint
+from singcheck.budget import checkpoint, remaining
 from singcheck.certify.classification import (
     EXACT_CORROBORATION_BUDGET,
     REGULAR,
@@ -84,6 +84,11 @@ PATH_CORROBORATION_BUDGET = EXACT_CORROBORATION_BUDGET
 FREE_PIECES_BUDGET = 1.0
 
 
+#: seconds of the trajectory's time limit kept for composing the pieces' reports when
+#: the exact corroboration's budget is cut to fit in it
+TIME_LIMIT_MARGIN = 1.0
+
+
 def corroborate_pieces(reports: list[TrajectoryReport], budget: float | None = None,
                        free_budget: float | None = None) -> list[TrajectoryReport]:
     """The exact engine's corroboration of the pieces the interval engine decided
@@ -96,6 +101,10 @@ def corroborate_pieces(reports: list[TrajectoryReport], budget: float | None = N
     engine did corroborate)."""
     budget = PATH_CORROBORATION_BUDGET if budget is None else budget
     free_budget = FREE_PIECES_BUDGET if free_budget is None else free_budget
+    left = remaining()  # the trajectory's time limit: the interval verdicts must fit in it
+    cut = left is not None and left - TIME_LIMIT_MARGIN < budget
+    if cut:
+        budget = max(0.0, left - TIME_LIMIT_MARGIN)
     pending = [i for i, r in enumerate(reports) if r.exact_pending is not None]
     crossing = [i for i in pending if reports[i].candidates]
     order = crossing + [i for i in pending if not reports[i].candidates]
@@ -118,7 +127,9 @@ def corroborate_pieces(reports: list[TrajectoryReport], budget: float | None = N
         out[i] = report
         done.append(i)
     if len(done) < len(pending):
-        why = (f"the exact engine's budget for the whole path ({budget:g} s, of which "
+        whole = (f"{budget:.3g} s: what the trajectory's time limit left" if cut else
+                 f"{budget:g} s")
+        why = (f"the exact engine's budget for the whole path ({whole}, of which "
                f"{free_budget:g} s for pieces without a proven crossing) ran out after "
                f"it corroborated {len(done)} of the {len(pending)} pieces the interval "
                "engine decided on its own")

@@ -526,6 +526,48 @@ def spline_rows() -> list[dict]:
              "candidates": len(report.candidates)}]
 
 
+#: issue 27: 2000-row CSV tables of poses (bench/csv_paths.py), default options
+LONG_CSV = ("bench/paths/heart-2000.csv", "bench/paths/circle-drift-2000.csv")
+LONG_CSV_TARGET = 10.0  # seconds of wall-clock time per path, 2 cores, default options
+
+
+def long_csv_rows(runs: int = 3) -> list[dict]:
+    """Each long CSV through ``singcheck run robots/orthoglide.yaml PATH --format json``
+    (default options: cubic spline, --engine auto, regions), ``runs`` times, the files
+    alternating: wall-clock and CPU seconds of the whole process, its verdict and what
+    backed it (the corroboration's status and how many pieces the exact engine saw)."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    out: dict[str, dict] = {p: {"walls": [], "cpus": []} for p in LONG_CSV}
+    for _ in range(runs):
+        for path in LONG_CSV:
+            cmd = [sys.executable, "-m", "singcheck", "run", "robots/orthoglide.yaml", path,
+                   "--format", "json"]
+            with tempfile.TemporaryFile() as stdout:
+                start = time.perf_counter()
+                code, _, cpu = run_measured(cmd, cwd=ROOT, env=env, stdout=stdout,
+                                            stderr=subprocess.DEVNULL)
+                wall = time.perf_counter() - start
+                stdout.seek(0)
+                (doc,) = json.loads(stdout.read())["trajectories"]
+            row = out[path]
+            row["walls"].append(wall)
+            row["cpus"].append(cpu)
+            row.update(exit_code=code, verdict=doc["verdict"],
+                       corroboration=doc["corroboration"]["status"],
+                       detail=doc["corroboration"]["detail"][:300])
+    return [{"case": path, **stats(r.pop("walls")), "cpu_median_s": statistics.median(
+        r.pop("cpus")), "target_s": LONG_CSV_TARGET, **r} for path, r in out.items()]
+
+
+def print_long_csv(rows: list[dict]) -> None:
+    print("\nlong CSV paths (issue 27): singcheck run, default options, whole process")
+    for r in rows:
+        met = "met" if r["median_s"] <= r["target_s"] else "NOT met"
+        print(f"  {r['case']:38} median {r['median_s']:6.2f} s wall ({met}: "
+              f"{r['target_s']:g} s), {r['cpu_median_s']:6.2f} s CPU; {r['verdict']}, "
+              f"corroboration {r['corroboration']}")
+
+
 #: issue 12's robots: (robot, its paths, target per path in seconds, projection cached)
 ROBOT_PATHS = (
     ("five-bar", ("five-bar-cross", "five-bar-free"), 0.050),
@@ -635,6 +677,8 @@ def main() -> None:
     for r in spline:
         print(f"  {r['case']:42} median {ms(r['median_s'])} ms wall, "
               f"{ms(r['cpu_median_s'])} ms CPU; {r['verdict']}, {r['candidates']} candidates")
+    results["long_csv"] = long_csv = long_csv_rows()
+    print_long_csv(long_csv)
     results["projection"] = proj = projection_rows()
     print("\nprojection of the Orthoglide (ξ, workspace and joint-limit surfaces), no cache")
     for r in proj:
@@ -700,8 +744,19 @@ def batch_only() -> None:
     out.write_text(json.dumps(results, indent=2) + "\n")
 
 
+def long_csv_only() -> None:
+    """``python bench/bench.py csv``: only the long CSV rows, merged into results.json."""
+    out = ROOT / "bench" / "results.json"
+    results = json.loads(out.read_text()) if out.exists() else {"machine": machine()}
+    results["long_csv"] = long_csv_rows()
+    print_long_csv(results["long_csv"])
+    out.write_text(json.dumps(results, indent=2) + "\n")
+
+
 if __name__ == "__main__":
     if sys.argv[1:] == ["batch"]:
         batch_only()
+    elif sys.argv[1:] == ["csv"]:
+        long_csv_only()
     else:
         main()

@@ -24,7 +24,7 @@ from collections.abc import Callable
 
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
-from singcheck.algebra.polynomials import memo_per_object
+from singcheck.algebra.polynomials import exact_terms, memo_per_object
 from singcheck.budget import checkpoint
 
 #: The most work (:func:`composition_work`) one FLINT composition call may get.  On the
@@ -49,8 +49,7 @@ class TooCostly(ValueError):
 
 def _bits(p: fmpq_mpoly) -> int:
     """The most bits of a numerator or denominator of ``p``'s coefficients."""
-    return max((max(c.numer().bit_length(), c.denom().bit_length()) for c in p.coeffs()),
-               default=0)
+    return max((c.height_bits() for _, c in exact_terms(p)), default=0)
 
 
 _WEIGHTS: dict = {}

@@ -20,6 +20,17 @@ def memo_per_object(cache: dict, obj, compute, keep: int = 256):
     return hit[1]
 
 
+_TERMS: dict = {}
+
+
+def exact_terms(p: fmpq_mpoly) -> list:
+    """``list(p.terms())``, once per polynomial object: reading the terms out of FLINT
+    costs more than using them when the coefficients run to thousands of digits (a long
+    cubic spline's pieces), and two stages read the same pose polynomial's (the cost
+    estimate of a composition, the ball split)."""
+    return memo_per_object(_TERMS, p, lambda p: list(p.terms()), keep=512)
+
+
 def restrict(p: fmpq_mpoly, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
     """``p`` (free of the dropped variables) re-expressed in the smaller context ``ctx``.
 

@@ -36,6 +36,8 @@ from flint import (
     fmpz_poly,
 )
 
+from singcheck.algebra.polynomials import exact_terms
+
 #: Q[t, s, c]; exponents are (t, s, c).
 TRIG = fmpq_mpoly_ctx.get(("t", "s", "c"), "lex")
 T, S, C = TRIG.gens()
@@ -407,7 +409,10 @@ def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | tuple | arb_poly:
             return split
     else:
         hit = (p, {})
-    split = hit[1][ctx.prec] = _split_at_precision(p)
+    exact = hit[1].get("exact")
+    if exact is None:  # the exact split once per polynomial, whatever the precision
+        exact = hit[1]["exact"] = _exact_split(p)
+    split = hit[1][ctx.prec] = _balls_of(exact)
     _SPLITS[id(p)] = hit
     _SPLITS.move_to_end(id(p))
     if len(_SPLITS) > _SPLITS_KEPT:
@@ -439,20 +444,37 @@ def _in_c(q: fmpq_mpoly) -> fmpq_poly:
 def _split_at_precision(p: fmpq_mpoly):
     """:func:`_split` at the current precision (FLINT rounds each rational coefficient
     outward when it makes the ball polynomial from an exact one)."""
-    q = reduce_trig(p)
+    return _balls_of(_exact_split(p))
+
+
+def _exact_split(p: fmpq_mpoly):
+    """The shape of :func:`_split` with exact polynomials (``fmpq_poly``): reading a
+    polynomial's terms costs more than rounding them (a long spline's coefficients run
+    to thousands of digits), so it is done once per polynomial, not per precision."""
+    dt, ds, dc = p.degrees()
+    q = p if ds <= 0 and dc <= 0 else reduce_trig(p)  # free of s and c: reduced already
     dt, ds, dc = q.degrees()
-    if ds == 0 and dc == 0:
-        by_t = [fmpq(0)] * (dt + 1)
-        for (i, _, _), a in q.terms():
+    if ds <= 0 and dc <= 0:
+        by_t = [fmpq(0)] * (max(dt, 0) + 1)
+        for (i, _, _), a in exact_terms(q):
             by_t[i] = a
-        return arb_poly(fmpq_poly(by_t))
+        return fmpq_poly(by_t)
     if dt <= 0 and dc >= 0:
-        p0, p1 = sin_cos_parts(q)
-        return (arb_poly(p0), arb_poly(p1) if p1 is not None else None)
+        return sin_cos_parts(q)
     coeffs = [[[fmpq(0)] * (dc + 1) for _ in range(2)] for _ in range(dt + 1)]
     for (i, j, k), a in q.terms():
         coeffs[i][j][k] = a
-    return [tuple(arb_poly(fmpq_poly(row)) for row in by_t) for by_t in coeffs]
+    return [tuple(fmpq_poly(row) for row in by_t) for by_t in coeffs]
+
+
+def _balls_of(exact):
+    """:func:`_exact_split`'s polynomials as ball polynomials at the current precision."""
+    if isinstance(exact, fmpq_poly):
+        return arb_poly(exact)
+    if type(exact) is tuple:
+        p0, p1 = exact
+        return (arb_poly(p0), arb_poly(p1) if p1 is not None else None)
+    return [tuple(arb_poly(row) for row in by_t) for by_t in exact]
 
 
 #: :func:`_split` under a public name: the ball polynomials :func:`evaluate_split` takes

@@ -144,6 +144,9 @@ class TrajectoryReport:
     spec: TrajectorySpec | None = None  # the whole path (None: path.trajectory)
     pieces: list[TrajectoryReport] = field(default_factory=list)  # per segment, if several
     corroboration: Corroboration | None = None  # the interval engine's check (per piece)
+    #: (path, modes, searches, tolerance) of a piece the interval engine decided whose
+    #: exact corroboration was left for later (:func:`corroborate_exactly`); else None
+    exact_pending: tuple | None = field(default=None, repr=False)
 
     @property
     def trajectory(self) -> TrajectorySpec:
@@ -370,12 +373,18 @@ def _clear_undecided(path, modes, box) -> bool:
 NOT_NEEDED = "none (no working mode is feasible)"
 
 
-def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
+def certify_path(path: PathModel, tolerance: float = 1e-9,
+                 defer_corroboration: bool = False) -> TrajectoryReport:
     """The verdict for one trajectory, with everything that supports it.
 
     When every working mode is proven infeasible the verdict is ``infeasible`` whatever
     μ's roots are (no mode can follow the path, so none of its singularities is met):
-    μ's roots are then not isolated, and the report lists no candidate."""
+    μ's roots are then not isolated, and the report lists no candidate.
+
+    ``defer_corroboration`` (a piece of a long path, ``--engine auto``): when the
+    interval engine decides the piece on its own, the exact engine does not run here;
+    the report is the interval engine's, its ``exact_pending`` set, and the caller
+    corroborates it later (:func:`corroborate_exactly`) within the path's one budget."""
     modes = working_modes(path, tolerance)
     if all(m.status == INFEASIBLE for m in modes):
         verdict, reason = verdict_of(modes, [], [])
@@ -384,7 +393,7 @@ def certify_path(path: PathModel, tolerance: float = 1e-9) -> TrajectoryReport:
         return _certify_exactly(path, modes, tolerance)
     if path.exact_refused:  # --engine interval
         return _certify_by_intervals(path, modes, tolerance=tolerance)
-    return _interval_engine_first(path, modes, tolerance)
+    return _interval_engine_first(path, modes, tolerance, defer_corroboration)
 
 
 #: seconds the exact engine may take to corroborate a verdict the interval engine
@@ -395,7 +404,7 @@ EXACT_CORROBORATION_BUDGET = 5.0
 
 
 def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
-                           tolerance: float) -> TrajectoryReport:
+                           tolerance: float, defer: bool = False) -> TrajectoryReport:
     """``--engine auto``: the interval engine first, then the exact one.
 
     When the intervals decide the path on their own (every feasible mode proven ≠ 0, or
@@ -423,6 +432,11 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
         if exact.mu is None:  # the intervals alone, with their whole budget this time
             return _certify_by_intervals(exact, modes, None, tolerance)
         return _certify_exactly(exact, modes, tolerance, searches)
+    if defer:
+        report = _certify_by_intervals(replace_path(path, CORROBORATION_PENDING), modes,
+                                       searches, tolerance)
+        report.exact_pending = (path, modes, searches, tolerance)
+        return report
     left = remaining()
     own = left is None or left > EXACT_CORROBORATION_BUDGET
     try:
@@ -436,6 +450,40 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
         exact = replace_path(path, f"the exact engine did not finish within its "
                                    f"{EXACT_CORROBORATION_BUDGET:g} s budget")
     return _certify_by_intervals(exact, modes, searches, tolerance)
+
+
+#: ``exact_refused`` of a piece whose exact corroboration is still to come
+CORROBORATION_PENDING = "the exact engine's corroboration is still to come"
+
+
+def corroborate_exactly(report: TrajectoryReport, seconds: float,
+                        why_not: str | None = None) -> TrajectoryReport | None:
+    """A piece the interval engine decided (``report.exact_pending``, from
+    :func:`certify_path` with ``defer_corroboration``), corroborated by the exact engine
+    within ``seconds`` (the exact engine's report, held against the intervals'; or the
+    interval engine's with the exact engine's refusal).  Past them, or with no seconds
+    left: the interval engine's verdict, ``why_not`` saying why the exact engine did not
+    run; None when ``why_not`` is None.  The trajectory's own time limit still raises
+    :class:`~singcheck.budget.TimeLimitExceeded`."""
+    from singcheck.budget import TimeLimitExceeded, deadline, remaining
+    from singcheck.certify.path import with_mu
+
+    path, modes, searches, tolerance = report.exact_pending
+    if seconds > 0:
+        left = remaining()
+        own = left is None or left > seconds
+        try:
+            with deadline(seconds):
+                exact = with_mu(path)
+                if exact.mu is not None:
+                    return _certify_exactly(exact, modes, tolerance, searches)
+                return _certify_by_intervals(exact, modes, searches, tolerance)
+        except TimeLimitExceeded:
+            if not own:
+                raise
+    if why_not is None:
+        return None
+    return _certify_by_intervals(replace_path(path, why_not), modes, searches, tolerance)
 
 
 #: seconds the interval engine's first pass may take before the exact engine goes first

@@ -25,21 +25,26 @@ answer is composed from them, in the user's parameter t:
 
 from __future__ import annotations
 
+import time
+
 from flint import arb
 
 from singcheck.algebra.intervals import working_precision
 from singcheck.algebra.trig_values import sum_is_zero
-from singcheck.budget import checkpoint
+from singcheck.budget import checkpoint, remaining
 from singcheck.certify.classification import (
+    EXACT_CORROBORATION_BUDGET,
     REGULAR,
     SINGULAR,
+    VERDICT_FREE,
     VERDICT_INFEASIBLE,
     Candidate,
     TrajectoryReport,
     certify_path,
+    corroborate_exactly,
     verdict_of,
 )
-from singcheck.certify.engines import combined, corroborated_verdict
+from singcheck.certify.engines import EXACT_NOT_RUN, combined, corroborated_verdict
 from singcheck.certify.path import AUTO, build_path
 from singcheck.certify.working_modes import FEASIBLE, INFEASIBLE, UNKNOWN, WorkingMode
 from singcheck.elimination.projection import RobotProjection
@@ -53,11 +58,86 @@ def certify_trajectory(projection: RobotProjection, spec: TrajectorySpec,
     ``engine``: :data:`~singcheck.certify.path.ENGINES`."""
     if not spec.segments and spec.time_scale is None:
         return certify_path(build_path(projection, spec, engine), tolerance)
-    reports = []
+    defer = engine == AUTO and len(spec.pieces) > 1
+    reports, ends = [], []
     for piece in spec.pieces:
         checkpoint()
-        reports.append(certify_path(build_path(projection, piece, engine), tolerance))
-    return compose(spec, reports)
+        report = certify_path(build_path(projection, piece, engine), tolerance,
+                              defer_corroboration=defer)
+        reports.append(report)
+        # the branches at both ends now, while the piece's ball polynomials are at hand
+        # (made again from thousand-digit coefficients when the joins are composed)
+        ends.append((_branch_values(report, piece.global_range.start),
+                     _branch_values(report, piece.global_range.end)))
+    if defer:
+        reports = corroborate_pieces(reports)
+    return compose(spec, reports, ends)
+
+
+#: seconds the exact engine may spend, over all the pieces of one path together,
+#: corroborating the pieces the interval engine decided on its own (a piece it left
+#: windows on is decided by the exact engine, within the trajectory's time limit)
+PATH_CORROBORATION_BUDGET = EXACT_CORROBORATION_BUDGET
+#: of which at most this many seconds go to pieces without a proven crossing (det A
+#: proven ≠ 0 along them by the intervals already): the pieces holding the singular
+#: times the verdict names come first
+FREE_PIECES_BUDGET = 1.0
+
+
+#: seconds of the trajectory's time limit kept for composing the pieces' reports when
+#: the exact corroboration's budget is cut to fit in it
+TIME_LIMIT_MARGIN = 1.0
+
+
+def corroborate_pieces(reports: list[TrajectoryReport], budget: float | None = None,
+                       free_budget: float | None = None) -> list[TrajectoryReport]:
+    """The exact engine's corroboration of the pieces the interval engine decided
+    (``exact_pending``), within one ``budget`` (default
+    :data:`PATH_CORROBORATION_BUDGET`) for the whole path: the pieces with a proven
+    crossing first (the singular times the verdict names), then the others in order,
+    these within ``free_budget`` (default :data:`FREE_PIECES_BUDGET`) of it.  A piece
+    left when the budget is spent keeps the interval engine's verdict, and its
+    corroboration says so (``exact engine not run``, with how many pieces the exact
+    engine did corroborate)."""
+    budget = PATH_CORROBORATION_BUDGET if budget is None else budget
+    free_budget = FREE_PIECES_BUDGET if free_budget is None else free_budget
+    left = remaining()  # the trajectory's time limit: the interval verdicts must fit in it
+    cut = left is not None and left - TIME_LIMIT_MARGIN < budget
+    if cut:
+        budget = max(0.0, left - TIME_LIMIT_MARGIN)
+    pending = [i for i, r in enumerate(reports) if r.exact_pending is not None]
+    crossing = [i for i in pending if reports[i].candidates]
+    order = crossing + [i for i in pending if not reports[i].candidates]
+    out = list(reports)
+    start = time.monotonic()
+    free_start = None
+    done: list[int] = []
+    for i in order:
+        checkpoint()
+        now = time.monotonic()
+        left = budget - (now - start)
+        if not reports[i].candidates:
+            free_start = now if free_start is None else free_start
+            left = min(left, free_budget - (now - free_start))
+        if left <= 0:
+            break
+        report = corroborate_exactly(reports[i], left)
+        if report is None:  # out of budget: this piece and those after it stay pending
+            break
+        out[i] = report
+        done.append(i)
+    if len(done) < len(pending):
+        whole = (f"{budget:.3g} s: what the trajectory's time limit left" if cut else
+                 f"{budget:g} s")
+        why = (f"the exact engine's budget for the whole path ({whole}, of which "
+               f"{free_budget:g} s for pieces without a proven crossing) ran out after "
+               f"it corroborated {len(done)} of the {len(pending)} pieces the interval "
+               "engine decided on its own")
+        corroborated = set(done)
+        for i in pending:
+            if i not in corroborated:
+                out[i] = corroborate_exactly(reports[i], 0, why)
+    return out
 
 
 def joins(spec: TrajectorySpec) -> list:
@@ -83,9 +163,13 @@ def _same_root_at_join(report: TrajectoryReport, left: Candidate, right: Candida
 
 
 def _branch_values(report: TrajectoryReport, at) -> list[dict]:
+    """Per leg, its branches enclosed at the join ``at`` (from the pose's balls where the
+    robot allows it: :meth:`~singcheck.certify.path.PathModel.leg_branches_at`, no leg
+    composed along the piece — along a long spline, whose coefficients have thousands of
+    digits, composing them cost more than certifying the piece)."""
     t = report.path.trajectory.local_time(at).ball()
     with working_precision(128):
-        return [leg.branches(t) for leg in report.path.legs]
+        return report.path.leg_branches_at(t)
 
 
 def _continuous(label: str, left: list[dict], right: list[dict]) -> bool:
@@ -102,9 +186,12 @@ def _piece(i: int, count: int) -> str:
     return f"segment {i + 1}: " if count > 1 else ""
 
 
-def _compose_modes(spec, reports) -> list[WorkingMode]:
-    at_joins = [(_branch_values(reports[i], j), _branch_values(reports[i + 1], j))
-                for i, j in enumerate(joins(spec))]
+def _compose_modes(spec, reports, ends=None) -> list[WorkingMode]:
+    if ends is not None:
+        at_joins = [(ends[i][1], ends[i + 1][0]) for i in range(len(reports) - 1)]
+    else:
+        at_joins = [(_branch_values(reports[i], j), _branch_values(reports[i + 1], j))
+                    for i, j in enumerate(joins(spec))]
     out = []
     for k, first in enumerate(reports[0].modes):
         per_piece = [r.modes[k] for r in reports]
@@ -137,9 +224,11 @@ def _restatus(c: Candidate, feasible: set[str]) -> Candidate:
     return c
 
 
-def compose(spec: TrajectorySpec, reports: list[TrajectoryReport]) -> TrajectoryReport:
-    """The whole path's report from its pieces' reports (in order)."""
-    modes = _compose_modes(spec, reports)
+def compose(spec: TrajectorySpec, reports: list[TrajectoryReport],
+            ends: list | None = None) -> TrajectoryReport:
+    """The whole path's report from its pieces' reports (in order); ``ends``: each
+    piece's leg branches at its start and end (:func:`_branch_values`), when known."""
+    modes = _compose_modes(spec, reports, ends)
     feasible = {m.label for m in modes if m.status == FEASIBLE}
     candidates: list[Candidate] = []
     at = joins(spec)
@@ -160,6 +249,11 @@ def compose(spec: TrajectorySpec, reports: list[TrajectoryReport]) -> Trajectory
         reason = _mode_change(spec, reports) or reason
     check = combined([r.corroboration for r in reports])
     verdict, reason = corroborated_verdict(verdict, reason, check)
+    if verdict == VERDICT_FREE and check.status == EXACT_NOT_RUN:
+        alone = sum(1 for r in reports if r.corroboration is not None
+                    and r.corroboration.status == EXACT_NOT_RUN)
+        reason += (f", by the interval engine alone on {alone} of the {len(reports)} "
+                   f"segments ({check.detail})")
     methods = list(dict.fromkeys(r.root_method for r in reports))
     return TrajectoryReport(reports[0].path, verdict, reason, candidates, modes,
                             methods[0] if len(methods) == 1 else " + ".join(methods),

@@ -314,16 +314,35 @@ def interpolated_pieces(path: str, name: str, parameter: str, times: list[Fracti
                         values: dict[str, list[Fraction]], kind: str, lines: list[int]):
     """One polynomial piece per interval [tᵢ, tᵢ₊₁] between waypoints, written in the
     local time u = t − tᵢ ∈ [0, tᵢ₊₁ − tᵢ]."""
-    per_coord = {v: (linear_pieces if kind == "linear" else natural_cubic_spline)(times, ys)
-                 for v, ys in values.items()}
+    if kind == "linear":
+        per_coord = {v: linear_pieces(times, ys) for v, ys in values.items()}
+    else:
+        per_coord = natural_cubic_splines(times, values)
     pieces = []
     for i in range(len(times) - 1):
         rng = TimeRange(LinearInPi(Fraction(0)), LinearInPi(times[i + 1] - times[i]))
         pieces.append(TrajectorySpec(path, f"{name}[{i + 1}]", parameter, rng,
                                      {v: polys[i] for v, polys in per_coord.items()},
                                      {"segment": lines[i]}, time_offset=times[i]))
-    check_joins(pieces, path, [*lines])
+    _check_interpolates(per_coord, times, values, path, lines)
     return pieces
+
+
+def _check_interpolates(per_coord: dict, times: list[Fraction], values: dict, path: str,
+                        lines: list[int]) -> None:
+    """Each piece takes its two waypoints' values at its ends, exactly (so consecutive
+    pieces meet: the check :func:`check_joins` makes of any segments, here at the cost
+    of two exact evaluations of a polynomial in u per piece and coordinate)."""
+    zero = fmpq(0)
+    for v, polys in per_coord.items():
+        ys = values[v]
+        for i, p in enumerate(polys):
+            checkpoint()
+            h = _q(times[i + 1] - times[i])
+            for u, y, line in ((zero, ys[i], lines[i]), (h, ys[i + 1], lines[i + 1])):
+                if p(u, zero, zero) != _q(y):  # pragma: no cover - by construction
+                    raise SpecError(f"internal error: piece {i + 1} of {v} misses its "
+                                    f"waypoint {v} = {y}", path=path, line=line, key=v)
 
 
 def _q(x: Fraction) -> fmpq:
@@ -335,6 +354,70 @@ def linear_pieces(ts: list[Fraction], ys: list[Fraction]) -> list[fmpq_mpoly]:
     one = TRIG.from_dict({(0, 0, 0): 1})
     return [one * _q(y0) + T * _q((y1 - y0) / (t1 - t0))
             for t0, t1, y0, y1 in zip(ts, ts[1:], ys, ys[1:], strict=False)]
+
+
+def natural_cubic_splines(ts: list[Fraction], values: dict[str, list[Fraction]]
+                          ) -> dict[str, list[fmpq_mpoly]]:
+    """:func:`natural_cubic_spline` of each coordinate through the same times: the
+    elimination's pivots depend on the times alone, so they are computed once (the
+    costly part over thousands of waypoints: exact rationals growing with the rows); a
+    coordinate constant along the path is that constant, piece by piece (its spline)."""
+    n = len(ts) - 1
+    t = [_q(x) for x in ts]
+    h = [t[i + 1] - t[i] for i in range(n)]
+    pivots = _pivots(h)
+    out = {}
+    for v, ys in values.items():
+        if all(y == ys[0] for y in ys):
+            const = TRIG.from_dict({(0, 0, 0): _q(ys[0])})
+            out[v] = [const] * n
+        else:
+            out[v] = _spline_pieces(h, [_q(y) for y in ys], pivots)
+    return out
+
+
+def _pivots(h: list[fmpq]) -> tuple[list[fmpq], list[fmpq]]:
+    """The pivots dᵢ of Thomas' elimination on the spline's tridiagonal system, and the
+    multipliers wᵢ = hᵢ₋₁/dᵢ₋₁ of its right-hand side."""
+    diag: list[fmpq] = []
+    factors: list[fmpq] = []
+    for i in range(1, len(h)):
+        checkpoint()
+        d = 2 * (h[i - 1] + h[i])
+        if diag:
+            w = h[i - 1] / diag[-1]
+            d -= w * h[i - 1]
+            factors.append(w)
+        diag.append(d)
+    return diag, factors
+
+
+def _spline_pieces(h: list[fmpq], y: list[fmpq], pivots: tuple) -> list[fmpq_mpoly]:
+    """The spline's pieces in u = t − tᵢ given its pivots (:func:`_pivots`)."""
+    diag, factors = pivots
+    n = len(h)
+    slope = [(y[i + 1] - y[i]) / h[i] for i in range(n)]
+    m = [fmpq(0)] * (n + 1)
+    rhs: list[fmpq] = []
+    for i in range(1, n):
+        checkpoint()
+        r = 6 * (slope[i] - slope[i - 1])
+        if rhs:
+            r -= factors[i - 2] * rhs[-1]
+        rhs.append(r)
+    for i in range(n - 1, 0, -1):
+        checkpoint()  # the exact Mᵢ grow with the rows: each step costs more
+        m[i] = (rhs[i - 1] - h[i] * m[i + 1]) / diag[i - 1]
+    out = []
+    for i in range(n):
+        checkpoint()
+        # S = yᵢ + (Δᵢ − h(2Mᵢ + Mᵢ₊₁)/6)u + Mᵢu²/2 + (Mᵢ₊₁ − Mᵢ)u³/6h: the expanded
+        # form of natural_cubic_spline's, written term by term (no products of
+        # polynomials with thousand-digit coefficients)
+        terms = {(0, 0, 0): y[i], (1, 0, 0): slope[i] - h[i] * (2 * m[i] + m[i + 1]) / 6,
+                 (2, 0, 0): m[i] / 2, (3, 0, 0): (m[i + 1] - m[i]) / (6 * h[i])}
+        out.append(TRIG.from_dict({e: c for e, c in terms.items() if c != 0}))
+    return out
 
 
 def natural_cubic_spline(ts: list[Fraction], ys: list[Fraction]) -> list[fmpq_mpoly]:

@@ -335,3 +335,29 @@ def test_square_classes_decide_sums_of_square_roots():
     assert _is_zero({0b11: Fraction(1), 0: Fraction(-2)}, [Fraction(2), Fraction(2)])
     assert not _is_zero({0b11: Fraction(1), 0: Fraction(-2)}, [Fraction(2), Fraction(3)])
     assert _is_zero({0b01: Fraction(1), 0b10: Fraction(-2)}, [Fraction(8), Fraction(2)])
+
+
+def test_segments_with_an_expression_piece_join_by_exact_balls(tmp_path):
+    """A segment x = 1 + cos(t − 1)/2 ends at t = 1 on x = 3/2 exactly (Arb's cos 0 is
+    the exact 1): it joins x = 3/2; a jump to x = 1 is refused; a join where the tree's
+    value is not exact cannot be checked and is refused with the reason."""
+    from singcheck.errors import SpecError
+
+    robot = load_robot("robots/orthoglide.yaml", backend="flint", cache=False)
+
+    def doc(second_x: str, end: str = "1") -> str:
+        path = tmp_path / f"seg{len(list(tmp_path.iterdir()))}.yaml"
+        path.write_text(f"name: seg\nparameter: t\nsegments:\n"
+                        f"  - range: [0, {end}]\n    pose: {{x: 1 + cos(t - 1)/2, y: 1/2, z: 1}}\n"
+                        f"  - range: [{end}, 2]\n    pose: {{x: {second_x}, y: 1/2, z: 1}}\n")
+        return str(path)
+
+    report = check(robot, load_trajectory(doc("3/2"), robot), regions=False).certificate
+    mp.mp.dps = 30
+    assert all(_orthoglide_det(1 + mp.cos(t - 1) / 2, mp.mpf(1) / 2, 1) > 0
+               for t in (mp.mpf(k) / 10 for k in range(11)))
+    assert report.verdict == "singularity-free"
+    with pytest.raises(SpecError, match="the pose jumps between segments 1 and 2"):
+        load_trajectory(doc("1"), robot)
+    with pytest.raises(SpecError, match="cannot check exactly that segments 1 and 2"):
+        load_trajectory(doc("1 + cos(1/2)/2", "3/2"), robot)

@@ -28,6 +28,7 @@ from fractions import Fraction
 from flint import fmpq, fmpq_mpoly
 
 from singcheck.algebra.intervals import working_precision
+from singcheck.algebra.opaque import is_opaque
 from singcheck.algebra.trig import TRIG, LinearInPi, T, TimeRange, evaluate_trig
 from singcheck.algebra.trig_values import sum_is_zero
 from singcheck.budget import checkpoint
@@ -123,6 +124,9 @@ def check_joins(pieces, path: str, lines: list[int | None]) -> None:
         at = left.global_range.end
         for v in left.pose:
             where = f"segments {i + 1} and {i + 2} at {left.parameter} = {at}"
+            if is_opaque(left.pose[v].context()) or is_opaque(right.pose[v].context()):
+                _join_by_balls(left, right, v, at, where, path, lines[i + 1], i)
+                continue
             if left.pose[v].context() is not TRIG or right.pose[v].context() is not TRIG:
                 raise SpecError(f"cannot check exactly that {where} meet: square roots in "
                                 "segments are not supported", path=path, line=lines[i + 1],
@@ -144,6 +148,29 @@ def check_joins(pieces, path: str, lines: list[int | None]) -> None:
             raise SpecError(f"the pose jumps between {where}: {v} is {float(a.mid()):.9g} "
                             f"at the end of segment {i + 1} and {float(b.mid()):.9g} at the "
                             f"start of segment {i + 2}", path=path, line=lines[i + 1], key=v)
+
+
+def _join_by_balls(left, right, v: str, at, where: str, path: str, line, i: int) -> None:
+    """A join where a side is kept as an expression tree (not algebraic): continuous when
+    both sides' enclosures at the join are exact balls and equal (cos 0 = 1 is exact in
+    Arb), a jump when they are disjoint; otherwise it cannot be decided, and is refused."""
+    from flint import arb
+
+    from singcheck.algebra.radicals import evaluate_path
+
+    with working_precision(256):
+        a, b = (evaluate_path(side.pose[v], side.local_time(at).ball()) +
+                arb.pi() * _q(Fraction(side.angle_offsets.get(v, 0))) for side in (left, right))
+    if a.is_exact() and b.is_exact() and a == b:
+        return
+    if not a.overlaps(b):
+        raise SpecError(f"the pose jumps between {where}: {v} is {float(a.mid()):.9g} at the "
+                        f"end of segment {i + 1} and {float(b.mid()):.9g} at the start of "
+                        f"segment {i + 2}", path=path, line=line, key=v)
+    raise SpecError(f"cannot check exactly that {where} meet: {v} is given there by an "
+                    "expression that is not a trig polynomial over Q (end a segment where it "
+                    "is exact, e.g. where the argument of its sin/cos is 0)", path=path,
+                    line=line, key=v)
 
 
 def _waypoints(doc, node, parameter: str, robot):

@@ -250,9 +250,19 @@ _FOURIER_MIN_DEGREE = 4
 FOURIER_ALWAYS = 24
 
 
+_HIGH: dict[int, tuple[fmpq_mpoly, bool]] = {}
+
+
 def _high_harmonic(p: fmpq_mpoly) -> bool:
-    d = p.degrees()
-    return len(d) == 3 and d[1] + d[2] >= FOURIER_ALWAYS
+    """Whether p's degree in (s, c) reaches :data:`FOURIER_ALWAYS` (memoised: asked at
+    every enclosure)."""
+    hit = _HIGH.get(id(p))
+    if hit is None or hit[0] is not p:
+        if len(_HIGH) > 1024:
+            _HIGH.clear()
+        d = p.degrees()
+        hit = _HIGH[id(p)] = (p, len(d) == 3 and d[1] + d[2] >= FOURIER_ALWAYS)
+    return hit[1]
 
 
 _LAST_T: tuple = (None, 0, {})  # (t, precision, {k: (sin kt, cos kt)})

@@ -518,19 +518,27 @@ class PathModel:
         expression trees is differentiated on its trees
         (:meth:`~singcheck.spec.real_paths.RealFunction.with_derivative`)."""
         from singcheck.algebra.opaque import opaque_rate
+
+        opaque, functions = self._rates_plan
+        if opaque is not None:
+            return [opaque_rate(name, t) for name in opaque]
+        if functions and not angle_functions:
+            return None
+        return [evaluate_path(d, t) for d in _coordinate_derivatives(self)]
+
+    @cached_property
+    def _rates_plan(self) -> tuple[list[str] | None, bool]:
+        """(the opaque variables' names of a path kept as expression trees, else None;
+        whether the path ring has angle functions), once per path."""
         from singcheck.algebra.radicals import has_angle_functions
 
         if self.legs and self.legs[0]._composer.opaque:
-            out = []
+            names = []
             for x in self.coordinates:
                 (exps, _), = x.terms()
-                out.append(opaque_rate(x.context().names()[list(exps).index(1)], t))
-            return out
-        if not angle_functions and any(has_angle_functions(x.context())
-                                       for x in self.coordinates):
-            return None
-        derivatives = _coordinate_derivatives(self)
-        return [evaluate_path(d, t) for d in derivatives]
+                names.append(x.context().names()[list(exps).index(1)])
+            return names, True
+        return None, any(has_angle_functions(x.context()) for x in self.coordinates)
 
     def det_A(self, joints: list, pose: list[arb], signs: dict[int, int] | None = None):
         """Enclosure of det A at the given joint values (a revolute joint's as a (cos,

@@ -361,3 +361,30 @@ def test_segments_with_an_expression_piece_join_by_exact_balls(tmp_path):
         load_trajectory(doc("1"), robot)
     with pytest.raises(SpecError, match="cannot check exactly that segments 1 and 2"):
         load_trajectory(doc("1 + cos(1/2)/2", "3/2"), robot)
+
+
+def test_an_expression_path_crosses_a_process_boundary(tmp_path):
+    """A Dask worker (a fresh process) unpickles the trajectory: the opaque variables'
+    functions travel with the path ring and the verdict there is the same."""
+    import pickle
+    import subprocess
+    import sys
+
+    import singcheck.algebra.pickling  # noqa: F401 - the reducers
+
+    doc = _doc(tmp_path, "shift", "[-pi, pi]", {"x": "1 + cos(t - 1)/2", "y": "1/2", "z": 1})
+    robot = load_robot("robots/orthoglide.yaml", backend="flint", cache=False)
+    here = check(robot, load_trajectory(doc, robot), regions=False).certificate
+    blob = tmp_path / "job.pkl"
+    blob.write_bytes(pickle.dumps((robot, load_trajectory(doc, robot))))
+    code = ("import pickle, sys; import singcheck.algebra.pickling; "
+            "from singcheck.api import check; "
+            f"r, t = pickle.load(open({str(blob)!r}, 'rb')); "
+            "c = check(r, t, regions=False).certificate; "
+            "print(c.verdict, [round(float(x.t.mid()), 6) for x in c.candidates])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split()[0] == here.verdict == "singular"
+    assert out.stdout.strip().endswith(str([round(float(x.t.mid()), 6)
+                                            for x in here.candidates]))

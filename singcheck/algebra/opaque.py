@@ -31,6 +31,11 @@ def opaque_name(kind: str, f) -> str:
     return name
 
 
+def register_opaque(name: str, f, kind: str) -> None:
+    """Register a name built by :func:`opaque_name` in another process (unpickling)."""
+    _OPAQUE.setdefault(name, (f, kind))
+
+
 def opaque_of(name: str) -> tuple[object, str] | None:
     """(function, kind) of an opaque variable's name, None for any other name."""
     return _OPAQUE.get(name) if name.endswith(CLOSE) else None

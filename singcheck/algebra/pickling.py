@@ -15,12 +15,23 @@ import copyreg
 from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly, fmpz_mpoly, fmpz_mpoly_ctx
 
 
-def _ctx(kind, names: tuple[str, ...], ordering: str):
+def _ctx(kind, names: tuple[str, ...], ordering: str, opaque: dict | None = None):
+    if opaque:  # the functions behind a path ring's opaque variables, registered again
+        from singcheck.algebra.opaque import register_opaque
+
+        for name, (function, what) in opaque.items():
+            register_opaque(name, function, what)
     return kind.get(names, ordering)
 
 
 def _reduce_ctx(ctx):
-    return _ctx, (type(ctx), tuple(ctx.names()), ctx.ordering().name)
+    """The context by its names; a path ring's opaque variables (coordinates kept as
+    expression trees, :mod:`singcheck.algebra.opaque`) travel with their functions."""
+    from singcheck.algebra.opaque import opaque_of
+
+    names = tuple(ctx.names())
+    opaque = {n: opaque_of(n) for n in names if opaque_of(n) is not None}
+    return _ctx, (type(ctx), names, ctx.ordering().name, opaque or None)
 
 
 def _mpoly(ctx, terms: dict):

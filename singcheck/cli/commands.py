@@ -329,7 +329,11 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         except SpecError as e:
             fail(e.message, ExitCode.USAGE)
     spec = load_robot(robot)
-    documents = read_documents(trajectories, interpolation, csv=table, all_csv=all_csv)
+    # past the first documents, the workers read and compose each document (spans): this
+    # process only cuts the input into documents and keeps their names (not with
+    # --certificate or --plot, which need every document's text here)
+    documents = read_documents(trajectories, interpolation, csv=table, all_csv=all_csv,
+                               spans=not certificate_dir and not plot_dir)
     # the first documents (all of a small batch) are parsed here, before any work: a bad
     # one stops the run at once (exit 2, one line); past them, the documents are parsed
     # by the workers, and a bad one is that trajectory's result
@@ -369,6 +373,10 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
                    ordered=fmt != "jsonl", notify=progress.note, engine=certify_with,
                    **selection)
+    if fmt == "jsonl":  # each line written by the worker that checked its trajectory
+        from singcheck.report.trajectory import JsonLine, robot_json
+
+        options["line"] = JsonLine(robot_json(projection))
     if scheduler:
         from singcheck.cluster import check_on_cluster
 
@@ -457,22 +465,23 @@ class _Sink:
     """Where results go: kept for the end (table, json, junit), or streamed (jsonl)."""
 
     def __init__(self, fmt: str, out, projection) -> None:
-        from singcheck.report.trajectory import robot_json
+        from singcheck.report.trajectory import JsonLine, robot_json
 
         self.fmt, self.out, self.projection = fmt, out, projection
-        self.robot = robot_json(projection)
+        self.line = JsonLine(robot_json(projection))
         self.results: list[dict] = []
 
-    def add(self, doc: dict) -> None:
-        seconds = doc.pop("time_s", None)  # JUnit's time, and each jsonl line's
-        if self.fmt in ("junit", "jsonl"):
-            doc["time_s"] = seconds
-        if self.fmt != "jsonl":
+    def add(self, doc) -> None:
+        """One result: a trajectory object, or a :class:`singcheck.api.Formatted` whose
+        jsonl line a worker wrote."""
+        if self.fmt == "jsonl":
+            line = doc.line if hasattr(doc, "line") else self.line(doc)
+        else:
+            seconds = doc.pop("time_s", None)  # JUnit's time
+            if self.fmt == "junit":
+                doc["time_s"] = seconds
             self.results.append(doc)
             return
-        import json
-
-        line = json.dumps({**doc, "robot": self.robot}, ensure_ascii=False) + "\n"
         with _signals_held():  # a line is written whole, or not at all
             self.out.write(line)
             self.out.flush()

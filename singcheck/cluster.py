@@ -122,23 +122,36 @@ def check_on_cluster(address: str, robot: Robot,
         window = max(8, TASKS_PER_WORKER * threads)  # tasks in flight
         size = CHUNK if len(head) == LOOKAHEAD else max(1, min(CHUNK, -(-len(head) // window)))
         yield from _results(_Submitter(client, shipped, chain(head, items), options,
-                                       robot.region_cache is not None, window, size, line),
-                            ordered)
+                                       robot.region_cache is not None, window, size, line,
+                                       threads), ordered)
     finally:
         client.close()  # the tasks still queued or running are cancelled with it
 
 
+#: the fewest trajectories a task of a batch's end holds
+TAIL = 4
+
+
 class _Submitter:
     """Submits the tasks a window at a time (``window`` in flight), so that neither this
-    process nor the scheduler holds a task per trajectory of a long batch at once."""
+    process nor the scheduler holds a task per trajectory of a long batch at once.
+
+    It reads two tasks ahead: once the input has ended, the last trajectories go in
+    smaller and smaller tasks (a share of what is left per worker thread, at least
+    TAIL), so that the batch does not end with one worker on a whole task of 64 while
+    the others wait."""
 
     def __init__(self, client, shipped, items: Iterator, options, region_cache: bool,
-                 window: int, size: int, line=None) -> None:
+                 window: int, size: int, line=None, threads: int = 1) -> None:
+        from collections import deque
+
         from distributed import as_completed
 
         self.client, self.shipped, self.options, self.line = client, shipped, options, line
         self.region_cache = region_cache
-        self.items, self.size = items, size
+        self.items, self.size, self.threads = items, size, max(1, threads)
+        self.ahead: deque = deque()  # read, not submitted yet
+        self.ended = False
         self.read = 0
         self.batch = uuid.uuid4().hex[:12]
         self.chunks: dict[str, tuple[int, list]] = {}  # key -> (first index, trajectories)
@@ -148,18 +161,27 @@ class _Submitter:
 
     def next(self) -> None:
         """Submit the next few trajectories as one task, if any is left."""
-        from itertools import islice
-
-        chunk = [item.loaded() if isinstance(item, Span) else item
-                 for item in islice(self.items, self.size)]
-        if not chunk:
+        while not self.ended and len(self.ahead) < 2 * self.size:
+            item = next(self.items, _END)
+            if item is _END:
+                self.ended = True
+            else:
+                self.ahead.append(item)
+        if not self.ahead:
             return
+        count = self.size if not self.ended else \
+            min(self.size, max(TAIL, -(-len(self.ahead) // (2 * self.threads))))
+        chunk = [self.ahead.popleft() for _ in range(min(count, len(self.ahead)))]
+        chunk = [item.loaded() if isinstance(item, Span) else item for item in chunk]
         future = self.client.submit(_remote_check, self.shipped, chunk, self.options,
                                     self.region_cache, self.line,
                                     key=f"singcheck-{self.batch}-{self.read}", pure=False)
         self.chunks[future.key] = (self.read, chunk)
         self.read += len(chunk)
         self.completed.add(future)
+
+
+_END = object()
 
 
 def _results(tasks: _Submitter, ordered: bool) -> Iterator[dict]:

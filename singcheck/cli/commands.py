@@ -383,7 +383,8 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
                    ordered=fmt != "jsonl", notify=progress.note, engine=certify_with,
                    **selection)
-    if fmt == "jsonl":  # each line written by the worker that checked its trajectory
+    if fmt == "jsonl" and not certificate_dir:  # each line written by the worker that
+        # checked its trajectory (a certificate needs the whole object here)
         from singcheck.report.trajectory import JsonLine, robot_json
 
         options["line"] = JsonLine(robot_json(projection))

@@ -48,6 +48,7 @@ sys.path.insert(0, str(ROOT / "bench"))
 from contender import contender  # noqa: E402
 from generate import waypoints_yaml, write, write_stream  # noqa: E402
 from peak_rss import run_measured  # noqa: E402
+from scaling import print_scaling, scaling_rows  # noqa: E402
 
 from singcheck.certify.classification import certify_path  # noqa: E402
 from singcheck.certify.path import build_path  # noqa: E402
@@ -365,6 +366,8 @@ def _timed_run(cmd: list[str], stdin_path: Path, env: dict) -> dict:
             "peak_rss_mb": peak_mb}
 
 
+#: issue 32's side-by-side scaling run: paths, rounds, workers (BENCH_SCALING=2000,3,2)
+SCALING = tuple(int(n) for n in os.environ.get("BENCH_SCALING", "2000,3,2").split(","))
 BATCH_COUNTS = tuple(int(n) for n in os.environ.get("BENCH_BATCH", "1000,10000").split(","))
 BATCH_TARGET = 200  # paths per second, 10,000 paths with --no-regions (issue 15)
 FLAT_MB = 10  # "memory flat": peak RSS grows less than this from the fewest paths to the most
@@ -704,6 +707,12 @@ def main() -> None:
     results["batch"] = batch = batch_rows()
     results["batch_targets"] = batch_targets(batch)
     print_batch(batch)
+    results["scaling"] = scaling = scaling_rows(*SCALING)
+    print_scaling(scaling)
+    from user_inputs import print_rows, rows as input_rows
+
+    results["user_inputs"] = inputs = input_rows()
+    print_rows(inputs)
     results["growth"] = growth = growth_rows()
     print("\ngrowth: certification CPU time per trajectory (projection cached), singcheck and "
           "the branch-and-bound round-robin")
@@ -753,10 +762,36 @@ def long_csv_only() -> None:
     out.write_text(json.dumps(results, indent=2) + "\n")
 
 
+def scaling_only() -> None:
+    """``python bench/bench.py scaling``: only the scaling rounds, merged into
+    results.json."""
+    out = ROOT / "bench" / "results.json"
+    results = json.loads(out.read_text()) if out.exists() else {"machine": machine()}
+    results["scaling"] = scaling_rows(*SCALING)
+    print_scaling(results["scaling"])
+    out.write_text(json.dumps(results, indent=2) + "\n")
+
+
+def user_inputs_only() -> None:
+    """``python bench/bench.py inputs``: only the inputs issue 27 listed as refused or
+    stalled, merged into results.json."""
+    from user_inputs import print_rows, rows
+
+    out = ROOT / "bench" / "results.json"
+    results = json.loads(out.read_text()) if out.exists() else {"machine": machine()}
+    results["user_inputs"] = rows()
+    print_rows(results["user_inputs"])
+    out.write_text(json.dumps(results, indent=2) + "\n")
+
+
 if __name__ == "__main__":
     if sys.argv[1:] == ["batch"]:
         batch_only()
     elif sys.argv[1:] == ["csv"]:
         long_csv_only()
+    elif sys.argv[1:] == ["scaling"]:
+        scaling_only()
+    elif sys.argv[1:] == ["inputs"]:
+        user_inputs_only()
     else:
         main()

@@ -31,7 +31,7 @@ from singcheck.certify.pieces import certify_trajectory
 from singcheck.certify.working_modes import WorkingMode
 from singcheck.elimination.projection import MAX_SURFACE_TERMS, RobotProjection, project_robot
 from singcheck.model.robot import RobotModel, build_model
-from singcheck.spec.files import Document, RobotSpec, TrajectorySpec
+from singcheck.spec.files import Document, RobotSpec, Span, TrajectorySpec
 from singcheck.spec.files import load_robot as read_robot_spec
 from singcheck.spec.files import load_trajectory as read_trajectory_spec
 
@@ -416,10 +416,38 @@ def _worker_signals() -> None:
 _HELD = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
 
 
-def _check_chunk(chunk: list) -> list[dict]:
-    """A worker's task: several trajectories (specs, or documents it parses), in turn."""
-    robot, options = _WORKER["robot"], _WORKER["options"]
-    return [check_item(robot, item, **options) for item in chunk]
+def _check_chunk(chunk: list) -> list[dict | Formatted]:
+    """A worker's task: several trajectories (specs, or documents it reads and parses),
+    in turn; each result formatted here when the batch has a ``line`` format."""
+    robot, options, line = _WORKER["robot"], _WORKER["options"], _WORKER.get("line")
+    return [formatted(check_item(robot, item, **options), line) for item in chunk]
+
+
+@dataclass(frozen=True)
+class Formatted:
+    """One trajectory's result as the worker that checked it wrote it (a batch with a
+    ``line`` format): the line, and the few keys that its reader reads (``name``,
+    ``verdict`` and, for an error, ``error.kind`` and ``error.message``), so that the
+    process that gathers a batch neither pickles whole reports back nor formats them."""
+
+    summary: dict
+    line: str
+
+    def __getitem__(self, key: str):
+        return self.summary[key]
+
+    def __contains__(self, key: str) -> bool:
+        return key in self.summary
+
+
+def formatted(doc: dict, line: Callable[[dict], str] | None) -> dict | Formatted:
+    """``doc`` as a :class:`Formatted` result by ``line`` (itself when ``line`` is None)."""
+    if line is None:
+        return doc
+    summary = {"name": doc["name"], "verdict": doc["verdict"]}
+    if "error" in doc:
+        summary["error"] = {"kind": doc["error"]["kind"], "message": doc["error"]["message"]}
+    return Formatted(summary, line(doc))
 
 
 @dataclass
@@ -434,12 +462,15 @@ class Parsed:
     reason: str = ""
 
 
-def parse_within(document: Document, robot_spec: RobotSpec,
+def parse_within(document: Document | Span, robot_spec: RobotSpec,
                  time_limit: float | None) -> Parsed:
     """Parse ``document`` as the first stage of its trajectory's check: under its time
     limit (a 5,000-row CSV's exact cubic spline is solved here).  A bad document raises
     :class:`~singcheck.errors.SpecError`."""
     import time
+
+    if isinstance(document, Span):
+        document = document.document()
 
     start = time.perf_counter()
     try:
@@ -456,7 +487,7 @@ def spec_of(item: TrajectorySpec | Document | Parsed) -> TrajectorySpec | Docume
     return item.spec if isinstance(item, Parsed) else item
 
 
-def check_item(robot: Robot, item: TrajectorySpec | Document | Parsed,
+def check_item(robot: Robot, item: TrajectorySpec | Document | Span | Parsed,
                **options) -> dict[str, Any]:
     """:func:`check_safely` of a trajectory spec, or of a :class:`Document` read but not
     parsed yet: it is parsed here, within the trajectory's time limit (past it: verdict
@@ -465,6 +496,8 @@ def check_item(robot: Robot, item: TrajectorySpec | Document | Parsed,
     a batch."""
     from singcheck.report.trajectory import error_json, time_limited_json
 
+    if isinstance(item, Span):  # its bytes read and composed here
+        item = item.document()
     if isinstance(item, Document):
         from singcheck.errors import SpecError
 
@@ -524,7 +557,8 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
                 tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
                 time_limit: float | None = DEFAULT_TIME_LIMIT, jobs: int = 1,
                 ordered: bool = True, notify: Notify = _quiet,
-                engine: str = "auto", **selection) -> Iterator[dict]:
+                engine: str = "auto", line: Callable[[dict], str] | None = None,
+                ordered_head: int = 0, **selection) -> Iterator[dict | Formatted]:
     """Certify many trajectories, in ``jobs`` forked processes when there are more than 4;
     yields each one's JSON trajectory object as soon as it is known: in input order, or
     (``ordered=False``) in the order they finish.
@@ -536,7 +570,15 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
     worker process breaks are run again (:func:`_forked`), and only a trajectory whose
     worker dies twice is an ``error`` result.  ``time_limit`` bounds each
     trajectory (and the shared region maps, once).  ``selection``: :func:`check`'s
-    ``mode``, ``start_joints``, ``clearance`` and ``min_clearance``, for each trajectory."""
+    ``mode``, ``start_joints``, ``clearance`` and ``min_clearance``, for each trajectory.
+
+    ``line`` (a function of a trajectory object, e.g.
+    :class:`~singcheck.report.trajectory.JsonLine`): each result is instead a
+    :class:`Formatted`, the line written by the worker that checked it; with
+    :class:`~singcheck.spec.files.Span` items (``read_documents(…, spans=True)``) this
+    process then only cuts the input into documents and writes the lines.
+    ``ordered_head``: the first that many results come in input order even when not
+    ``ordered`` (so that a caller can hold them until it knows them all)."""
     from itertools import chain, islice
 
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
@@ -545,13 +587,16 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
     head = list(islice(items, LOOKAHEAD))
     if jobs > 1 and len(head) > 4:
         shared_regions(robot, head, options, notify)
-        yield from _forked(robot, chain(head, items), options, jobs, ordered)
+        yield from _forked(robot, chain(head, items), options, jobs, ordered, line,
+                           ordered_head)
         return
     for item in chain(head, items):
-        yield check_item(robot, item, **options)
+        yield formatted(check_item(robot, item, **options), line)
 
 
-def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterator[dict]:
+def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
+            line: Callable[[dict], str] | None = None,
+            ordered_head: int = 0) -> Iterator[dict | Formatted]:
     """The batch in ``jobs`` forked workers, CHUNK trajectories per task and
     TASKS_PER_WORKER tasks per worker in flight: a finished task is replaced by the next
     one read (before its results are yielded), so at most that many trajectories are
@@ -573,7 +618,7 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
     from singcheck.report.trajectory import error_json
 
     register()  # specs cross to the workers by pickle
-    _WORKER.update(robot=robot, options=options, parent=os.getpid())
+    _WORKER.update(robot=robot, options=options, parent=os.getpid(), line=line)
 
     def start():
         return ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
@@ -621,7 +666,8 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
             if isinstance(result, Exception):
                 reason = (f"its worker process died twice (killed, or out of memory): "
                           f"{type(result).__name__}: {result}")
-                result = [{**error_json(_head(item), "internal", reason), "time_s": 0.0}]
+                result = [formatted({**error_json(_head(item), "internal", reason),
+                                     "time_s": 0.0}, line)]
             out.append((index, result[0]))
         return out
 
@@ -644,7 +690,7 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
                 results += rerun(*lost.popleft())
             while not lost and len(in_flight) < jobs * TASKS_PER_WORKER and submit():
                 pass
-            if not ordered:
+            if not ordered and next_out >= ordered_head:
                 for _, doc in results:
                     yield doc
                 continue
@@ -652,6 +698,9 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
             while next_out in done_early:
                 yield done_early.pop(next_out)
                 next_out += 1
+            if not ordered and next_out >= ordered_head:  # the head is out: the rest
+                for index in sorted(done_early):  # as it comes
+                    yield done_early.pop(index)
     finally:
         _WORKER.clear()
         _stop(pool)
@@ -659,6 +708,8 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool) -> Iterat
 
 def _head(item):
     """What names a batch's item in its result: the spec, else the document."""
+    if isinstance(item, Span):
+        return item.head()
     return item.document if isinstance(item, Parsed) and item.spec is None else \
         spec_of(item)
 

@@ -21,14 +21,17 @@ from singcheck.api import (
     DEFAULT_TIME_LIMIT,
     DEFAULT_TOLERANCE,
     LOOKAHEAD,
+    Formatted,
     Notify,
     Robot,
+    _head,
     _quiet,
     check_item,
+    formatted,
     shared_regions,
 )
 from singcheck.errors import BackendError, SpecError
-from singcheck.spec.files import Document, TrajectorySpec
+from singcheck.spec.files import Document, Span, TrajectorySpec
 
 CONNECT_TIMEOUT = 30  # seconds to reach the scheduler
 
@@ -65,14 +68,16 @@ def _client(address: str):
         raise BackendError(f"cannot reach the Dask scheduler at {address}: {e}") from None
 
 
-def _remote_check(robot: Robot, chunk: list, options: dict, region_cache: bool) -> list[dict]:
+def _remote_check(robot: Robot, chunk: list, options: dict, region_cache: bool,
+                  line=None) -> list[dict | Formatted]:
     """One task, on a worker: the public API on the shipped robot, for a few
-    trajectories (specs, or documents parsed here) in turn."""
+    trajectories (specs, or documents read and parsed here) in turn; each result
+    formatted here by ``line`` when the batch has one."""
     if region_cache and robot.region_cache is None:
         from singcheck.spaces.region_map import RegionMapCache
 
         robot.region_cache = RegionMapCache()  # the worker's own cache directory
-    return [check_item(robot, item, **options) for item in chunk]
+    return [formatted(check_item(robot, item, **options), line) for item in chunk]
 
 
 #: trajectories per task: on a 2-worker LocalCluster a task cost about 14 ms of CPU
@@ -86,13 +91,15 @@ def check_on_cluster(address: str, robot: Robot,
                      trajectories: Iterable[TrajectorySpec | Document], *,
                      tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
                      time_limit: float | None = DEFAULT_TIME_LIMIT, ordered: bool = True,
-                     notify: Notify = _quiet, engine: str = "auto",
-                     **selection) -> Iterator[dict]:
+                     notify: Notify = _quiet, engine: str = "auto", line=None,
+                     ordered_head: int = 0, **selection) -> Iterator[dict | Formatted]:
     """:func:`singcheck.api.check_batch` on the dask.distributed scheduler at
     ``address``: yields each trajectory's JSON object in input order, or
     (``ordered=False``) as the tasks finish.  ``trajectories`` is read lazily, a bounded
     number of tasks ahead.  Stopping the iteration (Ctrl-C) cancels the tasks still
-    queued."""
+    queued.  ``line`` and ``ordered_head``: as for :func:`~singcheck.api.check_batch`
+    (the workers write each result's line); a :class:`~singcheck.spec.files.Span`
+    travels with its bytes (a cluster's workers need not see this machine's files)."""
     from itertools import chain, islice
 
     from singcheck.algebra.pickling import register
@@ -108,26 +115,43 @@ def check_on_cluster(address: str, robot: Robot,
         items = iter(trajectories)
         head = list(islice(items, LOOKAHEAD))
         shared_regions(robot, head, options, notify)
-        shipped = client.scatter(replace(robot, region_cache=None), broadcast=True)
+        # hash=False: a random key, not a token of the robot (tokenizing pickled it all
+        # once more, about 0.3 s of every run on 2 cores)
+        shipped = client.scatter(replace(robot, region_cache=None), broadcast=True,
+                                 hash=False)
         window = max(8, TASKS_PER_WORKER * threads)  # tasks in flight
         size = CHUNK if len(head) == LOOKAHEAD else max(1, min(CHUNK, -(-len(head) // window)))
         yield from _results(_Submitter(client, shipped, chain(head, items), options,
-                                       robot.region_cache is not None, window, size), ordered)
+                                       robot.region_cache is not None, window, size, line,
+                                       threads), ordered, ordered_head)
     finally:
         client.close()  # the tasks still queued or running are cancelled with it
 
 
+#: the fewest trajectories a task of a batch's end holds
+TAIL = 4
+
+
 class _Submitter:
     """Submits the tasks a window at a time (``window`` in flight), so that neither this
-    process nor the scheduler holds a task per trajectory of a long batch at once."""
+    process nor the scheduler holds a task per trajectory of a long batch at once.
+
+    It reads two tasks ahead: once the input has ended, the last trajectories go in
+    smaller and smaller tasks (a share of what is left per worker thread, at least
+    TAIL), so that the batch does not end with one worker on a whole task of 64 while
+    the others wait."""
 
     def __init__(self, client, shipped, items: Iterator, options, region_cache: bool,
-                 window: int, size: int) -> None:
+                 window: int, size: int, line=None, threads: int = 1) -> None:
+        from collections import deque
+
         from distributed import as_completed
 
-        self.client, self.shipped, self.options = client, shipped, options
+        self.client, self.shipped, self.options, self.line = client, shipped, options, line
         self.region_cache = region_cache
-        self.items, self.size = items, size
+        self.items, self.size, self.threads = items, size, max(1, threads)
+        self.ahead: deque = deque()  # read, not submitted yet
+        self.ended = False
         self.read = 0
         self.batch = uuid.uuid4().hex[:12]
         self.chunks: dict[str, tuple[int, list]] = {}  # key -> (first index, trajectories)
@@ -137,20 +161,30 @@ class _Submitter:
 
     def next(self) -> None:
         """Submit the next few trajectories as one task, if any is left."""
-        from itertools import islice
-
-        chunk = list(islice(self.items, self.size))
-        if not chunk:
+        while not self.ended and len(self.ahead) < 2 * self.size:
+            item = next(self.items, _END)
+            if item is _END:
+                self.ended = True
+            else:
+                self.ahead.append(item)
+        if not self.ahead:
             return
+        count = self.size if not self.ended else \
+            min(self.size, max(TAIL, -(-len(self.ahead) // (2 * self.threads))))
+        chunk = [self.ahead.popleft() for _ in range(min(count, len(self.ahead)))]
+        chunk = [item.loaded() if isinstance(item, Span) else item for item in chunk]
         future = self.client.submit(_remote_check, self.shipped, chunk, self.options,
-                                    self.region_cache, key=f"singcheck-{self.batch}-{self.read}",
-                                    pure=False)
+                                    self.region_cache, self.line,
+                                    key=f"singcheck-{self.batch}-{self.read}", pure=False)
         self.chunks[future.key] = (self.read, chunk)
         self.read += len(chunk)
         self.completed.add(future)
 
 
-def _results(tasks: _Submitter, ordered: bool) -> Iterator[dict]:
+_END = object()
+
+
+def _results(tasks: _Submitter, ordered: bool, ordered_head: int = 0) -> Iterator[dict]:
     from singcheck.report.trajectory import error_json
 
     done: dict[int, dict] = {}
@@ -160,15 +194,19 @@ def _results(tasks: _Submitter, ordered: bool) -> Iterator[dict]:
         try:
             docs = future.result()
         except Exception as e:  # the task was lost (a worker died) or could not run
-            docs = [error_json(item, "internal",
-                               f"the Dask task failed: {type(e).__name__}: {e}")
+            docs = [formatted(error_json(_head(item), "internal",
+                                         f"the Dask task failed: {type(e).__name__}: {e}"),
+                              tasks.line)
                     for item in chunk]
         future.release()
         tasks.next()
-        if not ordered:
+        if not ordered and next_out >= ordered_head:
             yield from docs
             continue
         done.update(enumerate(docs, first))
         while next_out in done:
             yield done.pop(next_out)
             next_out += 1
+        if not ordered and next_out >= ordered_head:  # the head is out: the rest as it
+            for index in sorted(done):  # comes
+                yield done.pop(index)

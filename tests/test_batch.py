@@ -736,3 +736,147 @@ def test_the_schema_test_can_fail():
     assert not schema.is_valid(good.replace('time="0.5">', 'time="0.123456">'))
     assert not schema.is_valid(good.replace('<testcase name="c"', '<testcase file="f" name="c"'))
     assert not schema.is_valid(good.replace('failures="0"', 'failures="-1"'))
+
+
+# -- issue 32: the parent cuts the stream, the workers read, check and format ------------
+
+#: past api.LOOKAHEAD (the documents parsed up front), where the workers read the spans
+MIXED_COUNT = 130
+BAD_AT = 110  # a document whose YAML is broken
+REPEATED_AT = 120  # a name used before (by the document at 7)
+QUOTED_AT = 115  # a quoted name: the quick scan leaves it to YAML, in the parent
+
+
+def _mixed_stream(path):
+    """MIXED_COUNT straight-line documents (cheap to certify) with a broken one, a repeated
+    name and a quoted name past the first api.LOOKAHEAD; each document 8 lines long."""
+    docs = []
+    for i in range(MIXED_COUNT):
+        name = {REPEATED_AT: "line-7", QUOTED_AT: f'"line {i}"'}.get(i, f"line-{i}")
+        z = "[1" if i == BAD_AT else "1"  # an unclosed flow sequence: not YAML
+        docs.append(f"---\nname: {name}\nparameter: t\nrange: [0, 1]\npose:\n"
+                    f"  x: {i % 7}/10 + t/{i % 5 + 2}\n  y: {i % 3 + 1}/4\n  z: {z}\n")
+    path.write_text("".join(docs))
+    return path
+
+
+def test_the_quick_scan_cuts_what_yaml_reads(tmp_path):
+    """read_documents(spans=True): the same documents, numbers, lines and names as the
+    composed reading; plain names are spans (a regular file's byte range, standard
+    input's bytes), and each span composes to the composed reading's document."""
+    from singcheck.spec.files import Document, Span, read_documents
+
+    stream = _mixed_stream(tmp_path / "mixed.yaml")
+    composed = list(read_documents([stream]))
+    scanned = list(read_documents([stream], spans=True))
+    assert len(scanned) == len(composed) == MIXED_COUNT
+    for i, (s, c) in enumerate(zip(scanned, composed, strict=True)):
+        assert (s.path, s.number, s.line) == (c.path, c.number, c.line), i
+        # the broken one: the scan reads its name line, YAML reads no name
+        assert s.name == (f"line-{BAD_AT}" if i == BAD_AT else c.name), i
+        if i == QUOTED_AT:  # not a plain word: composed here, as before
+            assert isinstance(s, Document) and s.name == f"line {QUOTED_AT}"
+        elif i == REPEATED_AT:  # the repeated name is found by the scan, here
+            assert isinstance(s, Document) and "already used by" in s.error.message
+            assert s.error.message == c.error.message
+        else:
+            assert isinstance(s, Span) and s.source == str(stream) and s.data is None
+            read = s.document()
+            assert (read.text, read.name, read.name_line) == (c.text, c.name, c.name_line)
+            assert (read.error is None) == (c.error is None) == (i != BAD_AT)
+            assert read.label == c.label
+    assert str(scanned[BAD_AT].document().error) == str(composed[BAD_AT].error)
+
+
+def test_a_name_line_that_is_not_the_name_key_is_refused_not_misread(tmp_path):
+    """A line starting with 'name:' inside a multi-line quoted value, the real name given
+    another way: the worker's YAML disagrees with the quick scan, and says so (the name
+    the scan kept for uniqueness would be wrong)."""
+    from singcheck.spec.files import Span, read_documents
+
+    stream = tmp_path / "odd.yaml"
+    stream.write_text('---\n"name": real\ndescription: "two\nname: fake\n  end"\n'
+                      "parameter: t\nrange: [0, 1]\npose:\n  x: t\n  y: 1/4\n  z: 1\n")
+    (span,) = read_documents([stream], spans=True)
+    assert isinstance(span, Span) and span.name == "fake"
+    error = span.document().error
+    assert error is not None and "line 4 reads as the name 'fake'" in error.message
+
+
+def _mixed_run(tmp_path, fmt: str, runner: str, cluster=None):
+    env = {"SINGCHECK_CACHE_DIR": str(tmp_path / "cache")}
+    args = ["run", ORTHO, str(tmp_path / "mixed.yaml"), "--format", fmt, "--backend",
+            "flint", "--no-regions", "-q"]
+    if runner == "dask":
+        args += ["--scheduler", cluster.scheduler_address]
+    else:
+        args += ["--jobs", runner]
+    out = singcheck(*args, env=env)
+    assert out.returncode == 2, out.stderr  # the broken document's outcome: a spec error
+    return out.stdout
+
+
+@pytest.mark.parametrize("runner", ["1", "2", pytest.param("dask", marks=pytest.mark.slow)])
+def test_a_mixed_batch_gives_the_same_results_whatever_runs_it(tmp_path, runner, request,
+                                                               orthoglide_robot):
+    """MIXED_COUNT documents with a broken one, a repeated name and a quoted name past
+    the documents parsed up front: --jobs 1, --jobs 2 and a 2-worker Dask cluster give
+    each path the verdict of api.check, the errors of the composed reading (the
+    stream's lines, the document's number), json in input order and jsonl the same
+    objects (but time_s and the robot)."""
+    from singcheck import api
+    from singcheck.spec.files import read_documents
+
+    stream = _mixed_stream(tmp_path / "mixed.yaml")
+    composed = list(read_documents([stream]))
+    cluster = request.getfixturevalue("local_cluster") if runner == "dask" else None
+    lines = [json.loads(line) for line in
+             _mixed_run(tmp_path, "jsonl", runner, cluster).splitlines()]
+    doc = json.loads(_mixed_run(tmp_path, "json", runner, cluster))["trajectories"]
+    names = [d.label for d in composed]
+    assert names[BAD_AT] == f"{stream}:{8 * BAD_AT + 1}"  # no name read: FILE:LINE
+    assert [d["name"] for d in doc] == names  # input order
+    assert sorted(d["name"] for d in lines) == sorted(names)  # each once, in any order
+    for d in lines:
+        del d["robot"]
+        assert isinstance(d.pop("time_s"), float)
+    assert sorted(json.dumps(d, sort_keys=True) for d in lines) == \
+        sorted(json.dumps(d, sort_keys=True) for d in doc)
+    for i in (BAD_AT, REPEATED_AT):
+        assert doc[i]["verdict"] == "error" and doc[i]["error"]["kind"] == "spec"
+        assert doc[i]["error"]["message"] == str(composed[i].error)
+        assert doc[i]["error"]["message"].endswith(f"(document {i + 1})")
+    assert doc[REPEATED_AT]["error"]["message"].startswith(f"{stream}:{8 * REPEATED_AT + 2}: ")
+    assert f"already used by {stream}:{8 * 7 + 2}" in doc[REPEATED_AT]["error"]["message"]
+    line = int(doc[BAD_AT]["error"]["message"].split(":")[1])
+    assert 8 * BAD_AT + 1 <= line <= 8 * BAD_AT + 9, doc[BAD_AT]  # in (or just past) it
+    expected = [api.check(orthoglide_robot, d.parse(orthoglide_robot.spec),
+                          regions=False).verdict
+                for i, d in enumerate(composed) if i not in (BAD_AT, REPEATED_AT)]
+    assert [d["verdict"] for i, d in enumerate(doc) if i not in (BAD_AT, REPEATED_AT)] == \
+        expected
+
+
+@pytest.mark.parametrize("fmt", ["jsonl", "json"])
+def test_a_bad_document_among_the_first_stops_a_worker_batch(tmp_path, fmt):
+    """--jobs 2 --no-regions: the first documents are parsed by the workers, not up
+    front, and their results held until all are in: a bad one among them still stops the
+    run with exit 2, its located message on one line, nothing on stdout."""
+    good = [f"---\nname: p{i}\nparameter: t\nrange: [0, 1]\npose:\n  x: {i}/5 + t/2\n"
+            "  y: 1/4\n  z: 1\n" for i in range(8)]
+    text = "".join(good[:5]) + "---\nname: bad\nparameter: t\nrange: [0, 1]\npose:\n" \
+        "  x: t\n  y: 0\n  z: sin(t\n" + "".join(good[5:])
+    out = singcheck_in(text, "run", ORTHO, "-", "--backend", "flint", "--no-regions",
+                       "--jobs", "2", "--format", fmt,
+                       env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert out.returncode == 2, out.stderr
+    assert out.stdout == ""
+    line = len("".join(good[:5]).splitlines()) + 8
+    assert out.stderr.startswith(f"singcheck: error: <stdin>:{line}: pose.z:")
+    assert out.stderr.rstrip().endswith("(document 6)") and out.stderr.count("\n") == 1
+    fine = singcheck_in("".join(good), "run", ORTHO, "-", "--backend", "flint",
+                        "--no-regions", "--jobs", "2", "--format", "jsonl",
+                        env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
+    assert fine.returncode in (0, 1), fine.stderr
+    assert [json.loads(x)["name"] for x in fine.stdout.splitlines()] == \
+        [f"p{i}" for i in range(8)]  # the first documents' results in input order

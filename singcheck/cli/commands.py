@@ -192,7 +192,8 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     trajectory may also be a CSV table of poses).  A YAML file may hold several
     trajectories as documents separated by ---; their names must be unique in a run.
     They are read one at a time as the batch goes, so memory stays flat: a bad one
-    among the first 100 stops the run at once, a later one is that trajectory's error.
+    among the first 100 stops the run (before anything is written), a later one is that
+    trajectory's error.
 
     For every trajectory it prints the candidate singular times (certified
     enclosures of the roots of μ(t)), the pose and joints there, which working
@@ -329,7 +330,11 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         except SpecError as e:
             fail(e.message, ExitCode.USAGE)
     spec = load_robot(robot)
-    documents = read_documents(trajectories, interpolation, csv=table, all_csv=all_csv)
+    # past the first documents, the workers read and compose each document (spans): this
+    # process only cuts the input into documents and keeps their names (not with
+    # --certificate or --plot, which need every document's text here)
+    documents = read_documents(trajectories, interpolation, csv=table, all_csv=all_csv,
+                               spans=not certificate_dir and not plot_dir)
     # the first documents (all of a small batch) are parsed here, before any work: a bad
     # one stops the run at once (exit 2, one line); past them, the documents are parsed
     # by the workers, and a bad one is that trajectory's result
@@ -340,9 +345,18 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         if robot != "-":
             with open(robot, encoding="utf-8") as f:
                 robot_text = f.read()
-    # (each within its trajectory's time limit: parsing is the first stage of its check)
-    first = [api.parse_within(document, spec, time_limit)
-             for document in islice(documents, api.LOOKAHEAD)]
+    first = list(islice(documents, api.LOOKAHEAD))
+    # a batch for worker processes without the region statement: they parse the first
+    # documents too, and the first results are held until they are all in (an error among
+    # them stops the run then, nothing written); else they are parsed here (the region
+    # maps are prepared from them), each within its trajectory's time limit: parsing is
+    # the first stage of its check
+    held = scheduler is not None or (jobs > 1 and len(first) > 4)
+    held = held and not regions and not certificate_dir and not plot_dir
+    if not held:
+        first = [api.parse_within(document, spec, time_limit) for document in first]
+    else:  # an error among the first documents is then the only line, as before
+        progress.hold()
     total = len(first) if len(first) < api.LOOKAHEAD else None  # None: not known yet
     items = chain(first, documents)
     kept: list = []
@@ -369,6 +383,13 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
                    ordered=fmt != "jsonl", notify=progress.note, engine=certify_with,
                    **selection)
+    if fmt == "jsonl" and not certificate_dir:  # each line written by the worker that
+        # checked its trajectory (a certificate needs the whole object here)
+        from singcheck.report.trajectory import JsonLine, robot_json
+
+        options["line"] = JsonLine(robot_json(projection))
+    if held:
+        options["ordered_head"] = len(first)
     if scheduler:
         from singcheck.cluster import check_on_cluster
 
@@ -379,7 +400,7 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     used: set = set()  # certificate file names written
     with _sink(fmt, output, projection) as sink, progress.bar(total) as advance, \
             closing(batch) as docs:
-        for doc in docs:
+        for doc in _head_checked(docs, len(first) if held else 0, progress):
             sink.add(doc)
             if certificate_dir:
                 _certify(certificate_dir, robot_text, texts, doc, used, progress)
@@ -392,6 +413,28 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         _plot_all(certificates, plot_dir, progress,
                   _clearances(certificates, bool(selection.get("clearance")), gate), gate)
     return code
+
+
+def _head_checked(docs, head: int, progress):
+    """``docs``, the first ``head`` of them (in input order) held until they are all in,
+    and the progress notes with them: a document among them that is no valid trajectory
+    stops the run then (exit 2, its located message the one line on stderr, nothing
+    written), as when they are parsed up front."""
+    held: list = []
+    for doc in docs:
+        if len(held) < head:
+            if doc["verdict"] == "error" and doc["error"]["kind"] == "spec":
+                progress.release(print_them=False)
+                fail(doc["error"]["message"], ExitCode.USAGE)
+            held.append(doc)
+            if len(held) == head:
+                progress.release()
+                yield from held
+            continue
+        yield doc
+    progress.release()
+    if len(held) < head:  # a batch of fewer results than documents: cannot be
+        yield from held
 
 
 def _texts_kept(documents, texts: dict):
@@ -457,22 +500,23 @@ class _Sink:
     """Where results go: kept for the end (table, json, junit), or streamed (jsonl)."""
 
     def __init__(self, fmt: str, out, projection) -> None:
-        from singcheck.report.trajectory import robot_json
+        from singcheck.report.trajectory import JsonLine, robot_json
 
         self.fmt, self.out, self.projection = fmt, out, projection
-        self.robot = robot_json(projection)
+        self.line = JsonLine(robot_json(projection))
         self.results: list[dict] = []
 
-    def add(self, doc: dict) -> None:
-        seconds = doc.pop("time_s", None)  # JUnit's time, and each jsonl line's
-        if self.fmt in ("junit", "jsonl"):
-            doc["time_s"] = seconds
-        if self.fmt != "jsonl":
+    def add(self, doc) -> None:
+        """One result: a trajectory object, or a :class:`singcheck.api.Formatted` whose
+        jsonl line a worker wrote."""
+        if self.fmt == "jsonl":
+            line = doc.line if hasattr(doc, "line") else self.line(doc)
+        else:
+            seconds = doc.pop("time_s", None)  # JUnit's time
+            if self.fmt == "junit":
+                doc["time_s"] = seconds
             self.results.append(doc)
             return
-        import json
-
-        line = json.dumps({**doc, "robot": self.robot}, ensure_ascii=False) + "\n"
         with _signals_held():  # a line is written whole, or not at all
             self.out.write(line)
             self.out.flush()

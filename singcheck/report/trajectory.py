@@ -242,6 +242,22 @@ def to_json(doc: dict[str, Any]) -> str:
     return json.dumps(doc, indent=2, ensure_ascii=False) + "\n"
 
 
+class JsonLine:
+    """The ``--format jsonl`` line of a trajectory object: the object with its
+    ``time_s`` last, then the robot (``robot``: :func:`robot_json`).  Picklable, so
+    that the worker that checked a trajectory writes its line
+    (:class:`singcheck.api.Formatted`)."""
+
+    def __init__(self, robot: dict[str, Any]) -> None:
+        self.robot = robot
+
+    def __call__(self, doc: dict[str, Any]) -> str:
+        doc = dict(doc)
+        doc["time_s"] = doc.pop("time_s", None)
+        doc["robot"] = self.robot
+        return json.dumps(doc, ensure_ascii=False) + "\n"
+
+
 def _modes_table(working_modes: list[dict[str, Any]], joints: list[str], verbose: bool):
     """The working modes of one trajectory: status, joints at the start, singular times
     and why (more than eight modes: the infeasible ones only with ``verbose``)."""

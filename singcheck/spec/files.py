@@ -43,7 +43,7 @@ from singcheck.spec.trajectory import (
 
 __all__ = ["RobotSpec", "TrajectorySpec", "load_robot", "load_trajectory",
            "load_trajectories", "parse_robot", "parse_trajectory", "parse_trajectories",
-           "Document", "read_documents"]
+           "Document", "Span", "read_documents"]
 
 ROBOT_KEYS = {"name": True, "description": False, "joints": True, "pose": True,
               "parameters": False, "constraints": True, "joint_limits": False,
@@ -597,6 +597,9 @@ class Document:
     name_line: int | None = None
     csv: CsvFormat | str | None = None  # a CSV table: how to read it (or its interpolation)
     error: SpecError | None = None
+    #: its node tree when it was composed where it is parsed (a worker), so that it is
+    #: not composed twice
+    node: object = field(default=None, compare=False, repr=False)
 
     @property
     def label(self) -> str:
@@ -611,7 +614,9 @@ class Document:
         if self.csv is not None:
             return parse_csv(self.text, self.path, robot, self.csv, self.name)
         try:
-            return _trajectory(_compose(self.text, self.path, self.line), self.path, robot)
+            node = self.node if self.node is not None else \
+                _compose(self.text, self.path, self.line)
+            return _trajectory(node, self.path, robot)
         except SpecError as e:
             if _looks_like_csv(self.text):
                 e = SpecError(f"{e.message} (is it a CSV table of poses? name it *.csv or "
@@ -623,6 +628,63 @@ class Document:
             return e
         return SpecError(f"{e.message} (document {self.number})", path=e.path, line=e.line,
                          key=e.key)
+
+
+@dataclass(frozen=True)
+class Span:
+    """One YAML document of a batch's input as the parent of the batch sees it: where its
+    bytes are, and its name read by a quick scan of its lines, not by YAML (a top-level
+    ``name:`` line with a plain word, :func:`read_documents` with ``spans``).  The worker
+    that certifies it reads it (:meth:`document`): from ``data``, or from ``source`` by
+    its byte range (a regular file), and composes it, once."""
+
+    path: str  # as messages name it (<stdin> for standard input)
+    number: int
+    line: int
+    name: str
+    name_line: int
+    source: str | None  # a regular file to read the byte range from, else ``data``
+    offset: int
+    length: int
+    data: bytes | None = None
+
+    @property
+    def label(self) -> str:
+        return self.name
+
+    def head(self) -> Document:
+        """A :class:`Document` that names it (path, number, lines), without its text."""
+        return Document(self.path, self.number, self.line, "", self.name, self.name_line)
+
+    def loaded(self) -> Span:
+        """This span with its bytes in ``data`` (to send it where ``source`` is not)."""
+        return self if self.data is not None else replace(self, data=self._read())
+
+    def _read(self) -> bytes:
+        with open(self.source, "rb") as f:
+            data = os.pread(f.fileno(), self.length, self.offset)
+        if len(data) != self.length:
+            raise OSError(f"{self.path} changed while the batch read it")
+        return data
+
+    def document(self, limit: int = MAX_BYTES) -> Document:
+        """The document, composed (its node kept for its parsing); the error of one that
+        cannot be read, or whose name is not the one the quick scan read."""
+        head = self.head()
+        try:
+            data = self.data if self.data is not None else self._read()
+        except OSError as e:
+            return replace(head, error=SpecError(f"cannot read the file: {e.strerror or e}",
+                                                 path=self.path, line=self.line))
+        document = _document(self.path, self.number, self.line, data, limit, keep_node=True)
+        if document is None or (document.error is None and (
+                document.name, document.name_line) != (self.name, self.name_line)):
+            return replace(head, error=head.located(SpecError(
+                f"line {self.name_line} reads as the name {self.name!r}, but it is not the "
+                "document's top-level name key (a line starting with 'name:' inside a "
+                "multi-line value): indent it, or put the name key first",
+                path=self.path, line=self.name_line, key="name")))
+        return document
 
 
 def _looks_like_csv(text: str) -> bool:
@@ -644,8 +706,23 @@ def _chunks(stream, limit: int) -> Iterator[tuple[int, bytes | None]]:
     document ends where the next ``---`` starts or at ``...``; comments and directives
     before a ``---`` go with its document.  A document over ``limit`` bytes is (line,
     None), skipped without being held."""
+    for start, _, data, _ in _cuts(stream, limit):
+        yield start, data
+
+
+#: a top-level ``name:`` line whose value is a plain word (what a quick scan can read
+#: without YAML: :func:`scan_documents`)
+_NAME_LINE = re.compile(rb"name:[ \t]+([A-Za-z0-9_][A-Za-z0-9_.+-]*)[ \t]*(?:#.*)?\r?\n?\Z")
+
+
+def _cuts(stream, limit: int) -> Iterator[tuple[int, int, bytes | None, list]]:
+    """:func:`_chunks` with, for each document, its byte offset in the stream and the
+    lines (number, line) that start with ``name:``; the marker line of a document that
+    starts with ``---`` is its first."""
     lines: list[bytes] = []
+    names: list[tuple[int, bytes]] = []
     size, start, number, content, too_big = 0, 1, 0, False, False
+    offset = position = 0
     while True:
         line = stream.readline(limit + 1)
         if not line:
@@ -653,8 +730,12 @@ def _chunks(stream, limit: int) -> Iterator[tuple[int, bytes | None]]:
         number += 1
         start_marker = _is_marker(line, b"---")
         if start_marker and content:
-            yield start, None if too_big else b"".join(lines)
-            lines, size, start, content, too_big = [], 0, number, False, False
+            yield start, offset, None if too_big else b"".join(lines), names
+            lines, names, size, start, content, too_big = [], [], 0, number, False, False
+            offset = position
+        position += len(line)
+        if line.startswith(b"name:"):
+            names.append((number, line))
         if not too_big:
             size += len(line)
             too_big = size > limit
@@ -668,10 +749,11 @@ def _chunks(stream, limit: int) -> Iterator[tuple[int, bytes | None]]:
             content = True
         if _is_marker(line, b"..."):
             if content:
-                yield start, None if too_big else b"".join(lines)
-            lines, size, start, content, too_big = [], 0, number + 1, False, False
+                yield start, offset, None if too_big else b"".join(lines), names
+            lines, names, size, start, content, too_big = [], [], 0, number + 1, False, False
+            offset = position
     if content:
-        yield start, None if too_big else b"".join(lines)
+        yield start, offset, None if too_big else b"".join(lines), names
 
 
 def _documents(stream, path: str, limit: int = MAX_BYTES) -> Iterator[Document]:
@@ -681,30 +763,10 @@ def _documents(stream, path: str, limit: int = MAX_BYTES) -> Iterator[Document]:
     number = 0
     try:
         for first, data in _chunks(stream, limit):
-            document = Document(path, number + 1, first, "")
-            if data is None:
+            document = _document(path, number + 1, first, data, limit)
+            if document is not None:  # None: an empty document (comments, a stray ---)
                 number += 1
-                yield replace(document, error=document.located(SpecError(
-                    f"the document is larger than {limit} bytes", path=path, line=first)))
-                continue
-            try:
-                text = data.decode("utf-8")
-            except UnicodeDecodeError as e:
-                number += 1
-                line = first + data[: e.start].count(b"\n")
-                yield replace(document, error=document.located(SpecError(
-                    "the file is not UTF-8 text", path=path, line=line)))
-                continue
-            try:
-                node = _compose(text, path, first, empty_ok=True)
-            except SpecError as e:
-                number += 1
-                yield replace(document, text=text, error=document.located(e))
-                continue
-            if node is None:  # an empty document (comments only, or a stray ---)
-                continue
-            number += 1
-            yield replace(document, text=text, **_name(node))
+                yield document
     except OSError as e:
         yield Document(path, number + 1, 1, "", error=SpecError(
             f"cannot read the file: {e.strerror or e}", path=path))
@@ -712,6 +774,71 @@ def _documents(stream, path: str, limit: int = MAX_BYTES) -> Iterator[Document]:
     if number == 0:
         yield Document(path, 1, 1, "", error=SpecError("the file is empty", path=path,
                                                         line=1))
+
+
+def _spans(stream, path: str, source: str | None,
+           limit: int = MAX_BYTES) -> Iterator[Document | Span]:
+    """:func:`_documents`, but a document with one ``name: WORD`` line (and nothing after
+    its ``---``) is a :class:`Span`, not composed: its bytes (``source`` None) or its
+    byte range in the file ``source``."""
+    number = 0
+    try:
+        for first, offset, data, names in _cuts(stream, limit):
+            match = _NAME_LINE.match(names[0][1]) if data is not None and \
+                len(names) == 1 else None
+            if match and _bare_marker(data):
+                number += 1
+                yield Span(path, number, first, match.group(1).decode(), names[0][0], source,
+                           offset, len(data), None if source else data)
+                continue
+            document = _document(path, number + 1, first, data, limit)
+            if document is not None:
+                number += 1
+                yield document
+    except OSError as e:
+        yield Document(path, number + 1, 1, "", error=SpecError(
+            f"cannot read the file: {e.strerror or e}", path=path))
+        return
+    if number == 0:
+        yield Document(path, 1, 1, "", error=SpecError("the file is empty", path=path,
+                                                        line=1))
+
+
+def _bare_marker(data: bytes) -> bool:
+    """No node on a document's ``---`` line (``--- |`` would make the rest a scalar)."""
+    for line in data.split(b"\n", 20):
+        if _is_marker(line + b"\n", b"---"):
+            rest = line[3:].strip()
+            return not rest or rest.startswith(b"#")
+        if line.strip() and not line.lstrip().startswith(b"#") and \
+                not line.startswith(b"%"):
+            return True  # content before any marker: no --- line
+    return False
+
+
+def _document(path: str, number: int, first: int, data: bytes | None,
+              limit: int = MAX_BYTES, keep_node: bool = False) -> Document | None:
+    """One document of a stream, ``number`` of its file, its text starting at line
+    ``first`` (``data`` None: it was over ``limit`` bytes), composed to read its name
+    (the node kept in the document with ``keep_node``, for its parsing); None when it
+    is empty.  One that cannot be read has its ``error``."""
+    document = Document(path, number, first, "")
+    if data is None:
+        return replace(document, error=document.located(SpecError(
+            f"the document is larger than {limit} bytes", path=path, line=first)))
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        line = first + data[: e.start].count(b"\n")
+        return replace(document, error=document.located(SpecError(
+            "the file is not UTF-8 text", path=path, line=line)))
+    try:
+        node = _compose(text, path, first, empty_ok=True)
+    except SpecError as e:
+        return replace(document, text=text, error=document.located(e))
+    if node is None:
+        return None
+    return replace(document, text=text, node=node if keep_node else None, **_name(node))
 
 
 def _name(node) -> dict:
@@ -725,15 +852,18 @@ def _name(node) -> dict:
 
 
 def read_documents(paths: Iterable[str | os.PathLike], interpolation: str | None = None,
-                   *, csv: CsvFormat | None = None, all_csv: bool = False
-                   ) -> Iterator[Document]:
+                   *, csv: CsvFormat | None = None, all_csv: bool = False,
+                   spans: bool = False) -> Iterator[Document | Span]:
     """Every trajectory of the files, lazily, as :class:`Document` (a YAML file, or
     ``-``, standard input, holds one or more documents; a CSV file one table), read one
     at a time: memory does not grow with the number of trajectories but for their
     names, which must be unique in a run (a repeated one is that document's error).
     A file that cannot be opened, or ``-`` given twice, is refused here, at once.
     ``csv``: how CSV tables are read (``*.csv`` files; with ``all_csv``, every input,
-    standard input too)."""
+    standard input too).  With ``spans``, a YAML document whose name a quick scan of its
+    lines reads (a ``name: WORD`` line, once) is a :class:`Span`, not composed here:
+    the worker that certifies it composes it (the parent of a batch only cuts the
+    stream into documents and keeps the names)."""
     paths = [os.fspath(p) for p in paths]
     if paths.count(STDIN) > 1:
         raise SpecError("standard input (-) is given twice", path=STDIN)
@@ -744,12 +874,12 @@ def read_documents(paths: Iterable[str | os.PathLike], interpolation: str | None
                     pass
             except OSError as e:
                 raise SpecError(f"cannot read the file: {e.strerror or e}", path=path) from None
-    return _unique(_all_documents(paths, interpolation, csv, all_csv))
+    return _unique(_all_documents(paths, interpolation, csv, all_csv, spans))
 
 
 def _all_documents(paths: list[str], interpolation: str | None,
-                   table: CsvFormat | None = None, all_csv: bool = False
-                   ) -> Iterator[Document]:
+                   table: CsvFormat | None = None, all_csv: bool = False,
+                   spans: bool = False) -> Iterator[Document | Span]:
     for path in paths:
         if all_csv or path.lower().endswith(".csv"):
             stdin = path == STDIN
@@ -762,7 +892,8 @@ def _all_documents(paths: list[str], interpolation: str | None,
                 yield replace(document, error=e)
             continue
         if path == STDIN:
-            yield from _documents(sys.stdin.buffer, STDIN_NAME)
+            yield from (_spans(sys.stdin.buffer, STDIN_NAME, None) if spans else
+                        _documents(sys.stdin.buffer, STDIN_NAME))
             continue
         try:
             stream = open(path, "rb")
@@ -771,7 +902,13 @@ def _all_documents(paths: list[str], interpolation: str | None,
                 f"cannot read the file: {e.strerror or e}", path=path))
             continue
         with stream:
-            yield from _documents(stream, path)
+            if not spans:
+                yield from _documents(stream, path)
+                continue
+            import stat
+
+            regular = stat.S_ISREG(os.fstat(stream.fileno()).st_mode)
+            yield from _spans(stream, path, path if regular else None)
 
 
 def _unique(documents: Iterator[Document]) -> Iterator[Document]:
@@ -780,8 +917,10 @@ def _unique(documents: Iterator[Document]) -> Iterator[Document]:
     seen: dict[str, tuple[str, int | None]] = {}
     for document in documents:
         name = document.name
-        if document.error is None and name is not None:
+        if getattr(document, "error", None) is None and name is not None:
             if name in seen:
+                if isinstance(document, Span):
+                    document = document.head()
                 path, line = seen[name]
                 document = replace(document, error=document.located(SpecError(
                     f"trajectory name {name!r} is already used by {path}:{line or '?'} "

@@ -709,7 +709,8 @@ def main() -> None:
     print_batch(batch)
     results["scaling"] = scaling = scaling_rows(*SCALING)
     print_scaling(scaling)
-    from user_inputs import print_rows, rows as input_rows
+    from user_inputs import print_rows
+    from user_inputs import rows as input_rows
 
     results["user_inputs"] = inputs = input_rows()
     print_rows(inputs)

@@ -388,3 +388,29 @@ def test_an_expression_path_crosses_a_process_boundary(tmp_path):
     assert out.stdout.split()[0] == here.verdict == "singular"
     assert out.stdout.strip().endswith(str([round(float(x.t.mid()), 6)
                                             for x in here.candidates]))
+
+
+def test_prismatic_limits_as_any_real_number(tmp_path):
+    """Orthoglide limits [0, 2√2], [0, π], [1/2, 4]: along heart 1, mode +++'s ρ₁ =
+    x + √(4 − y² − z²) passes 2√2 near t = π/2 (oracle at 50 digits), so the mode is
+    proven infeasible there by ball arithmetic, naming the limit. The region statement is
+    not made (no algebraic limit surface)."""
+    text = open("robots/orthoglide.yaml").read().replace(
+        "joint_limits: {rho1: [0, 4], rho2: [0, 4], rho3: [0, 4]}",
+        "joint_limits: {rho1: [0, 2*sqrt(2)], rho2: [0, pi], rho3: [0.5, 4]}")
+    robot_file = tmp_path / "orthoglide-real.yaml"
+    robot_file.write_text(text)
+    robot = load_robot(str(robot_file), backend="flint", cache=False)
+    mp.mp.dps = 50
+
+    def rho1(t):
+        x = mp.mpf(8) / 7 * mp.sin(t) ** 3
+        y = (mp.mpf(13) / 14 * mp.cos(t) - mp.mpf(5) / 14 * mp.cos(2 * t)
+             - mp.cos(3 * t) / 10 - mp.cos(4 * t) / 14)
+        return x + mp.sqrt(4 - y * y - 1)
+
+    assert rho1(mp.pi / 2) > 2 * mp.sqrt(2)
+    heart1 = check(robot, load_trajectory("trajectories/heart1.yaml", robot))
+    mode = next(m for m in heart1.certificate.modes if m.label == "+++")
+    assert mode.status == "infeasible" and "2*sqrt(2)" in mode.reason
+    assert heart1.workspace is None

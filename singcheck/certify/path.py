@@ -443,7 +443,8 @@ def limit_balls(limits) -> tuple[arb, arb]:
     if hit is None or hit[0] is not limits:  # the entry holds limits: its id is not reused
         if len(_LIMIT_BALLS) > 256:
             _LIMIT_BALLS.clear()
-        hit = _LIMIT_BALLS[key] = (limits, tuple(fraction_ball(v) for v in limits))
+        hit = _LIMIT_BALLS[key] = (limits, tuple(
+            v.ball() if hasattr(v, "ball") else fraction_ball(v) for v in limits))
     return hit[1]
 
 

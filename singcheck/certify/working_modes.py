@@ -25,6 +25,7 @@ Whatever cannot be proven makes the branch ``unknown``, with the reason.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from fractions import Fraction
 from functools import cached_property
 from itertools import product
 
@@ -388,7 +389,9 @@ def _exact_limits_unavailable(leg: LegAlongPath, limits) -> bool:
 
     if leg._composer.opaque:  # (read from the path: composing nothing)
         return True
-    return leg.revolute and not all(exact_angle_limit(v) for v in limits)
+    if not leg.revolute:
+        return not all(isinstance(v, Fraction) for v in limits)  # 2*sqrt(2), pi
+    return not all(exact_angle_limit(v) for v in limits)
 
 
 #: evaluations per 2π an interval-only feasibility proof may spend (a leg's branch)

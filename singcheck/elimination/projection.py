@@ -19,6 +19,7 @@ the joints along its own path instead (:func:`singcheck.certify.path.eliminate_a
 from __future__ import annotations
 
 from dataclasses import dataclass
+from fractions import Fraction
 from functools import cached_property
 from math import comb
 
@@ -170,10 +171,18 @@ def workspace_boundary(model: RobotModel, pose_ctx: fmpq_mpoly_ctx) -> tuple[fmp
 def transcendental_limits(model: RobotModel) -> str:
     """Which angle limits have no algebraic cos and sin ("" when none): with them the
     joint-limit surfaces are not algebraic, so no region statement is made."""
-    found = [f"{leg.joint} {value}" for leg in model.legs if leg.kind == REVOLUTE
+    found = [f"{leg.joint} {value}" for leg in model.legs
              for value in model.spec.joint_limits.get(leg.joint, ())
-             if not exact_angle_limit(value)]
+             if not algebraic_limit(leg, value)]
     return ", ".join(found)
+
+
+def algebraic_limit(leg, value) -> bool:
+    """Whether the limit's surface is algebraic over Q: a rational prismatic limit, an
+    angle limit qπ with 12q an integer."""
+    if leg.kind == REVOLUTE:
+        return exact_angle_limit(value)
+    return isinstance(value, Fraction)
 
 
 def exact_angle_limit(value) -> bool:
@@ -220,7 +229,7 @@ def joint_limit_surfaces(model: RobotModel, pose_ctx) -> tuple[JointLimitSurface
         if limits is None:
             continue
         for bound, value in zip(("min", "max"), limits, strict=True):
-            if leg.kind == REVOLUTE and not exact_angle_limit(value):
+            if not algebraic_limit(leg, value):
                 continue  # not algebraic: the region statement is refused for this robot
             try:
                 poly = norm_radicals(limit_constraint(model, leg, value))

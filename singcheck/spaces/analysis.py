@@ -147,11 +147,17 @@ def refuse_transcendental_limits(model: RobotModel) -> None:
     """Regions need the joint-limit surfaces as polynomials: an angle limit whose cos
     and sin are not algebraic (not a multiple of π/12) is refused with the reason (the
     trajectory check takes it, by ball arithmetic)."""
-    from singcheck.elimination.projection import angle_limit_values, exact_angle_limit
+    from singcheck.elimination.projection import algebraic_limit, angle_limit_values
 
     for leg in model.legs:
         for value in model.spec.joint_limits.get(leg.joint, ()):
-            if leg.kind == REVOLUTE and not exact_angle_limit(value):
+            if leg.kind != REVOLUTE and not algebraic_limit(leg, value):
+                raise UnsupportedRobotError(
+                    f"the limit {value} of joint {leg.joint} is not rational: regions need "
+                    "algebraic limit surfaces (`singcheck run` takes it)",
+                    path=model.spec.path, line=model.spec.lines.get("joint_limits"),
+                    key=f"joint_limits.{leg.joint}")
+            if leg.kind == REVOLUTE and not algebraic_limit(leg, value):
                 try:
                     angle_limit_values(leg.joint, value)
                 except UnsupportedRobotError as e:
@@ -214,6 +220,7 @@ def jointspace_variety(model: RobotModel, backend,
     from singcheck.algebra.radicals import reduce_relations
 
     refuse_jointspace(model)
+    refuse_transcendental_limits(model)
     chart = space_chart(model, JOINTSPACE)
     out = []
     for leg in model.legs:

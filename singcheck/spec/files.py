@@ -23,6 +23,7 @@ from singcheck.errors import SpecError
 from singcheck.spec.grammar import (
     Constant,
     ExprError,
+    RealLimit,
     angles_in,
     compile_constant,
     compile_polynomial,
@@ -192,6 +193,18 @@ class _Doc:
         if value.pi_coefficient:
             raise self.error(node, key, f"must be an exact rational number, not {text!r}")
         return value.rational
+
+    def limit(self, node, key: str) -> Fraction | RealLimit:
+        """A prismatic joint's limit: a Fraction when rational, else any exact real
+        (``2*sqrt(2)``, ``pi``) as a :class:`RealLimit`."""
+        text = self.text(node, key)
+        try:
+            value = compile_value(parse(text), {})
+        except (ExprError, ValueError, ZeroDivisionError) as e:
+            raise self.error(node, key, f"{e} in {_excerpt(text)}") from None
+        if not value.pi_coefficient and value.surd.is_rational():
+            return value.surd.rational_value()
+        return RealLimit(value, text)
 
     def value(self, node, key: str, parameters: dict) -> Fraction | Constant:
         """A parameter's exact value: a Fraction when rational, else a Constant."""
@@ -420,8 +433,8 @@ def parse_robot(text: str, path: str) -> RobotSpec:
                 if not exactly_less(lo, hi):
                     raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
             else:
-                lo, hi = (doc.number(v, key) for v in vnode.value)
-                if not lo < hi:
+                lo, hi = (doc.limit(v, key) for v in vnode.value)
+                if not _below(lo, hi):
                     raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
             limits[jname] = (lo, hi)
     final = dict(zip(ctx.names(), ctx.gens(), strict=True))
@@ -433,6 +446,27 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     return RobotSpec(path, name, description, joints, pose, parameters, ctx,
                      tuple(constraints), tuple(constraint_lines), limits, lines,
                      angles=angles, radicals=used, drawing=drawing, clearance_length=length)
+
+
+def _below(lo, hi) -> bool:
+    """lo < hi for rational or :class:`RealLimit` values, proven (by balls at rising
+    precision for a real one; equal reals are never proven below each other)."""
+    if isinstance(lo, Fraction) and isinstance(hi, Fraction):
+        return lo < hi
+    from flint import arb, fmpq
+
+    from singcheck.algebra.intervals import working_precision
+
+    def ball(v):
+        return v.ball() if isinstance(v, RealLimit) else arb(fmpq(v.numerator, v.denominator))
+
+    for bits in (64, 256, 1024):
+        with working_precision(bits):
+            if ball(lo) < ball(hi):
+                return True
+            if ball(lo) >= ball(hi):
+                return False
+    return False
 
 
 def _clearance_length(doc: _Doc, node) -> Fraction:

@@ -308,6 +308,31 @@ class Constant:
         return " + ".join(parts)
 
 
+@dataclass(frozen=True)
+class RealLimit:
+    """A prismatic joint's limit that is not rational (``2*sqrt(2)``, ``pi``): an exact
+    real ``surd + pi_coefficient·π``, compared by ball arithmetic only (its crossings are
+    never isolated exactly; :mod:`singcheck.certify.working_modes`)."""
+
+    value: Constant
+    text: str
+
+    def ball(self):
+        from flint import arb, fmpq
+
+        out = self.value.surd.ball()
+        q = self.value.pi_coefficient
+        if q:
+            out += arb.pi() * arb(fmpq(q.numerator, q.denominator))
+        return out
+
+    def __float__(self) -> float:
+        return float(self.value.surd) + float(self.value.pi_coefficient) * 3.141592653589793
+
+    def __str__(self) -> str:
+        return self.text
+
+
 def _exponent(node: Node, value) -> int:
     if not isinstance(value, Fraction) or value.denominator != 1 or value < 0:
         raise ExprError("exponents must be non-negative integers", node.column)

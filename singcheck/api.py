@@ -426,9 +426,9 @@ def _check_chunk(chunk: list) -> list[dict | Formatted]:
 @dataclass(frozen=True)
 class Formatted:
     """One trajectory's result as the worker that checked it wrote it (a batch with a
-    ``line`` format): the line, and the few keys that its reader reads (``name``,
-    ``verdict`` and, for an error, ``error.kind`` and ``error.message``), so that the
-    process that gathers a batch neither pickles whole reports back nor formats them."""
+    ``line`` format): the line, and the few keys that its reader counts (``name``,
+    ``verdict`` and, for an error, ``error.kind``), so that the process that gathers a
+    batch neither pickles whole reports back nor formats them."""
 
     summary: dict
     line: str
@@ -446,7 +446,7 @@ def formatted(doc: dict, line: Callable[[dict], str] | None) -> dict | Formatted
         return doc
     summary = {"name": doc["name"], "verdict": doc["verdict"]}
     if "error" in doc:
-        summary["error"] = {"kind": doc["error"]["kind"], "message": doc["error"]["message"]}
+        summary["error"] = {"kind": doc["error"]["kind"]}
     return Formatted(summary, line(doc))
 
 
@@ -558,7 +558,7 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
                 time_limit: float | None = DEFAULT_TIME_LIMIT, jobs: int = 1,
                 ordered: bool = True, notify: Notify = _quiet,
                 engine: str = "auto", line: Callable[[dict], str] | None = None,
-                ordered_head: int = 0, **selection) -> Iterator[dict | Formatted]:
+                **selection) -> Iterator[dict | Formatted]:
     """Certify many trajectories, in ``jobs`` forked processes when there are more than 4;
     yields each one's JSON trajectory object as soon as it is known: in input order, or
     (``ordered=False``) in the order they finish.
@@ -576,9 +576,7 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
     :class:`~singcheck.report.trajectory.JsonLine`): each result is instead a
     :class:`Formatted`, the line written by the worker that checked it; with
     :class:`~singcheck.spec.files.Span` items (``read_documents(…, spans=True)``) this
-    process then only cuts the input into documents and writes the lines.
-    ``ordered_head``: the first that many results come in input order even when not
-    ``ordered`` (so that a caller can hold them until it knows them all)."""
+    process then only cuts the input into documents and writes the lines."""
     from itertools import chain, islice
 
     options = dict(tolerance=tolerance, regions=regions, time_limit=time_limit,
@@ -587,16 +585,14 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
     head = list(islice(items, LOOKAHEAD))
     if jobs > 1 and len(head) > 4:
         shared_regions(robot, head, options, notify)
-        yield from _forked(robot, chain(head, items), options, jobs, ordered, line,
-                           ordered_head)
+        yield from _forked(robot, chain(head, items), options, jobs, ordered, line)
         return
     for item in chain(head, items):
         yield formatted(check_item(robot, item, **options), line)
 
 
 def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
-            line: Callable[[dict], str] | None = None,
-            ordered_head: int = 0) -> Iterator[dict | Formatted]:
+            line: Callable[[dict], str] | None = None) -> Iterator[dict | Formatted]:
     """The batch in ``jobs`` forked workers, CHUNK trajectories per task and
     TASKS_PER_WORKER tasks per worker in flight: a finished task is replaced by the next
     one read (before its results are yielded), so at most that many trajectories are
@@ -690,7 +686,7 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
                 results += rerun(*lost.popleft())
             while not lost and len(in_flight) < jobs * TASKS_PER_WORKER and submit():
                 pass
-            if not ordered and next_out >= ordered_head:
+            if not ordered:
                 for _, doc in results:
                     yield doc
                 continue
@@ -698,9 +694,6 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
             while next_out in done_early:
                 yield done_early.pop(next_out)
                 next_out += 1
-            if not ordered and next_out >= ordered_head:  # the head is out: the rest
-                for index in sorted(done_early):  # as it comes
-                    yield done_early.pop(index)
     finally:
         _WORKER.clear()
         _stop(pool)

@@ -92,14 +92,14 @@ def check_on_cluster(address: str, robot: Robot,
                      tolerance: float = DEFAULT_TOLERANCE, regions: bool = True,
                      time_limit: float | None = DEFAULT_TIME_LIMIT, ordered: bool = True,
                      notify: Notify = _quiet, engine: str = "auto", line=None,
-                     ordered_head: int = 0, **selection) -> Iterator[dict | Formatted]:
+                     **selection) -> Iterator[dict | Formatted]:
     """:func:`singcheck.api.check_batch` on the dask.distributed scheduler at
     ``address``: yields each trajectory's JSON object in input order, or
     (``ordered=False``) as the tasks finish.  ``trajectories`` is read lazily, a bounded
     number of tasks ahead.  Stopping the iteration (Ctrl-C) cancels the tasks still
-    queued.  ``line`` and ``ordered_head``: as for :func:`~singcheck.api.check_batch`
-    (the workers write each result's line); a :class:`~singcheck.spec.files.Span`
-    travels with its bytes (a cluster's workers need not see this machine's files)."""
+    queued.  ``line``: as for :func:`~singcheck.api.check_batch`, the workers write each
+    result's line; a :class:`~singcheck.spec.files.Span` travels with its bytes (a
+    cluster's workers need not see this machine's files)."""
     from itertools import chain, islice
 
     from singcheck.algebra.pickling import register
@@ -123,7 +123,7 @@ def check_on_cluster(address: str, robot: Robot,
         size = CHUNK if len(head) == LOOKAHEAD else max(1, min(CHUNK, -(-len(head) // window)))
         yield from _results(_Submitter(client, shipped, chain(head, items), options,
                                        robot.region_cache is not None, window, size, line,
-                                       threads), ordered, ordered_head)
+                                       threads), ordered)
     finally:
         client.close()  # the tasks still queued or running are cancelled with it
 
@@ -184,7 +184,7 @@ class _Submitter:
 _END = object()
 
 
-def _results(tasks: _Submitter, ordered: bool, ordered_head: int = 0) -> Iterator[dict]:
+def _results(tasks: _Submitter, ordered: bool) -> Iterator[dict]:
     from singcheck.report.trajectory import error_json
 
     done: dict[int, dict] = {}
@@ -200,13 +200,10 @@ def _results(tasks: _Submitter, ordered: bool, ordered_head: int = 0) -> Iterato
                     for item in chunk]
         future.release()
         tasks.next()
-        if not ordered and next_out >= ordered_head:
+        if not ordered:
             yield from docs
             continue
         done.update(enumerate(docs, first))
         while next_out in done:
             yield done.pop(next_out)
             next_out += 1
-        if not ordered and next_out >= ordered_head:  # the head is out: the rest as it
-            for index in sorted(done):  # comes
-                yield done.pop(index)

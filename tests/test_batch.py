@@ -855,28 +855,3 @@ def test_a_mixed_batch_gives_the_same_results_whatever_runs_it(tmp_path, runner,
                 for i, d in enumerate(composed) if i not in (BAD_AT, REPEATED_AT)]
     assert [d["verdict"] for i, d in enumerate(doc) if i not in (BAD_AT, REPEATED_AT)] == \
         expected
-
-
-@pytest.mark.parametrize("fmt", ["jsonl", "json"])
-def test_a_bad_document_among_the_first_stops_a_worker_batch(tmp_path, fmt):
-    """--jobs 2 --no-regions: the first documents are parsed by the workers, not up
-    front, and their results held until all are in: a bad one among them still stops the
-    run with exit 2, its located message on one line, nothing on stdout."""
-    good = [f"---\nname: p{i}\nparameter: t\nrange: [0, 1]\npose:\n  x: {i}/5 + t/2\n"
-            "  y: 1/4\n  z: 1\n" for i in range(8)]
-    text = "".join(good[:5]) + "---\nname: bad\nparameter: t\nrange: [0, 1]\npose:\n" \
-        "  x: t\n  y: 0\n  z: sin(t\n" + "".join(good[5:])
-    out = singcheck_in(text, "run", ORTHO, "-", "--backend", "flint", "--no-regions",
-                       "--jobs", "2", "--format", fmt,
-                       env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
-    assert out.returncode == 2, out.stderr
-    assert out.stdout == ""
-    line = len("".join(good[:5]).splitlines()) + 8
-    assert out.stderr.startswith(f"singcheck: error: <stdin>:{line}: pose.z:")
-    assert out.stderr.rstrip().endswith("(document 6)") and out.stderr.count("\n") == 1
-    fine = singcheck_in("".join(good), "run", ORTHO, "-", "--backend", "flint",
-                        "--no-regions", "--jobs", "2", "--format", "jsonl",
-                        env={"SINGCHECK_CACHE_DIR": str(tmp_path)})
-    assert fine.returncode in (0, 1), fine.stderr
-    assert [json.loads(x)["name"] for x in fine.stdout.splitlines()] == \
-        [f"p{i}" for i in range(8)]  # the first documents' results in input order

@@ -345,18 +345,9 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         if robot != "-":
             with open(robot, encoding="utf-8") as f:
                 robot_text = f.read()
-    first = list(islice(documents, api.LOOKAHEAD))
-    # a batch for worker processes without the region statement: they parse the first
-    # documents too, and the first results are held until they are all in (an error among
-    # them stops the run then, nothing written); else they are parsed here (the region
-    # maps are prepared from them), each within its trajectory's time limit: parsing is
-    # the first stage of its check
-    held = scheduler is not None or (jobs > 1 and len(first) > 4)
-    held = held and not regions and not certificate_dir and not plot_dir
-    if not held:
-        first = [api.parse_within(document, spec, time_limit) for document in first]
-    else:  # an error among the first documents is then the only line, as before
-        progress.hold()
+    # (each within its trajectory's time limit: parsing is the first stage of its check)
+    first = [api.parse_within(document, spec, time_limit)
+             for document in islice(documents, api.LOOKAHEAD)]
     total = len(first) if len(first) < api.LOOKAHEAD else None  # None: not known yet
     items = chain(first, documents)
     kept: list = []
@@ -388,8 +379,6 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         from singcheck.report.trajectory import JsonLine, robot_json
 
         options["line"] = JsonLine(robot_json(projection))
-    if held:
-        options["ordered_head"] = len(first)
     if scheduler:
         from singcheck.cluster import check_on_cluster
 
@@ -400,7 +389,7 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
     used: set = set()  # certificate file names written
     with _sink(fmt, output, projection) as sink, progress.bar(total) as advance, \
             closing(batch) as docs:
-        for doc in _head_checked(docs, len(first) if held else 0, progress):
+        for doc in docs:
             sink.add(doc)
             if certificate_dir:
                 _certify(certificate_dir, robot_text, texts, doc, used, progress)
@@ -413,28 +402,6 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
         _plot_all(certificates, plot_dir, progress,
                   _clearances(certificates, bool(selection.get("clearance")), gate), gate)
     return code
-
-
-def _head_checked(docs, head: int, progress):
-    """``docs``, the first ``head`` of them (in input order) held until they are all in,
-    and the progress notes with them: a document among them that is no valid trajectory
-    stops the run then (exit 2, its located message the one line on stderr, nothing
-    written), as when they are parsed up front."""
-    held: list = []
-    for doc in docs:
-        if len(held) < head:
-            if doc["verdict"] == "error" and doc["error"]["kind"] == "spec":
-                progress.release(print_them=False)
-                fail(doc["error"]["message"], ExitCode.USAGE)
-            held.append(doc)
-            if len(held) == head:
-                progress.release()
-                yield from held
-            continue
-        yield doc
-    progress.release()
-    if len(held) < head:  # a batch of fewer results than documents: cannot be
-        yield from held
 
 
 def _texts_kept(documents, texts: dict):

@@ -18,17 +18,6 @@ class Progress:
     def __init__(self, quiet: bool) -> None:
         self.quiet = quiet
         self._console = None
-        self._held: list[str] | None = None
-
-    def hold(self) -> None:
-        """Keep the notes from now on, unprinted, until :meth:`release`."""
-        self._held = []
-
-    def release(self, print_them: bool = True) -> None:
-        """Print the notes kept since :meth:`hold` (or drop them), and print the next."""
-        held, self._held = self._held or [], None
-        for message in held if print_them else ():
-            self.note(message)
 
     @property
     def console(self):
@@ -43,9 +32,6 @@ class Progress:
 
     def note(self, message: str) -> None:
         if self.quiet:
-            return
-        if self._held is not None:
-            self._held.append(message)
             return
         if self._terminal():
             from rich.markup import escape

@@ -192,8 +192,7 @@ def run(robot, trajectories, backend, timeout, no_cache, tolerance, fmt, output,
     trajectory may also be a CSV table of poses).  A YAML file may hold several
     trajectories as documents separated by ---; their names must be unique in a run.
     They are read one at a time as the batch goes, so memory stays flat: a bad one
-    among the first 100 stops the run (before anything is written), a later one is that
-    trajectory's error.
+    among the first 100 stops the run at once, a later one is that trajectory's error.
 
     For every trajectory it prints the candidate singular times (certified
     enclosures of the roots of μ(t)), the pose and joints there, which working

@@ -3,7 +3,9 @@
 Three kinds of hostile specs, all grown from the bundled ones: *structure* (a trajectory
 built key by key, keys dropped, added or nested), *grammar* (expressions generated from
 singcheck's grammar, hostile literals, deep nesting, large multiples and exponents) and
-*bytes* (the bundled files with bytes flipped, inserted, deleted or repeated).  The
+*bytes* (the bundled files with bytes flipped, inserted, deleted or repeated), and
+*paths of pieces* (segments, waypoints linear or cubic, CSV tables) on every bundled
+robot class, pose angles in radians or degrees (``30 deg``).  The
 property: every case ends with an exit status 0–3 (free, singular, bad spec, unknown)
 within its time budget, never with another exception (what the command line reports as
 exit 70) — the spec is untrusted input, and the README's "Security model" says what
@@ -15,7 +17,8 @@ The cases run in-process through the API and the command line's own exit-code ma
 
 ``SINGCHECK_FUZZ_EXAMPLES=N`` scales the number of cases (the CI default keeps the run
 near a minute); ``SINGCHECK_FUZZ_REPORT=FILE`` writes the counts of exit statuses as it
-goes (``SINGCHECK_FUZZ_REGIONS=0`` leaves out the region statement, for speed), and
+goes (``SINGCHECK_FUZZ_REGIONS=0`` leaves out the region statement, for speed;
+``SINGCHECK_FUZZ_BUDGET=S`` sets each case's time limit, 2 s by default), and
 with ``SINGCHECK_FUZZ_KEEP_GOING=1`` (a long campaign) a failing case is
 appended to ``FILE.failures`` (JSON lines: the two specs and the error) instead of
 stopping the run.
@@ -24,6 +27,7 @@ stopping the run.
 from __future__ import annotations
 
 import atexit
+import functools
 import json
 import os
 import subprocess
@@ -42,7 +46,9 @@ from hypothesis import strategies as st  # noqa: E402
 from tests.conftest import ROBOTS, ROOT, TRAJECTORIES  # noqa: E402
 
 EXAMPLES = int(os.environ.get("SINGCHECK_FUZZ_EXAMPLES", "30"))
-BUDGET = 2.0  # seconds of certification per case (api.check's time_limit)
+#: seconds of certification per case (api.check's time_limit); SINGCHECK_FUZZ_BUDGET: a
+#  campaign may ask for less, so that more cases run in its time
+BUDGET = float(os.environ.get("SINGCHECK_FUZZ_BUDGET", "2"))
 #: what a check may run past it (SINGCHECK_FUZZ_SLACK: a campaign asks for 1 s): one
 #   step no checkpoint can cut (a piece of a composition, a product or resultant within
 #   the path-wise bound, a FLINT root isolation), with room for a loaded machine;
@@ -240,7 +246,10 @@ def _yaml_scalar(text: str) -> str:
     return json.dumps(text, ensure_ascii=False)  # a JSON string is a YAML scalar
 
 
+@functools.lru_cache(maxsize=256)
 def _robot_pose(robot_text: str) -> list[str]:
+    """The robot's pose variables (memoised: PyYAML's pure-Python loader took a quarter
+    of a campaign's time on the same few texts)."""
     import yaml
 
     try:
@@ -250,9 +259,10 @@ def _robot_pose(robot_text: str) -> list[str]:
 
 
 @st.composite
-def structured_trajectories(draw, pose: list[str]) -> str:
+def structured_trajectories(draw, pose: list[str], angles: list[str] = ()) -> str:
     """A trajectory built key by key: generated coordinates and ranges, sometimes a key
-    missing, an extra one, or a value of the wrong shape."""
+    missing, an extra one, or a value of the wrong shape; a pose angle sometimes in
+    degrees."""
     parameter = draw(st.sampled_from(["t"] * 12 + ["s", "x", "pi", "sin"]))
     names = [parameter]
     ends = st.one_of(st.sampled_from(["-pi", "pi", "0", "1", "-1", "2*pi", "-1000000",
@@ -263,6 +273,12 @@ def structured_trajectories(draw, pose: list[str]) -> str:
            "pose": {v: draw(st.one_of(path_coordinates(parameter),
                                       path_coordinates(parameter),
                                       expressions(names, parameter))) for v in pose}}
+    for v in angles:  # an angle of the pose, sometimes in degrees
+        if draw(st.integers(0, 2)) == 0:
+            doc["pose"][v] = draw(st.one_of(
+                st.sampled_from(DEGREES),
+                st.tuples(path_coordinates(parameter), st.sampled_from(DEGREES)).map(
+                    lambda a: f"{a[0]} + {a[1]}")))
     if draw(st.integers(0, 9)) == 0:
         doc.pop(draw(st.sampled_from(sorted(doc))))
     if draw(st.integers(0, 9)) == 0:
@@ -281,6 +297,17 @@ def structured_trajectories(draw, pose: list[str]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _robot_angles(robot_text: str, pose: list[str]) -> list[str]:
+    """The pose variables that are angles (under a sin or cos in the robot's constraints:
+    the 3-PRR's and 3-RPR's phi, the Gough-Stewart's psi, theta, phi)."""
+    return [v for v in pose if f"cos({v})" in robot_text or f"sin({v})" in robot_text]
+
+
+#: angles in degrees (`d deg` is d·π/180 exactly), some not multiples of π/12
+DEGREES = ["0 deg", "30 deg", "-45 deg", "90 deg", "15 deg", "1.5 deg", "1/3 deg",
+           "360 deg", "-720 deg", "7 deg"]
+
+
 def _plain(text: str) -> str:
     """A number as a YAML flow value: as is when plain, else a quoted string."""
     import re
@@ -289,15 +316,20 @@ def _plain(text: str) -> str:
 
 
 @st.composite
-def path_forms(draw, pose: list[str]) -> tuple[str, str | None]:
+def path_forms(draw, pose: list[str], angles: list[str] = ()) -> tuple[str, str | None]:
     """A path of pieces as people write them, with its ``csv`` interpolation (None: YAML):
     ``segments`` (straight lines through waypoints, so they join, or a generated
     coordinate that may jump), ``waypoints`` (linear or cubic) or a CSV table; numbers
-    sometimes hostile, sometimes a time out of order, a cell missing or a stray one."""
+    sometimes hostile, sometimes a time out of order, a cell missing or a stray one.
+    The pose ``angles`` take degrees (``30 deg``) as often as radians, and one case in
+    ten puts a degree on a length."""
     usual = st.sampled_from(["0", "1", "1/2", "-1/2", "3/4", "0.3", "2", "-1", "1/3",
                              "0.125", "5/7", "1.5", "0.61", "-0.2"])
     hostile = draw(st.integers(0, 5)) == 0  # one case in six: any number, hostile ones too
     value = st.one_of(usual, usual, usual, numbers()) if hostile else usual
+    degrees = st.one_of(usual, st.sampled_from(DEGREES))
+    stray_degree = draw(st.integers(0, 9)) == 0
+    values = {v: degrees if v in angles or stray_degree else value for v in pose}
     n = draw(st.integers(2, 7))
     times = [Fraction(0)]
     for _ in range(n - 1):
@@ -309,7 +341,7 @@ def path_forms(draw, pose: list[str]) -> tuple[str, str | None]:
         times_text[i], times_text[i + 1] = times_text[i + 1], times_text[i]
     if hostile and draw(st.booleans()):
         times_text[draw(st.integers(0, n - 1))] = draw(numbers())
-    rows = [{v: draw(value) for v in pose} for _ in range(n)]
+    rows = [{v: draw(values[v]) for v in pose} for _ in range(n)]
     form = draw(st.sampled_from(["segments", "waypoints", "csv"]))
     if form == "csv":
         columns = list(pose)
@@ -400,7 +432,8 @@ def byte_mutations(draw, text: str) -> str:
 @given(st.data())
 def test_structured_and_grammar_trajectories_end_with_exit_0_to_3(data):
     robot_text = data.draw(mutated_robots())
-    trajectory_text = data.draw(structured_trajectories(_robot_pose(robot_text)))
+    pose = _robot_pose(robot_text)
+    trajectory_text = data.draw(structured_trajectories(pose, _robot_angles(robot_text, pose)))
     outcome(robot_text, trajectory_text)
 
 
@@ -430,13 +463,35 @@ def test_byte_mutated_specs_end_with_exit_0_to_3(data):
 @FUZZ
 @given(st.data())
 def test_paths_of_pieces_end_with_exit_0_to_3(data):
-    """Segments, waypoints and CSV tables on every robot class (planar, spatial, with an
-    angle; not the stacked Orthoglide, whose projection takes seconds)."""
-    robot_file = data.draw(st.sampled_from([p for p in ROBOT_FILES if "stacked" not in
-                                            p.name]))
+    """Segments, waypoints and CSV tables on every bundled robot — planar and spatial,
+    prismatic and revolute legs, a pose angle (3-PRR, 3-RPR), three (Gough-Stewart), the
+    stacked Orthoglide (its projection read once per process) — angles in radians or
+    degrees."""
+    robot_file = data.draw(st.sampled_from(ROBOT_FILES))
     robot_text = robot_file.read_text()
-    text, csv = data.draw(path_forms(_robot_pose(robot_text)))
+    pose = _robot_pose(robot_text)
+    text, csv = data.draw(path_forms(pose, _robot_angles(robot_text, pose)))
     outcome(robot_text, text, csv)
+
+
+def test_the_fuzzed_path_forms_cover_every_robot_class_and_unit():
+    """The properties above draw from every bundled robot and write each path form
+    (segments, waypoints, CSV) with angles in degrees: kept so when robots are added."""
+    from hypothesis import find
+
+    classes = {"planar": "five-bar", "spatial": "orthoglide", "revolute": "rotary-delta",
+               "one angle": "3-rpr", "three angles": "gough-stewart",
+               "stacked": "stacked-orthoglide"}
+    assert {p.stem for p in ROBOT_FILES} >= set(classes.values())
+    assert _robot_angles((ROBOTS / "gough-stewart.yaml").read_text(),
+                         ["x", "psi", "theta", "phi"]) == ["psi", "theta", "phi"]
+    pose = ["x", "y", "phi"]
+    for form in ("segments:", "waypoints:"):
+        text, csv = find(path_forms(pose, ["phi"]),
+                         lambda c, form=form: form in c[0] and " deg" in c[0])
+        assert csv is None
+    text, csv = find(path_forms(pose, ["phi"]), lambda c: c[1] is not None and " deg" in c[0])
+    assert text.startswith("t,x,y,phi") or text.startswith("t,")
 
 
 CLI_SAMPLE = [

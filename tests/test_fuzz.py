@@ -195,6 +195,7 @@ HOSTILE_LITERALS = ["0", "1", "0.5", "1e400", "1e-400", "1.0e+308", "9" * 200,
                     "1e999999999"]
 
 
+@functools.cache
 def numbers() -> st.SearchStrategy[str]:
     return st.one_of(st.integers(-1000, 1000).map(str),
                      st.tuples(st.integers(-99, 99), st.integers(1, 99)).map(
@@ -204,12 +205,19 @@ def numbers() -> st.SearchStrategy[str]:
 
 
 def expressions(names: list[str], parameter: str = "t") -> st.SearchStrategy[str]:
-    """Expressions of singcheck's grammar over ``names`` (and some that are not)."""
+    """Expressions of singcheck's grammar over ``names`` (and some that are not); one
+    strategy object per arguments (building a recursive strategy afresh for every draw
+    was most of a structured case's generation time)."""
+    return _expressions(tuple(names), parameter)
+
+
+@functools.lru_cache(maxsize=256)
+def _expressions(names: tuple[str, ...], parameter: str) -> st.SearchStrategy[str]:
     calls = st.tuples(st.sampled_from(["sin", "cos", "sqrt", "tan", "sin", "cos"]),
                       st.one_of(st.integers(-4, 4), st.integers(-300, 300))).map(
         lambda c: f"{c[0]}({c[1]}*{parameter})" if c[1] != 1 else f"{c[0]}({parameter})")
     usual = st.one_of(st.integers(-5, 5).map(str), st.sampled_from(["1/2", "3/7", "0.25"]),
-                      st.sampled_from(names or ["x"]), calls)
+                      st.sampled_from(list(names) or ["x"]), calls)
     atoms = st.one_of(usual, usual, usual, usual, numbers(),
                       st.sampled_from(["pi", "pi/2", "sqrt(2)", "x_unknown"]))
 
@@ -232,6 +240,7 @@ def expressions(names: list[str], parameter: str = "t") -> st.SearchStrategy[str
     return st.one_of(plain, plain, plain, deep)
 
 
+@functools.cache
 def path_coordinates(parameter: str = "t") -> st.SearchStrategy[str]:
     """Coordinates like the bundled ones: a few terms c·sin(kt), c·cos(kt), c·tⁿ."""
     term = st.tuples(st.sampled_from(["1", "-1", "1/2", "3/7", "2", "-5/14", "0.1"]),
@@ -253,7 +262,8 @@ def _robot_pose(robot_text: str) -> list[str]:
     import yaml
 
     try:
-        return [str(v) for v in yaml.safe_load(robot_text)["pose"]]
+        return [str(v) for v in yaml.load(robot_text, Loader=getattr(yaml, "CSafeLoader",
+                                                                      yaml.SafeLoader))["pose"]]
     except Exception:
         return ["x", "y", "z"]
 

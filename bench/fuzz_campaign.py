@@ -112,8 +112,21 @@ def main() -> int:
                              "by more than 1 s of wall clock but not of CPU is counted and "
                              "kept in worker-N-R.json.overruns, not a failure")
     parser.add_argument("--out", type=Path, default=Path("fuzz-campaign"))
+    parser.add_argument("--summarize", action="store_true",
+                        help="run nothing: merge the reports already in --out (a campaign "
+                             "stopped before its end) into its summary.json")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
+    started = time.monotonic()
+    if not args.summarize:
+        run_workers(args)
+    return summarize(args.out, (time.monotonic() - started) / 60 if not args.summarize
+                     else None, args)
+
+
+def run_workers(args) -> None:
+    """The workers, each running the properties in turn, until the time or the cases are
+    reached; then interrupted (their counts are written as they exit)."""
     started = time.monotonic()
     runs = [0] * args.jobs
 
@@ -138,11 +151,16 @@ def main() -> int:
         except subprocess.TimeoutExpired:
             os.killpg(w.pid, signal.SIGKILL)
             w.wait()
+
+
+def summarize(out: Path, minutes: float | None, args) -> int:
+    """Merge the runs' reports in ``out`` into ``out/summary.json`` (printed too); 1 when
+    there is a failure or a stray file."""
     total: Counter = Counter()
     per_property: Counter = Counter()
     past, cpu_past = 0, -10**9
     failures = []
-    for report in sorted(args.out.glob("worker-*.json")):
+    for report in sorted(out.glob("worker-*.json")):
         if report.exists():
             counts = json.loads(report.read_text())
             past = max(past, counts.pop("max ms past the limit", 0))
@@ -157,14 +175,14 @@ def main() -> int:
     failures = [f for f in failures if not f.startswith("AssertionError: 130\n")]
     total["exit 130"] -= stopped
     total["cases"] -= stopped
-    summary = {"minutes": round((time.monotonic() - started) / 60, 1), "jobs": args.jobs,
+    summary = {"minutes": None if minutes is None else round(minutes, 1), "jobs": args.jobs,
                "budget s": args.budget, "examples per run": args.examples,
                **{k: v for k, v in sorted(total.items()) if v}, "stopped at the end": stopped,
                "cases per property": dict(sorted(per_property.items())),
                "max ms past the limit": past, "max ms of CPU past the limit": cpu_past,
                "failures": Counter(failures).most_common(),
-               "stray files": {n: strays(args.out / f"sandbox-{n}") for n in range(args.jobs)}}
-    (args.out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+               "stray files": {p.name: strays(p) for p in sorted(out.glob("sandbox-*"))}}
+    (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
     print(json.dumps(summary, indent=1))
     return 1 if failures or any(summary["stray files"].values()) else 0
 

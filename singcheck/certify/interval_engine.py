@@ -154,7 +154,7 @@ def search_det_a(path, modes: list, refine: set[str] | None = None,
             steep = [m for m in unproven if m.label in forms
                      and not excludes_zero(values[m.label]) and excludes_zero(forms[m.label][1])]
             if steep:
-                monotone = _end_signs(path, steep, piece)
+                monotone = _end_signs(path, steep, piece, interval)
         again = []
         for mode in open_modes:
             v = values[mode.label]
@@ -177,11 +177,18 @@ def search_det_a(path, modes: list, refine: set[str] | None = None,
     return {label: _summarise(label, pieces_found) for label, pieces_found in found.items()}
 
 
-def _end_signs(path, modes: list, piece: arb) -> dict[str, tuple[int, int]]:
+def _end_signs(path, modes: list, piece: arb, interval) -> dict[str, tuple[int, int]]:
     """The proven signs of det A at the two ends of the piece (exact points) for each
-    mode where both are proven."""
-    _, _, at_lo = mode_values(path, modes, arb(piece.lower()))
-    _, _, at_hi = mode_values(path, modes, arb(piece.upper()))
+    mode where both are proven.  An end past the path's range (the first and last
+    pieces of :func:`~singcheck.certify.covers.pieces` reach slightly beyond it: a ball's
+    radius is rounded up) is replaced by the range's own end: a sign outside the path
+    proves nothing about it (fuzz campaign, issue 31: y = 10⁻⁹¹ + 3t/40 on [0, 10] of the
+    biglide, det A = 4y(q - p) < 0 at t = -1.6·10⁻⁹, made a crossing the exact engine
+    rightly did not find, an ``inconsistent`` error, exit 70)."""
+    start, end = interval.start.ball(), interval.end.ball()
+    lo, hi = arb(piece.lower()), arb(piece.upper())
+    _, _, at_lo = mode_values(path, modes, start if lo < start.upper() else lo)
+    _, _, at_hi = mode_values(path, modes, end if hi > end.lower() else hi)
     out = {}
     for mode in modes:
         a, b = at_lo[mode.label], at_hi[mode.label]

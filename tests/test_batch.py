@@ -617,7 +617,7 @@ def _killing(monkeypatch, killer):
     return real
 
 
-def _stream(tmp_path):
+def _twelve_paths(tmp_path):
     stream = tmp_path / "stream.yaml"
     stream.write_text("".join(f"---\nname: p{i}\nparameter: t\nrange: [0, 1]\npose:\n"
                               f"  x: {i}/20 + t/2\n  y: 1/4\n  z: 1\n" for i in range(12)))
@@ -631,7 +631,7 @@ def _killing_batch(orthoglide_robot, tmp_path, monkeypatch, killer):
     from singcheck.spec.files import read_documents
 
     _killing(monkeypatch, killer)
-    stream = _stream(tmp_path)
+    stream = _twelve_paths(tmp_path)
     docs = list(api.check_batch(orthoglide_robot, read_documents([stream]), regions=False,
                                 jobs=2))
     assert [d["name"] for d in docs] == [f"p{i}" for i in range(12)]
@@ -663,7 +663,7 @@ def test_a_batch_whose_path_kills_its_worker_twice_exits_4_not_70(tmp_path, monk
     from tests.test_hardening import run_cli
 
     _killing(monkeypatch, lambda name: name == "p1")
-    code, out, err = run_cli(monkeypatch, capsys, "run", str(ORTHO), str(_stream(tmp_path)),
+    code, out, err = run_cli(monkeypatch, capsys, "run", str(ORTHO), str(_twelve_paths(tmp_path)),
                              "--jobs", "2", "--no-regions", "--backend", "flint", "-q",
                              "--format", "jsonl")
     lines = [json.loads(line) for line in out.splitlines()]

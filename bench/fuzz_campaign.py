@@ -1,20 +1,26 @@
-"""An offline fuzz campaign: tests/test_fuzz.py's properties, run long, in parallel.
+"""An offline fuzz campaign: tests/test_fuzz.py's properties, run long.
 
 Not part of CI (which runs the same properties at 30 examples each, in seconds).  Each
-worker is a pytest process running the fuzz properties with a large number of
-examples, ``SINGCHECK_FUZZ_KEEP_GOING=1`` (a failing case is recorded, not shrunk) and
-``SINGCHECK_FUZZ_SLACK=1`` (a case more than 1 s past its 2 s limit is a failure), in a
-sandbox of its own: its working directory, ``HOME``, ``TMPDIR`` and cache are in it, so
-that afterwards every file in the sandbox that is neither the cache nor a case file
-is something written outside the named outputs.  At the end (``--minutes``) the
-workers are interrupted and their counts merged::
+worker is a pytest process running one fuzz property (round robin) with a large number
+of examples, in-process through the API (the robot's projection memoised per text, so
+thousands of specs share it), with ``SINGCHECK_FUZZ_KEEP_GOING=1`` (a failing case is
+recorded, not shrunk), ``SINGCHECK_FUZZ_SLACK=1`` (a case more than 1 s past its time
+limit is a failure) and ``SINGCHECK_FUZZ_BUDGET`` (``--budget``: each case's time
+limit; shorter than the CI's 2 s, so more cases run in the time), in a sandbox of its
+own: its working directory, ``HOME``, ``TMPDIR`` and cache are in it, so that
+afterwards every file in the sandbox that is neither the cache nor a case file is
+something written outside the named outputs.  One run in ``--regions-every`` states
+the workspace region too (the rest leave it out: it triples a case's cost).  At the
+end (``--minutes``, or ``--cases`` reached) the workers are interrupted and their
+counts merged::
 
-    python bench/fuzz_campaign.py --minutes 60 --jobs 2 --out /tmp/campaign
+    nice -n 19 python bench/fuzz_campaign.py --minutes 60 --jobs 1 --out /tmp/campaign
 
-writes ``/tmp/campaign/summary.json`` (cases, exit statuses, failures, the largest
-overrun of the time limit, stray files) and keeps each worker's failures
-(``worker-N.json.failures``: JSON lines, the specs and the error) for
-tests/data/crashes/.
+writes ``/tmp/campaign/summary.json`` (cases, exit statuses, cases per property,
+failures, the largest overrun of the time limit, stray files) and keeps each run's
+failures (``worker-N-R.json.failures``: JSON lines, the specs and the error) for
+tests/data/crashes/.  On a shared 2-core machine, under ``nice -n 19`` with other
+work running, one worker ran about 10-20 cases a second.
 """
 
 from __future__ import annotations
@@ -35,16 +41,22 @@ PROPERTIES = ["test_structured_and_grammar_trajectories_end_with_exit_0_to_3",
               "test_paths_of_pieces_end_with_exit_0_to_3"]
 
 
-def start_worker(n: int, run: int, out: Path, examples: int) -> subprocess.Popen:
-    """Worker slot ``n``'s ``run``-th pytest process: one property (round robin)."""
+def start_worker(n: int, run: int, out: Path, examples: int, budget: float = 1.0,
+                 regions_every: int = 4, shared: bool = False) -> subprocess.Popen:
+    """Worker slot ``n``'s ``run``-th pytest process: one property (round robin), the
+    region statement in one run of ``regions_every`` (0: never)."""
+    regions = regions_every > 0 and run % regions_every == 0
     sandbox = out / f"sandbox-{n}"
     for sub in ("home", "tmp", "cases", "cwd"):
         (sandbox / sub).mkdir(parents=True, exist_ok=True)
     env = {**os.environ, "PYTHONPATH": str(ROOT), "HOME": str(sandbox / "home"),
            "TMPDIR": str(sandbox / "tmp"), "SINGCHECK_FUZZ_DIR": str(sandbox / "cases"),
            "SINGCHECK_FUZZ_EXAMPLES": str(examples), "SINGCHECK_FUZZ_KEEP_GOING": "1",
-           "SINGCHECK_FUZZ_SLACK": "1",
-           "SINGCHECK_FUZZ_REPORT": str(out / f"worker-{n}-{run}.json"),
+           "SINGCHECK_FUZZ_SLACK": "1", "SINGCHECK_FUZZ_BUDGET": str(budget),
+           "SINGCHECK_FUZZ_SHARED": "1" if shared else "0",
+           "SINGCHECK_FUZZ_REGIONS": "1" if regions else "0",
+           "SINGCHECK_FUZZ_REPORT": str(out / f"worker-{n}-{run}-{PROPERTIES[run % 3][5:9]}"
+                                        f"{'-regions' if regions else ''}.json"),
            "XDG_CONFIG_HOME": str(sandbox / "home" / ".config")}
     env.pop("SINGCHECK_CACHE_DIR", None)
     argv = [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider",
@@ -71,26 +83,65 @@ def strays(sandbox: Path) -> list[str]:
     return out
 
 
+def cases_so_far(out: Path) -> int:
+    """The cases the runs' reports count (each written every 25 cases and at exit)."""
+    total = 0
+    for report in out.glob("worker-*.json"):
+        try:
+            total += json.loads(report.read_text()).get("cases", 0)
+        except (OSError, ValueError):  # being rewritten
+            pass
+    return total
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--minutes", type=float, default=60)
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1)
-    parser.add_argument("--examples", type=int, default=300,
+    parser.add_argument("--examples", type=int, default=1000,
                         help="examples per pytest run (each worker runs the properties "
                              "in turn, a run each, until the time is up)")
+    parser.add_argument("--cases", type=int, default=0,
+                        help="stop once this many cases have run (0: run --minutes)")
+    parser.add_argument("--budget", type=float, default=1.0,
+                        help="each case's time limit in seconds (CI: 2)")
+    parser.add_argument("--regions-every", type=int, default=4,
+                        help="state the workspace region in one run of this many (0: never)")
+    parser.add_argument("--shared", action="store_true",
+                        help="a machine shared with other work: a case past its time limit "
+                             "by more than 1 s of wall clock but not of CPU is counted and "
+                             "kept in worker-N-R.json.overruns, not a failure")
     parser.add_argument("--out", type=Path, default=Path("fuzz-campaign"))
+    parser.add_argument("--summarize", action="store_true",
+                        help="run nothing: merge the reports already in --out (a campaign "
+                             "stopped before its end) into its summary.json")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     started = time.monotonic()
+    if not args.summarize:
+        run_workers(args)
+    return summarize(args.out, (time.monotonic() - started) / 60 if not args.summarize
+                     else None, args)
+
+
+def run_workers(args) -> None:
+    """The workers, each running the properties in turn, until the time or the cases are
+    reached; then interrupted (their counts are written as they exit)."""
+    started = time.monotonic()
     runs = [0] * args.jobs
-    workers = [start_worker(n, 0, args.out, args.examples) for n in range(args.jobs)]
+
+    def start(n: int) -> subprocess.Popen:
+        return start_worker(n, runs[n], args.out, args.examples, args.budget,
+                            args.regions_every, args.shared)
+
+    workers = [start(n) for n in range(args.jobs)]
     end = started + args.minutes * 60
-    while time.monotonic() < end:
+    while time.monotonic() < end and not (args.cases and cases_so_far(args.out) >= args.cases):
         time.sleep(2)
         for n, w in enumerate(workers):
             if w.poll() is not None:
                 runs[n] += 1
-                workers[n] = start_worker(n, runs[n], args.out, args.examples)
+                workers[n] = start(n)
     for w in workers:
         if w.poll() is None:
             os.killpg(w.pid, signal.SIGINT)  # pytest stops; the counts are written at exit
@@ -100,15 +151,22 @@ def main() -> int:
         except subprocess.TimeoutExpired:
             os.killpg(w.pid, signal.SIGKILL)
             w.wait()
+
+
+def summarize(out: Path, minutes: float | None, args) -> int:
+    """Merge the runs' reports in ``out`` into ``out/summary.json`` (printed too); 1 when
+    there is a failure or a stray file."""
     total: Counter = Counter()
-    total.pop("failures", None)
-    past = 0
+    per_property: Counter = Counter()
+    past, cpu_past = 0, -10**9
     failures = []
-    for report in sorted(args.out.glob("worker-*.json")):
+    for report in sorted(out.glob("worker-*.json")):
         if report.exists():
             counts = json.loads(report.read_text())
             past = max(past, counts.pop("max ms past the limit", 0))
+            cpu_past = max(cpu_past, counts.pop("max ms of CPU past the limit", -10**9))
             total.update(counts)
+            per_property[report.stem.split("-", 3)[3]] += counts.get("cases", 0)
         failed = report.with_name(report.name + ".failures")
         if failed.exists():
             failures += [json.loads(line)["error"] for line in failed.read_text().splitlines()]
@@ -117,12 +175,14 @@ def main() -> int:
     failures = [f for f in failures if not f.startswith("AssertionError: 130\n")]
     total["exit 130"] -= stopped
     total["cases"] -= stopped
-    summary = {"minutes": round((time.monotonic() - started) / 60, 1), "jobs": args.jobs,
+    summary = {"minutes": None if minutes is None else round(minutes, 1), "jobs": args.jobs,
+               "budget s": args.budget, "examples per run": args.examples,
                **{k: v for k, v in sorted(total.items()) if v}, "stopped at the end": stopped,
-               "max ms past the 2 s limit": past,
+               "cases per property": dict(sorted(per_property.items())),
+               "max ms past the limit": past, "max ms of CPU past the limit": cpu_past,
                "failures": Counter(failures).most_common(),
-               "stray files": {n: strays(args.out / f"sandbox-{n}") for n in range(args.jobs)}}
-    (args.out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+               "stray files": {p.name: strays(p) for p in sorted(out.glob("sandbox-*"))}}
+    (out / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
     print(json.dumps(summary, indent=1))
     return 1 if failures or any(summary["stray files"].values()) else 0
 

@@ -602,7 +602,9 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
     with it: each of those tasks is run again, alone in a new pool (no other task in
     flight, so that a second death is its own); if it dies again, its trajectories are
     run one by one, alone, and one whose worker dies then is that trajectory's
-    ``error`` (it killed its worker twice).  The others' results are kept."""
+    ``error`` of kind ``worker-died`` (it killed its worker twice: the OOM killer, most
+    likely; not a bug, so the command exits 4 for it, as for a backend past its memory
+    bound, not 70).  The others' results are kept."""
     import multiprocessing
     import os
     from collections import deque
@@ -662,7 +664,7 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
             if isinstance(result, Exception):
                 reason = (f"its worker process died twice (killed, or out of memory): "
                           f"{type(result).__name__}: {result}")
-                result = [formatted({**error_json(_head(item), "internal", reason),
+                result = [formatted({**error_json(_head(item), "worker-died", reason),
                                      "time_s": 0.0}, line)]
             out.append((index, result[0]))
         return out

@@ -596,14 +596,13 @@ def test_memory_stays_flat_from_500_to_5000_paths_on_stdin(tmp_path):
     assert small < 200, small  # the command's own peak, not the launcher's parent's
 
 
-def _killing_batch(orthoglide_robot, tmp_path, monkeypatch, killer):
-    """A 12-path batch in 2 workers, one path a task, where ``killer(name)`` says whether
-    checking that path SIGKILLs its worker (as the OOM killer would)."""
+def _killing(monkeypatch, killer):
+    """``api.check_safely`` SIGKILLs its process (as the OOM killer would) for a path
+    ``killer(name)`` names; two paths a task, two tasks a worker.  Returns the real one."""
     import os
     import signal
 
     from singcheck import api
-    from singcheck.spec.files import read_documents
 
     real = api.check_safely
 
@@ -615,9 +614,24 @@ def _killing_batch(orthoglide_robot, tmp_path, monkeypatch, killer):
     monkeypatch.setattr(api, "check_safely", check_safely)
     monkeypatch.setattr(api, "CHUNK", 2)
     monkeypatch.setattr(api, "TASKS_PER_WORKER", 2)
+    return real
+
+
+def _twelve_paths(tmp_path):
     stream = tmp_path / "stream.yaml"
     stream.write_text("".join(f"---\nname: p{i}\nparameter: t\nrange: [0, 1]\npose:\n"
                               f"  x: {i}/20 + t/2\n  y: 1/4\n  z: 1\n" for i in range(12)))
+    return stream
+
+
+def _killing_batch(orthoglide_robot, tmp_path, monkeypatch, killer):
+    """A 12-path batch in 2 workers, one path a task, where ``killer(name)`` says whether
+    checking that path SIGKILLs its worker (as the OOM killer would)."""
+    from singcheck import api
+    from singcheck.spec.files import read_documents
+
+    _killing(monkeypatch, killer)
+    stream = _twelve_paths(tmp_path)
     docs = list(api.check_batch(orthoglide_robot, read_documents([stream]), regions=False,
                                 jobs=2))
     assert [d["name"] for d in docs] == [f"p{i}" for i in range(12)]
@@ -635,9 +649,28 @@ def test_a_path_that_kills_its_worker_twice_is_its_own_error(orthoglide_robot, t
     docs, expected = _killing_batch(orthoglide_robot, tmp_path, monkeypatch,
                                     lambda name: name == "p1")
     assert docs[1]["verdict"] == "error"
+    assert docs[1]["error"]["kind"] == "worker-died", docs[1]
     assert docs[1]["error"]["message"].startswith("its worker process died twice"), docs[1]
     assert [d["verdict"] for i, d in enumerate(docs) if i != 1] == \
         [v for i, v in enumerate(expected) if i != 1]
+
+
+def test_a_batch_whose_path_kills_its_worker_twice_exits_4_not_70(tmp_path, monkeypatch,
+                                                                  capsys):
+    """Issue 31: that path's ``error`` (kind ``worker-died``) is no bug of singcheck: the
+    batch exits as for a backend past its memory bound (4, docs/outputs.md), the other
+    paths' lines complete, and stderr says nothing of an internal error."""
+    from tests.test_hardening import run_cli
+
+    _killing(monkeypatch, lambda name: name == "p1")
+    code, out, err = run_cli(monkeypatch, capsys, "run", str(ORTHO), str(_twelve_paths(tmp_path)),
+                             "--jobs", "2", "--no-regions", "--backend", "flint", "-q",
+                             "--format", "jsonl")
+    lines = [json.loads(line) for line in out.splitlines()]
+    assert code == 4, err
+    assert len(lines) == 12 and "internal error" not in err, err
+    dead = [d for d in lines if d["verdict"] == "error"]
+    assert [(d["name"], d["error"]["kind"]) for d in dead] == [("p1", "worker-died")]
 
 
 def test_a_worker_killed_once_loses_no_path(orthoglide_robot, tmp_path, monkeypatch):

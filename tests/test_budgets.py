@@ -368,3 +368,73 @@ def test_the_region_statement_never_holds_the_verdict(monkeypatch):
     assert "--regions waits for it" in hurried.to_dict()["reason"]
     waited = api.check(robot, traj, time_limit=120, regions="wait")
     assert waited.verdict == "singular" and waited.workspace is not None
+
+
+def test_a_slow_call_in_a_fork_stops_at_the_deadline():
+    """``until_deadline``: a call its caller thinks may be slow runs in a fork that the
+    deadline kills (the worded ``time limit`` of a checkpoint, well under 1 s late); a
+    cheap one, or one without a deadline, runs here."""
+    from singcheck.budget import TimeLimitExceeded, deadline
+    from singcheck.elimination.cas.forked import until_deadline
+
+    start = time.monotonic()
+    with deadline(0.3), pytest.raises(TimeLimitExceeded, match=r"time limit \(0.3 s\)"):
+        until_deadline(time.sleep, 30, "a sleep", costly=True)
+    assert time.monotonic() - start < 0.3 + 0.5
+    here = []
+    with deadline(5):
+        assert until_deadline(lambda x: here.append(x) or 2 * x, 21, "cheap", False) == 42
+    assert here == [21]  # ran in this process
+    assert until_deadline(lambda x: here.append(x) or x, 1, "no deadline", True) == 1
+    assert here == [21, 1]
+    with deadline(5):  # a slow one comes back through the pipe, exceptions too
+        assert until_deadline(lambda x: here.append(x) or x + 1, 1, "forked", True) == 2
+        with pytest.raises(ZeroDivisionError):
+            until_deadline(lambda x: 1 / x, 0, "forked", True)
+    assert here == [21, 1]  # the forked call appended in the child only
+
+
+@pytest.mark.parametrize("where", ["norm_chain", "through_norm"])
+def test_the_norm_steps_on_large_polynomials_run_where_the_deadline_stops_them(
+        monkeypatch, where):
+    """Issue 31: the path-wise norm chain's squarefree parts (1.2 s on a rotary Delta
+    cubic path) and the factorization of μ's norm over sin t (17.9 s on a stacked
+    Orthoglide path) were single FLINT calls past a 2 s limit.  Each step on a
+    polynomial that ``may_be_slow`` goes through ``until_deadline`` as costly, and the
+    answers are those of the calls made here."""
+    from flint import fmpq_mpoly_ctx
+
+    from singcheck.algebra.polynomials import may_be_slow
+    from singcheck.budget import deadline
+    from singcheck.elimination.cas import forked
+    from singcheck.elimination.requests import norm_chain
+
+    calls = []
+    real = forked.until_deadline
+
+    def spy(fn, argument, what, costly):
+        calls.append((what, costly))
+        return real(fn, argument, what, costly)
+
+    monkeypatch.setattr(forked, "until_deadline", spy)
+    ring = fmpq_mpoly_ctx.get(("r", "t", "s", "c"), "lex")
+    r, t, s, c = ring.gens()
+    if where == "norm_chain":
+        g = (r * t + s + c) ** 2 * (r - t) * ((t + s + 1) ** 40 + c * t ** 3)
+        assert may_be_slow(g) and not may_be_slow(r - t)
+        with deadline(60):
+            fast = norm_chain(g, [("r", r * r - t * s - 1)])
+        monkeypatch.setattr(forked, "until_deadline", lambda fn, a, w, c: fn(a))
+        assert fast == norm_chain(g, [("r", r * r - t * s - 1)])
+    else:
+        from fractions import Fraction
+
+        from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, reduce_trig
+        from singcheck.roots.isolation import _through_norm
+
+        t, s, c = TRIG.gens()
+        p = reduce_trig(((t - s) ** 2 + c * t ** 5 - c) * ((t + 3) ** 60 - s * c * t ** 40))
+        with deadline(60):
+            _through_norm(p, TimeRange(LinearInPi(Fraction(0)),
+                                         LinearInPi(Fraction(1))), 1e-9)
+    assert any(costly for _, costly in calls), calls

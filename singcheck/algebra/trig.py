@@ -37,6 +37,7 @@ from flint import (
 )
 
 from singcheck.algebra.polynomials import exact_terms
+from singcheck.budget import checkpoint
 
 #: Q[t, s, c]; exponents are (t, s, c).
 TRIG = fmpq_mpoly_ctx.get(("t", "s", "c"), "lex")
@@ -379,12 +380,17 @@ _CHEBYSHEV: dict[tuple[int, int], fmpq_mat] = {}
 def _chebyshev_change(n: int, part: int) -> fmpq_mat:
     """The (n+1)×(n+1) rational matrix taking power coefficients c⁰…cⁿ to Chebyshev
     ones: T₀…Tₙ for ``part`` 0, U₀…Uₙ for ``part`` 1 (from c·Tₖ = (Tₖ₊₁ + T|ₖ₋₁|)/2 and
-    c·Uₖ = (Uₖ₊₁ + Uₖ₋₁)/2 with U₋₁ = 0)."""
+    c·Uₖ = (Uₖ₊₁ + Uₖ₋₁)/2 with U₋₁ = 0).
+
+    Its cost grows as n² in Python (0.4 s of CPU at n = 512, 1.5 s at 1024: a rotary
+    Delta path with sin(255t) ran 8.9 s past a 1 s limit here), so a
+    :func:`~singcheck.budget.checkpoint` comes before each column and each row."""
     key = (n, part)
     hit = _CHEBYSHEV.get(key)
     if hit is None:
         columns = [[fmpq(1)] + [fmpq(0)] * n]
         for _ in range(n):
+            checkpoint()
             prev, nxt = columns[-1], [fmpq(0)] * (n + 1)
             for k, a in enumerate(prev):
                 if a == 0:
@@ -396,8 +402,11 @@ def _chebyshev_change(n: int, part: int) -> fmpq_mat:
                 elif part == 0:  # c·T₀ = T₁
                     nxt[1] += a / 2
             columns.append(nxt)
-        hit = _CHEBYSHEV[key] = fmpq_mat(n + 1, n + 1, [columns[m][k] for k in range(n + 1)
-                                                         for m in range(n + 1)])
+        entries: list = []
+        for k in range(n + 1):
+            checkpoint()
+            entries += [columns[m][k] for m in range(n + 1)]
+        hit = _CHEBYSHEV[key] = fmpq_mat(n + 1, n + 1, entries)
     return hit
 
 

@@ -182,7 +182,9 @@ def inside_range(path, piece: arb) -> tuple[arb, arb]:
     balls may reach an ulp past the range (rounded radii), and a sign proven there would
     place a zero outside it; such an end is replaced by the range end's own ball (exact,
     or a tight ball about an irrational end such as π: a sign proven on it holds at the
-    end itself)."""
+    end itself).  (Fuzz campaign, issue 31: y = 10⁻⁹¹ + 3t/40 on [0, 10] of the biglide,
+    det A = 4y(q - p) < 0 at t = -1.6·10⁻⁹, made a crossing the exact engine rightly did
+    not find, an ``inconsistent`` error, exit 70.)"""
     rng = path.trajectory.range
     start, end = rng.start.ball(), rng.end.ball()
     lo, hi = arb(piece.lower()), arb(piece.upper())

@@ -240,8 +240,8 @@ def _outcome(doc: dict) -> ExitCode:
     if verdict == "singularity-free":
         return ExitCode.SINGULARITY_FREE
     if verdict == "error":
-        return {"backend": ExitCode.BACKEND, "spec": ExitCode.USAGE}.get(
-            doc["error"]["kind"], ExitCode.INTERNAL)
+        return {"backend": ExitCode.BACKEND, "worker-died": ExitCode.BACKEND,
+                "spec": ExitCode.USAGE}.get(doc["error"]["kind"], ExitCode.INTERNAL)
     return ExitCode.UNKNOWN
 
 

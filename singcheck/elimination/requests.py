@@ -16,7 +16,7 @@ from typing import Protocol
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
 from singcheck.algebra.composition import multiply_in_pieces
-from singcheck.algebra.polynomials import coefficient_in, squarefree_part
+from singcheck.algebra.polynomials import coefficient_in, may_be_slow, squarefree_part
 from singcheck.algebra.radicals import radical_prime
 from singcheck.budget import checkpoint
 
@@ -197,6 +197,13 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
     maps each intermediate to an equivalent one modulo relations of the ring (along a
     path: s² + c² = 1), which keeps the same zeros on the variety of those relations.
 
+    **Within the deadline.**  A checkpoint comes before every step, and each FLINT call
+    on a polynomial that :func:`~singcheck.algebra.polynomials.may_be_slow` (a
+    factorization, a resultant, a squarefree part: one uninterruptible call each) runs
+    in a forked child that the current deadline stops
+    (:func:`~singcheck.elimination.cas.forked.until_deadline`): a cubic path of the
+    rotary Delta spent 1.2 s in one squarefree part, past a 2 s limit.
+
     **Zero stays zero.**  The norm of the zero polynomial is zero, and so is the norm of g
     once any step of its chain is identically zero (a path on the singularity: det A
     vanishes in some mode all along it); FLINT factors zero into no factor, so without
@@ -205,8 +212,13 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
     """
     if g.is_zero():
         return g
+    from singcheck.elimination.cas.forked import until_deadline
+
+    def stoppable(fn, p: fmpq_mpoly, what: str):  # one FLINT call a deadline can stop
+        return until_deadline(fn, p, f"the norm chain's {what}", may_be_slow(p))
+
     names = g.context().names()
-    _, factors = g.factor()
+    _, factors = stoppable(lambda p: p.factor(), g, "factorization")
     one = g.context().from_dict({(0,) * g.context().nvars(): 1})
     total = one
     later = [{names.index(x) for v, _ in legs[i + 1:]
@@ -219,22 +231,23 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
                 continue  # a leg that does not touch this factor only raises its power
             checkpoint()
             acc = revolute_norm(acc, v[0], v[1], f, reduce) if isinstance(v, tuple) else \
-                acc.resultant(f, v)
+                stoppable(lambda p, f=f, v=v: p.resultant(f, v), acc, "resultant")
             acc, reduced = reduce(acc) if reduce else acc, True
             if acc.is_zero():
                 return acc  # this factor's norm is zero, so the whole norm is zero
             checkpoint()
             if later[i]:
-                acc, free = _split_free(acc, later[i])
+                acc, free = stoppable(lambda p, i=i: _split_free(p, later[i]), acc,
+                                      "squarefree part")
                 aside *= free
             else:
-                acc = squarefree_part(acc)
+                acc = stoppable(squarefree_part, acc, "squarefree part")
         if aside != one:
-            acc = squarefree_part(acc * aside)
+            acc = stoppable(squarefree_part, acc * aside, "squarefree part")
         if len(factors) == 1 and reduced:
             return acc  # squarefree and monic already: the one factor's norm
         total *= acc
-    return squarefree_part(total)
+    return stoppable(squarefree_part, total, "squarefree part")
 
 
 def _split_free(p: fmpq_mpoly, variables: set[int]) -> tuple[fmpq_mpoly, fmpq_mpoly]:

@@ -18,7 +18,7 @@ from __future__ import annotations
 from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 
 from singcheck.algebra.intervals import excludes_zero, working_precision
-from singcheck.algebra.polynomials import restrict
+from singcheck.algebra.polynomials import may_be_slow, restrict
 from singcheck.algebra.radicals import (
     angle_function_of,
     conjugates,
@@ -172,17 +172,27 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
     bracketed by branch-and-bound.  At each one, whether p vanishes is decided exactly
     (:meth:`~singcheck.roots.transcendental.TranscendentalPoint.is_zero`; at t = kπ by
     :func:`~singcheck.roots.branch_bound.vanishes_at_multiple_of_pi`): p's zeros are
-    exactly those where it does, every other stretch is root-free."""
+    exactly those where it does, every other stretch is root-free.
+
+    A norm that :func:`~singcheck.algebra.polynomials.may_be_slow` is factored in a
+    forked child that the current deadline stops
+    (:func:`~singcheck.elimination.cas.forked.until_deadline`): one FLINT factorization
+    of a stacked Orthoglide's μ-norm took 17.9 s, past a 2 s limit."""
     circle = angle_circle(p)  # a pose angle's (C, S), renamed (c, s) for the algebra
     p0, p1 = split_s(p if circle is None else circle.to_trig(p))
     if p0.is_zero() or p1.is_zero():
         return None
     norm = p0 * p0 - p1 * p1 * ONE_MINUS_C2
-    if all(m == 1 for _, m in norm.factor_squarefree()[1]):
+    from singcheck.elimination.cas.forked import until_deadline
+
+    slow = may_be_slow(norm)  # then factored where the deadline can stop it
+    if all(m == 1 for _, m in until_deadline(lambda q: q.factor_squarefree(), norm,
+                                             "the squarefree part of μ's norm", slow)[1]):
         return None
     roots: list[RealRoot] = []
     undecided: list[Undecided] = []
-    for k, _ in norm.factor()[1]:
+    for k, _ in until_deadline(lambda q: q.factor(), norm, "the factorization of μ's norm",
+                               slow)[1]:
         if k.is_constant():
             continue
         checkpoint()

@@ -194,7 +194,11 @@ def _results(tasks: _Submitter, ordered: bool) -> Iterator[dict]:
         try:
             docs = future.result()
         except Exception as e:  # the task was lost (a worker died) or could not run
-            docs = [formatted(error_json(_head(item), "internal",
+            # Dask re-runs a task whose worker died; KilledWorker means it killed every
+            # worker it was given (out of memory, most likely): like a path that kills
+            # its --jobs worker twice, that is the paths' own error, not a bug
+            kind = "worker-died" if type(e).__name__ == "KilledWorker" else "internal"
+            docs = [formatted(error_json(_head(item), kind,
                                          f"the Dask task failed: {type(e).__name__}: {e}"),
                               tasks.line)
                     for item in chunk]

@@ -888,3 +888,47 @@ def test_a_mixed_batch_gives_the_same_results_whatever_runs_it(tmp_path, runner,
                 for i, d in enumerate(composed) if i not in (BAD_AT, REPEATED_AT)]
     assert [d["verdict"] for i, d in enumerate(doc) if i not in (BAD_AT, REPEATED_AT)] == \
         expected
+
+
+def test_a_dask_task_that_killed_its_workers_is_those_paths_error(orthoglide_robot):
+    """Dask re-runs a task whose worker died and gives up with KilledWorker: the task's
+    paths get ``worker-died`` (exit 4, as a --jobs worker killed twice), while any other
+    failure of a task stays ``internal``."""
+    from dataclasses import replace
+
+    from distributed import KilledWorker
+
+    from singcheck.api import load_trajectory
+    from singcheck.cluster import _results
+
+    heart = load_trajectory(ROOT / "trajectories" / "heart1.yaml", orthoglide_robot)
+    p0, p1, p2 = (replace(heart, name=f"p{i}") for i in range(3))
+
+    class Future:
+        def __init__(self, key, error):
+            self.key, self.error = key, error
+
+        def result(self):
+            raise self.error
+
+        def release(self):
+            pass
+
+    class Worker:  # (what KilledWorker names: the last worker the task ran on)
+        address = "tcp://127.0.0.1:1"
+
+    class Tasks:
+        line = None
+
+        def __init__(self):
+            self.completed = [Future("a", KilledWorker("singcheck-0-0", Worker(), 3)),
+                              Future("b", RuntimeError("boom"))]
+            self.chunks = {"a": (0, [p0, p1]), "b": (2, [p2])}
+
+        def next(self):
+            pass
+
+    docs = list(_results(Tasks(), ordered=True))
+    assert "KilledWorker" in docs[0]["error"]["message"]
+    assert [(d["name"], d["error"]["kind"]) for d in docs] == [
+        ("p0", "worker-died"), ("p1", "worker-died"), ("p2", "internal")]

@@ -93,5 +93,28 @@ SLOW_SIZE = 20_000
 def may_be_slow(p: fmpq_mpoly) -> bool:
     """Whether one FLINT factorization, squarefree part or resultant of ``p`` may run
     long enough (a large fraction of a second) to be worth running where a deadline can
-    stop it (:func:`singcheck.elimination.cas.forked.until_deadline`)."""
-    return len(p) * max(1, max(p.degrees(), default=0)) > SLOW_SIZE
+    stop it (:func:`singcheck.elimination.cas.forked.until_deadline`): its terms times its
+    degree, times its coefficients' 64-bit words (a path written with 10⁻⁹¹ carries
+    thousand-digit coefficients into μ)."""
+    size = len(p) * max(1, max(p.degrees(), default=0))
+    return size > SLOW_SIZE or size * (1 + _height_bits(p) // 64) > SLOW_SIZE
+
+
+def products_may_be_slow(*pairs: tuple[fmpq_mpoly, fmpq_mpoly]) -> bool:
+    """Whether the FLINT products of these pairs may run for a large fraction of a second
+    (terms times terms times the coefficients' 64-bit words): then they are formed where
+    a deadline can stop them too."""
+    work = 0
+    for a, b in pairs:
+        work += len(a) * len(b) * (1 + _height_bits(a) // 64) * (1 + _height_bits(b) // 64)
+    return work > SLOW_PRODUCT
+
+
+#: :func:`products_may_be_slow`'s bound (a 600-term product of 64-bit coefficients: 0.4
+#: ms; of 4,800-bit ones, seconds)
+SLOW_PRODUCT = 5_000_000
+
+
+def _height_bits(p: fmpq_mpoly) -> int:
+    """The most bits of a numerator or denominator of p's coefficients."""
+    return max((c.height_bits() for c in p.coeffs()), default=0)

@@ -18,7 +18,7 @@ from __future__ import annotations
 from flint import arb, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpq_poly
 
 from singcheck.algebra.intervals import excludes_zero, working_precision
-from singcheck.algebra.polynomials import may_be_slow, restrict
+from singcheck.algebra.polynomials import may_be_slow, products_may_be_slow, restrict
 from singcheck.algebra.radicals import (
     angle_function_of,
     conjugates,
@@ -182,8 +182,12 @@ def _through_norm(p: fmpq_mpoly, interval: TimeRange, tolerance: float
     p0, p1 = split_s(p if circle is None else circle.to_trig(p))
     if p0.is_zero() or p1.is_zero():
         return None
-    norm = p0 * p0 - p1 * p1 * ONE_MINUS_C2
     from singcheck.elimination.cas.forked import until_deadline
+
+    # (huge coefficients make even the norm's products long: formed where the deadline
+    # can stop them, as the factorizations below)
+    norm = until_deadline(lambda q: q[0] * q[0] - q[1] * q[1] * ONE_MINUS_C2, (p0, p1),
+                          "μ's norm over sin t", products_may_be_slow((p0, p0), (p1, p1)))
 
     slow = may_be_slow(norm)  # then factored where the deadline can stop it
     if all(m == 1 for _, m in until_deadline(lambda q: q.factor_squarefree(), norm,

@@ -437,19 +437,38 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
                                        searches, tolerance)
         report.exact_pending = (path, modes, searches, tolerance)
         return report
-    left = remaining()
-    own = left is None or left > EXACT_CORROBORATION_BUDGET
-    try:
-        with deadline(EXACT_CORROBORATION_BUDGET):
-            exact = with_mu(path)
-            if exact.mu is not None:
-                return _certify_exactly(exact, modes, tolerance, searches)
-    except TimeLimitExceeded:
-        if not own:
-            raise
+    report, exact = _exactly_within(path, modes, searches, tolerance,
+                                    EXACT_CORROBORATION_BUDGET)
+    if report is not None:
+        return report
+    if exact is None:
         exact = replace_path(path, f"the exact engine did not finish within its "
                                    f"{EXACT_CORROBORATION_BUDGET:g} s budget")
     return _certify_by_intervals(exact, modes, searches, tolerance)
+
+
+def _exactly_within(path: PathModel, modes: list[WorkingMode], searches: dict,
+                    tolerance: float, seconds: float):
+    """(report, path): the exact engine's report, held against the intervals'
+    ``searches``, within ``seconds`` (report None when it refused the path: the path
+    returned says why), or (None, None) when that budget ran out first.  The
+    trajectory's own time limit, when it ends first, still raises
+    :class:`~singcheck.budget.TimeLimitExceeded`."""
+    from singcheck.budget import TimeLimitExceeded, deadline, remaining
+    from singcheck.certify.path import with_mu
+
+    left = remaining()
+    own = left is None or left > seconds
+    try:
+        with deadline(seconds):
+            exact = with_mu(path)
+            if exact.mu is not None:
+                return _certify_exactly(exact, modes, tolerance, searches), exact
+    except TimeLimitExceeded:
+        if not own:
+            raise
+        return None, None
+    return None, exact
 
 
 #: ``exact_refused`` of a piece whose exact corroboration is still to come
@@ -465,22 +484,13 @@ def corroborate_exactly(report: TrajectoryReport, seconds: float,
     left: the interval engine's verdict, ``why_not`` saying why the exact engine did not
     run; None when ``why_not`` is None.  The trajectory's own time limit still raises
     :class:`~singcheck.budget.TimeLimitExceeded`."""
-    from singcheck.budget import TimeLimitExceeded, deadline, remaining
-    from singcheck.certify.path import with_mu
-
     path, modes, searches, tolerance = report.exact_pending
     if seconds > 0:
-        left = remaining()
-        own = left is None or left > seconds
-        try:
-            with deadline(seconds):
-                exact = with_mu(path)
-                if exact.mu is not None:
-                    return _certify_exactly(exact, modes, tolerance, searches)
-                return _certify_by_intervals(exact, modes, searches, tolerance)
-        except TimeLimitExceeded:
-            if not own:
-                raise
+        exact_report, exact = _exactly_within(path, modes, searches, tolerance, seconds)
+        if exact_report is not None:
+            return exact_report
+        if exact is not None:
+            return _certify_by_intervals(exact, modes, searches, tolerance)
     if why_not is None:
         return None
     return _certify_by_intervals(replace_path(path, why_not), modes, searches, tolerance)

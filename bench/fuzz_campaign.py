@@ -49,7 +49,8 @@ def start_worker(n: int, run: int, out: Path, examples: int, budget: float = 1.0
     sandbox = out / f"sandbox-{n}"
     for sub in ("home", "tmp", "cases", "cwd"):
         (sandbox / sub).mkdir(parents=True, exist_ok=True)
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "HOME": str(sandbox / "home"),
+    path = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)
+    env = {**os.environ, "PYTHONPATH": path, "HOME": str(sandbox / "home"),
            "TMPDIR": str(sandbox / "tmp"), "SINGCHECK_FUZZ_DIR": str(sandbox / "cases"),
            "SINGCHECK_FUZZ_EXAMPLES": str(examples), "SINGCHECK_FUZZ_KEEP_GOING": "1",
            "SINGCHECK_FUZZ_SLACK": "1", "SINGCHECK_FUZZ_BUDGET": str(budget),

@@ -407,7 +407,11 @@ def _with_radicals(p: fmpq_mpoly, interval: TimeRange, tolerance: float,
     ambiguous is reported undecided, never guessed."""
     ctx = p.context()
     rest = [n for n in ctx.names() if radical_prime(n) is None]
-    norm = restrict(norm_radicals(p), TRIG if len(rest) == 3 else
+    from singcheck.elimination.cas.forked import until_deadline
+
+    norm = until_deadline(norm_radicals, p, "μ's norm over its square roots",
+                          may_be_slow(p))  # large coefficients: seconds in one resultant
+    norm = restrict(norm, TRIG if len(rest) == 3 else
                     fmpq_mpoly_ctx.get(tuple(rest), "lex"))
     iso = isolate_real_roots(norm, interval, tolerance)
     sigmas = conjugates(p)

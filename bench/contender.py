@@ -32,6 +32,7 @@ from itertools import product
 
 from flint import arb, ctx, fmpq, fmpq_poly, fmpz_poly
 
+from singcheck.algebra.radicals import angle_names
 from singcheck.algebra.trig import derivative, reduce_trig
 from singcheck.model.robot import leg_coefficients
 
@@ -127,42 +128,118 @@ def _powers(values: list):
     return power
 
 
+def _slope(grads: list[tuple[int, Poly]], powers, rates: list[arb]) -> arb:
+    """Σ ∂p/∂vᵢ · vᵢ' over the ring variables vᵢ that p involves (the chain rule)."""
+    total = arb(0)
+    for i, g in grads:
+        total += g(powers) * rates[i]
+    return total
+
+
 @dataclass
 class Leg:
+    """A prismatic leg: a ρ² + b(X) ρ + c(X) (a constant), or a ρ + b(X)."""
+
     joint: str
     index: int  # the joint's position among the robot's variables
     degree: int
     a: arb  # leading coefficient in the joint (a constant)
     b: Poly  # quadratic: a ρ² + b(X) ρ + c(X); linear: a ρ + b(X)
-    db: list[Poly]  # ∂b/∂X
+    db: list[tuple[int, Poly]]  # ∂b/∂v for each ring variable v that b involves
     d: Poly | None  # D = b² - 4ac, expanded (tighter than b² - 4ac on balls)
-    dd: list[Poly] | None  # ∂D/∂X
+    dd: list[tuple[int, Poly]] | None  # ∂D/∂v
     limits: tuple[arb, arb] | None
 
-    def values(self, powers, dpose, with_derivative: bool):
-        """{label: (ρ, ρ')} on the box, None where D > 0 is not proven, 'complex' where
-        D < 0 is."""
+    @property
+    def labels(self) -> tuple[str, ...]:
+        return ("+", "-") if self.degree == 2 else ("o",)
+
+    def values(self, powers, rates):
+        """{label: [(variable, ρ, ρ')]} on the box (ρ' None without ``rates``), None
+        where D > 0 is not proven, 'complex' where D < 0 is."""
         b = self.b(powers)
-        db = None
-        if with_derivative:
-            db = arb(0)
-            for g, v in zip(self.db, dpose, strict=True):
-                db += g(powers) * v
+        db = _slope(self.db, powers, rates) if rates is not None else None
         if self.degree == 1:
-            return {"o": (-b / self.a, -db / self.a if with_derivative else None)}
+            return {"o": [(self.index, -b / self.a, -db / self.a if rates is not None else None)]}
         d = self.d(powers)
         if not d > 0:
             return "complex" if d < 0 else None
         root = d.sqrt()
         two_a = 2 * self.a
-        if not with_derivative:
-            return {"+": ((-b + root) / two_a, None), "-": ((-b - root) / two_a, None)}
-        dd = arb(0)
-        for g, v in zip(self.dd, dpose, strict=True):
-            dd += g(powers) * v
-        half = dd / (2 * root)
-        return {"+": ((-b + root) / two_a, (-db + half) / two_a),
-                "-": ((-b - root) / two_a, (-db - half) / two_a)}
+        if rates is None:
+            return {"+": [(self.index, (-b + root) / two_a, None)],
+                    "-": [(self.index, (-b - root) / two_a, None)]}
+        half = _slope(self.dd, powers, rates) / (2 * root)
+        return {"+": [(self.index, (-b + root) / two_a, (-db + half) / two_a)],
+                "-": [(self.index, (-b - root) / two_a, (-db - half) / two_a)]}
+
+    def inside(self, entries) -> bool | None:
+        """Within the joint limits on the whole box: True, False (certainly out
+        somewhere: a point ball is out), None (undecided)."""
+        if self.limits is None:
+            return True
+        rho = entries[0][1]
+        lo, hi = self.limits
+        if rho > lo and rho < hi:
+            return True
+        if rho < lo or rho > hi:
+            return False
+        return None
+
+
+@dataclass
+class RevoluteLeg:
+    """A revolute leg P(X) cos θ + Q(X) sin θ + R(X) = 0, with singcheck's branch labels
+    (singcheck/model/robot.py): on branch σ (label '+' for σ = 1, '-' for σ = -1),
+    W cos θ = -P R + σ Q √Δ, W sin θ = -Q R - σ P √Δ, W = P² + Q², Δ = W - R²; there
+    ∂F/∂θ = -P sin θ + Q cos θ = σ √Δ, so θ' = -(P' cos θ + Q' sin θ + R')/(σ √Δ)."""
+
+    joint: str
+    cos_index: int
+    sin_index: int
+    p: Poly
+    q: Poly
+    r: Poly
+    grads: tuple[list[tuple[int, Poly]], ...]  # ∂P, ∂Q, ∂R over the ring variables
+    delta: Poly  # Δ = P² + Q² - R², expanded
+    w: Poly  # W = P² + Q², expanded
+    limits: tuple[arb, arb, arb] | None  # cos c, sin c, cos h: θ ∈ [c - h, c + h]
+
+    labels = ("+", "-")
+
+    def values(self, powers, rates):
+        """{label: [(cos θ's variable, cos θ, its rate), (sin θ's, sin θ, rate)]},
+        None where Δ > 0 is not proven, 'complex' where Δ < 0 is."""
+        delta = self.delta(powers)
+        if not delta > 0:
+            return "complex" if delta < 0 else None
+        p, q, r, w = self.p(powers), self.q(powers), self.r(powers), self.w(powers)
+        root = delta.sqrt()
+        if rates is not None:
+            dp, dq, dr = (_slope(g, powers, rates) for g in self.grads)
+        out = {}
+        for label, sigma in (("+", 1), ("-", -1)):
+            c = (-p * r + sigma * q * root) / w
+            s = (-q * r - sigma * p * root) / w
+            dc = ds = None
+            if rates is not None:
+                dtheta = -(dp * c + dq * s + dr) / (sigma * root)
+                dc, ds = -s * dtheta, c * dtheta
+            out[label] = [(self.cos_index, c, dc), (self.sin_index, s, ds)]
+        return out
+
+    def inside(self, entries) -> bool | None:
+        """θ within [c - h, c + h] (h < π): exactly where cos(θ - c) >= cos h, tested on
+        θ itself through cos(θ - c) = cos θ cos c + sin θ sin c (no atan2 cut to avoid)."""
+        if self.limits is None:
+            return True
+        cos_c, sin_c, cos_h = self.limits
+        x = entries[0][1] * cos_c + entries[1][1] * sin_c
+        if x > cos_h:
+            return True
+        if x < cos_h:
+            return False
+        return None
 
 
 @dataclass
@@ -186,23 +263,50 @@ class BranchAndBound:
     """The contender on one (robot model, trajectory spec)."""
 
     def __init__(self, model, trajectory, tolerance: float = 1e-9) -> None:
+        if model.radical_legs:
+            raise NotImplementedError("the contender does not handle square roots")
         self.tolerance = tolerance
         self.range = trajectory.range
         names = model.context.names()
-        self.pose_index = [names.index(v) for v in model.pose]
         self.nvars = len(names)
+        # each pose variable's slots in the ring: (x,) or, for an angle, (cos φ, sin φ)
+        self.pose_slots = [tuple(names.index(n) for n in angle_names(v))
+                           if v in model.spec.angles else (names.index(v),)
+                           for v in model.pose]
         self.phi = [Fourier(trajectory.pose[v]) for v in model.pose]
         self.dphi = [Fourier(derivative(trajectory.pose[v])) for v in model.pose]
         self.harmonics = sorted(set().union(*(f.harmonics() for f in self.phi + self.dphi)))
         self.t_degree = max(f.degree_t() for f in self.phi + self.dphi)
         limits = model.spec.joint_limits
 
-        def grad(p) -> list[Poly]:
-            return [Poly(p.derivative(v)) for v in model.pose]
+        def grad(p) -> list[tuple[int, Poly]]:
+            """∂p/∂v for every ring variable v that p involves: multiplied by v's rate
+            (a pose coordinate's from the path, a joint's from its branch)."""
+            out = []
+            for i, v in enumerate(names):
+                g = p.derivative(v)
+                if not g.is_zero():
+                    out.append((i, Poly(g)))
+            return out
 
         self.legs = []
         for leg in model.legs:
             coeffs = leg_coefficients(leg)
+            if leg.kind == "revolute":
+                p, q, r = coeffs
+                lim = None
+                if leg.joint in limits:
+                    lo, hi = (v.ball() for v in limits[leg.joint])
+                    half = (hi - lo) / 2
+                    if half < arb.pi():  # a limit interval narrower than the circle
+                        sin_c, cos_c = ((lo + hi) / 2).sin_cos()
+                        lim = (cos_c, sin_c, half.cos())
+                ci, si = (names.index(n) for n in angle_names(leg.joint))
+                self.legs.append(RevoluteLeg(leg.joint, ci, si, Poly(p), Poly(q), Poly(r),
+                                             (grad(p), grad(q), grad(r)),
+                                             Poly(p * p + q * q - r * r), Poly(p * p + q * q),
+                                             lim))
+                continue
             lim = None
             if leg.joint in limits:
                 lo, hi = limits[leg.joint]
@@ -219,39 +323,46 @@ class BranchAndBound:
                 self.legs.append(Leg(leg.joint, names.index(leg.joint), 1, a, Poly(b), grad(b),
                                      None, None, lim))
         self.det = Poly(model.det_A)
-        self.det_grad = [Poly(model.det_A.derivative(v)) for v in names]
+        self.det_grad = grad(model.det_A)
         self.min_width = arb(max(tolerance, 1e-12) / 1000)
         self.boxes = 0
 
     # -- evaluation --------------------------------------------------------------
 
     def _pose(self, t: arb, with_derivative: bool):
-        """The pose X(T) and X'(T) (or None) on a box, from sin kT and cos kT."""
+        """The ring variables' values on a box T (the pose's; the joints' left 0) and,
+        with ``with_derivative``, their rates (else None), from sin kT and cos kT: an
+        angle φ's cos φ(T), sin φ(T) and rates -sin φ·φ', cos φ·φ' (the chain rule)."""
         sc = {k: (k * t).sin_cos() for k in self.harmonics}
         tp = [arb(1), t]
         for _ in range(self.t_degree - 1):
             tp.append(tp[-1] * t)
-        pose = [f(tp, sc) for f in self.phi]
-        dpose = [f(tp, sc) for f in self.dphi] if with_derivative else None
-        return pose, dpose
-
-    def _values(self, pose: list[arb]) -> list:
         values = [arb(0)] * self.nvars
-        for i, x in zip(self.pose_index, pose, strict=True):
-            values[i] = x
-        return values
+        rates = [arb(0)] * self.nvars if with_derivative else None
+        for slot, f, df in zip(self.pose_slots, self.phi, self.dphi, strict=True):
+            x = f(tp, sc)
+            dx = df(tp, sc) if with_derivative else None
+            if len(slot) == 1:
+                values[slot[0]] = x
+                if with_derivative:
+                    rates[slot[0]] = dx
+            else:
+                s, c = x.sin_cos()
+                values[slot[0]], values[slot[1]] = c, s
+                if with_derivative:
+                    rates[slot[0]], rates[slot[1]] = -s * dx, c * dx
+        return values, rates
 
     def _joints(self, t: arb, labels: str, with_derivative: bool):
-        pose, dpose = self._pose(t, with_derivative)
-        values = self._values(pose)
+        values, rates = self._pose(t, with_derivative)
         powers = _powers(values)
         joints = []
         for leg, label in zip(self.legs, labels, strict=True):
-            v = leg.values(powers, dpose, with_derivative)
+            v = leg.values(powers, rates)
             if v is None or v == "complex":
                 return None
-            joints.append((leg.index, *v[label]))
-        return values, dpose, joints
+            joints += v[label]
+        return values, rates, joints
 
     def det_a(self, t: arb, labels: str, with_derivative: bool = False):
         """(F(T), F'(T) or None), or None where a branch is not proven real on T."""
@@ -263,24 +374,18 @@ class BranchAndBound:
         got = self._joints(t, labels, with_derivative is not False)
         if got is None:
             return None
-        values, dpose, joints = got
+        values, rates, joints = got
         values = list(values)
-        for index, rho, _ in joints:
-            values[index] = rho
+        for index, value, _ in joints:
+            values[index] = value
         powers = _powers(values)
         value = self.det(powers)
         if with_derivative is False or (with_derivative is None and not value.contains(0)):
             return value, None
-        rates = [arb(0)] * self.nvars
-        for i, dx in zip(self.pose_index, dpose, strict=True):
-            rates[i] = dx
-        for index, _, drho in joints:
-            rates[index] = drho
-        slope = arb(0)
-        for g, rate in zip(self.det_grad, rates, strict=True):
-            if g.terms:
-                slope += g(powers) * rate
-        return value, slope
+        rates = list(rates)
+        for index, _, rate in joints:
+            rates[index] = rate
+        return value, _slope(self.det_grad, powers, rates)
 
     def _sign(self, point: arb, labels: str) -> int | None:
         r = self.det_a(point, labels)
@@ -298,42 +403,38 @@ class BranchAndBound:
 
     # -- feasibility ---------------------------------------------------------------
 
-    def leg_feasible(self, leg: Leg) -> dict[str, str]:
+    def leg_feasible(self, leg) -> dict[str, str]:
         """feasible | infeasible | unknown for each branch of one leg over the whole range
-        (both branches share the boxes and the evaluations)."""
-        labels = ("+", "-") if leg.degree == 2 else ("o",)
+        (both branches share the boxes and the evaluations).  A branch left unknown on
+        one box (its branches meet there, or it touches a limit) stays under test on the
+        later boxes: a box on which the leg is proven complex, or the branch proven out
+        of its limits, still makes it infeasible."""
+        labels = leg.labels
         status = dict.fromkeys(labels, "feasible")
         stack = [(lo, hi, labels) for lo, hi in self._pieces(FEASIBILITY_PIECES)]
         while stack:
             lo, hi, open_ = stack.pop()
-            open_ = tuple(lb for lb in open_ if status[lb] == "feasible")
+            open_ = tuple(lb for lb in open_ if status[lb] != "infeasible")
             if not open_:
                 continue
             self.boxes += 1
-            pose, _ = self._pose(_box(lo, hi), False)
-            v = leg.values(_powers(self._values(pose)), None, False)
+            values, _ = self._pose(_box(lo, hi), False)
+            v = leg.values(_powers(values), None)
             if v == "complex":
                 return dict.fromkeys(labels, "infeasible")
             left = []
             for label in open_:
-                if v is None:
-                    left.append(label)
-                    continue
-                if leg.limits is None:
-                    continue
-                rho = v[label][0]
-                lo_lim, hi_lim = leg.limits
-                if rho > lo_lim and rho < hi_lim:
-                    continue
-                if rho < lo_lim or rho > hi_lim:
+                inside = None if v is None else leg.inside(v[label])
+                if inside is False:
                     status[label] = "infeasible"
-                    continue
-                left.append(label)
+                elif inside is None:
+                    left.append(label)
             if not left:
                 continue
             if hi - lo < self.min_width or self.boxes > _MAX_BOXES:
                 for label in left:
-                    status[label] = "unknown"
+                    if status[label] == "feasible":
+                        status[label] = "unknown"
                 continue
             m = _mid(lo, hi)
             stack += [(m, hi, tuple(left)), (lo, m, tuple(left))]

@@ -25,6 +25,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from fractions import Fraction
 from pathlib import Path
 
 #: glibc's malloc thresholds, fixed for the whole bench (it re-executes itself with them).
@@ -50,6 +51,7 @@ from generate import waypoints_yaml, write, write_stream  # noqa: E402
 from peak_rss import run_measured  # noqa: E402
 from scaling import print_scaling, scaling_rows  # noqa: E402
 
+from singcheck.algebra.radicals import angle_names  # noqa: E402
 from singcheck.certify.classification import certify_path  # noqa: E402
 from singcheck.certify.path import build_path  # noqa: E402
 from singcheck.certify.pieces import certify_trajectory  # noqa: E402
@@ -121,29 +123,55 @@ def stats(ts: list) -> dict:
 # -- the sampling contender -------------------------------------------------------
 
 class SamplingScan:
-    """det A along one working mode at n points, vectorised; sign changes are 'found'."""
+    """det A along one working mode at n points, vectorised; sign changes are 'found'.
+
+    The robot's ring variables in the model's order: a pose coordinate's value, an
+    angle's cos and sin (3-RPR), a prismatic joint's branch (-b ± √D)/(2a), a revolute
+    joint's (cos θ, sin θ) branch σ (W cos θ = -a d + σ b √Δ, W sin θ = -b d - σ a √Δ,
+    singcheck's labels)."""
 
     def __init__(self, path, mode_label: str) -> None:
+        model = path.projection.model
+        names = model.context.names()
+        self.nvars = len(names)
         self.range = (float(path.trajectory.range.start), float(path.trajectory.range.end))
-        self.phi = [numpy_polynomial(p) for p in path.phi]
-        self.legs = [([numpy_polynomial(c) for c in leg.coefficients], sign)
+        self.pose = [(tuple(names.index(n) for n in angle_names(v)) if v in model.spec.angles
+                      else (names.index(v),), numpy_polynomial(p))
+                     for v, p in zip(model.pose, path.phi, strict=True)]
+        self.legs = [(leg.leg.kind, leg.leg.joint_index,
+                      [numpy_polynomial(c) for c in leg.coefficients], sign)
                      for leg, sign in zip(path.legs, mode_label, strict=True)]
-        self.det_a = numpy_polynomial(path.projection.model.det_A)
+        self.det_a = numpy_polynomial(model.det_A)
+        # the path's ring: t, s = sin t, c = cos t, then any square root a limit brought
+        # in (the 5-bar's pi/3 gives sqrt(3)), a constant
+        ring = path.phi[0].context().names()
+        self.surds = [float(Fraction(v[5:-1])) ** 0.5 for v in ring[3:]]
 
     def __call__(self, n: int) -> list[float]:
         t = np.linspace(*self.range, n)
-        tsc = [t, np.sin(t), np.cos(t)]
-        pose = [f(tsc) for f in self.phi]
-        joints = []
-        for coeffs, sign in self.legs:
-            values = [f(tsc) for f in coeffs]
-            if len(values) == 2:
-                joints.append(-values[1] / values[0])
+        tsc = [t, np.sin(t), np.cos(t), *(np.full(n, r) for r in self.surds)]
+        values = [np.zeros(n)] * self.nvars
+        for slots, f in self.pose:
+            x = f(tsc)
+            if len(slots) == 1:
+                values[slots[0]] = x
             else:
-                a, b, c = values
+                values[slots[0]], values[slots[1]] = np.cos(x), np.sin(x)
+        for kind, index, coeffs, sign in self.legs:
+            parts = [f(tsc) for f in coeffs]
+            if kind == "revolute":
+                a, b, d = parts
+                w = a * a + b * b
+                root = np.sqrt(w - d * d) * (1 if sign == "+" else -1)
+                values[index] = (-a * d + b * root) / w
+                values[index + 1] = (-b * d - a * root) / w
+            elif len(parts) == 2:
+                values[index] = -parts[1] / parts[0]
+            else:
+                a, b, c = parts
                 root = np.sqrt(b * b - 4 * a * c)
-                joints.append((-b + (root if sign == "+" else -root)) / (2 * a))
-        d = self.det_a([*joints, *pose])
+                values[index] = (-b + (root if sign == "+" else -root)) / (2 * a)
+        d = self.det_a(values)
         s = np.sign(d)
         idx = np.nonzero(s[:-1] * s[1:] < 0)[0]
         return list((t[idx] + t[idx + 1]) / 2)
@@ -166,9 +194,19 @@ PATHS = (("orthoglide", "trajectories/heart1.yaml", "heart 1"),
          ("orthoglide", "bench/paths/heart2-long.yaml", "heart 2, [-10π, 10π]"),
          ("orthoglide", "bench/paths/helix-long.yaml", "helix, [-10π, 10π]"),
          ("biglide", "trajectories/biglide-double-cross.yaml", "biglide, crosses twice"),
-         ("biglide", "trajectories/biglide-graze.yaml", "biglide, grazes"))
+         ("biglide", "trajectories/biglide-graze.yaml", "biglide, grazes"),
+         ("five-bar", "trajectories/five-bar-cross.yaml", "5-bar, crosses"),
+         ("five-bar", "trajectories/five-bar-free.yaml", "5-bar, free"),
+         ("3-rpr", "trajectories/3-rpr-cross.yaml", "3-RPR, crosses"),
+         ("3-rpr", "trajectories/3-rpr-free.yaml", "3-RPR, free"),
+         ("orthoglide", "trajectories/leaves-workspace.yaml", "leaves the workspace"),
+         ("orthoglide", "bench/paths/leaves-limits.yaml", "leaves the joint limits"))
 SHORT = ("heart 1", "heart 2", "helix", "8-harmonic heart")
 LONG = ("heart 1, [-10π, 10π]", "heart 2, [-10π, 10π]", "helix, [-10π, 10π]")
+#: issue 27: the bundled 5-bar and 3-RPR paths and the infeasible Orthoglide paths, where
+#: singcheck must take at most 1.0x the elimination-free peer (``bench.py peer``)
+PEER = ("5-bar, crosses", "5-bar, free", "3-RPR, crosses", "3-RPR, free",
+        "leaves the workspace", "leaves the joint limits")
 
 
 def load(robot: str, trajectory: str, backend: str = "flint"):
@@ -199,17 +237,22 @@ def agrees(answer, report, tolerance: float = 1e-9) -> bool:
     return True
 
 
-def compare(robot: str, trajectory: str, label: str) -> list[dict]:
-    """singcheck, the branch-and-bound contender and the sampling scans on one path."""
+def compare(robot: str, trajectory: str, label: str, backends: bool = True) -> list[dict]:
+    """singcheck, the branch-and-bound contender and the sampling scans on one path (and,
+    on heart 1 with ``backends``, singcheck with each CAS's projection)."""
     projection, spec = load(robot, trajectory)
     model = projection.model
     report = certify_path(build_path(projection, spec))
     answer = contender(model, spec)
-    mode = next(m.label for m in report.modes if m.feasible)
-    truth = truth_of(report, mode)
-    scan = SamplingScan(build_path(projection, spec), mode)
-    width = scan.range[1] - scan.range[0]
+    mode = next((m.label for m in report.modes if m.feasible), None)
+    truth = truth_of(report, mode) if mode is not None else []
     sizes = (10**3, 10**4, 10**5)
+    if mode is None:  # an infeasible path: no working mode to scan along
+        print(f"{label}: no feasible working mode ({report.verdict}): no sampling scan")
+        scan, sizes = None, ()
+    else:
+        scan = SamplingScan(build_path(projection, spec), mode)
+        width = scan.range[1] - scan.range[0]
     timings = interleaved([lambda: certify_path(build_path(projection, spec)),
                            lambda: contender(model, spec),
                            *[lambda n=n: scan(n) for n in sizes]])
@@ -226,7 +269,7 @@ def compare(robot: str, trajectory: str, label: str) -> list[dict]:
         rows.append({**case, "contender": f"NumPy sampling, {n:.0e}", **stats(ts),
                      "found": found_all(found, truth, 2 * width / (n - 1)),
                      "sign_changes": len(found)})
-    if (robot, Path(trajectory).stem) == ("orthoglide", "heart1"):
+    if backends and (robot, Path(trajectory).stem) == ("orthoglide", "heart1"):
         rows += [{**case, **r} for r in backend_rows(projection.model, spec, truth)]
     base = rows[0]["cpu_median_s"]
     for row in rows:
@@ -481,6 +524,23 @@ def growth_rows() -> list[dict]:
     return rows
 
 
+def peer_targets(paths: list[dict]) -> list[dict]:
+    """Issue 27: on the bundled 5-bar and 3-RPR paths and the infeasible Orthoglide
+    paths, singcheck's CPU median at most 1.0x the elimination-free peer's (the
+    branch-and-bound, same rounds); the peer's agreement is said alongside."""
+    out = []
+    for label in PEER:
+        mine = {r["contender"]: r for r in paths if r["case"] == label}
+        if not mine:
+            continue
+        ours, peer = mine["singcheck (certified)"], mine["branch-and-bound (certified)"]
+        ratio = ours["cpu_median_s"] / peer["cpu_median_s"]
+        out.append({"target": f"{label}: singcheck <= 1.0x the branch-and-bound",
+                    "value": ratio, "limit": 1.0, "met": ratio <= 1.0,
+                    "peer_agrees": peer["agrees_with_singcheck"]})
+    return out
+
+
 def targets(paths: list[dict], cli: list[dict], growth: list[dict]) -> list[dict]:
     """Issue 17's speed targets, checked on the figures of this run (the growth rows:
     singcheck's median per trajectory over the branch-and-bound's, same rounds)."""
@@ -495,6 +555,7 @@ def targets(paths: list[dict], cli: list[dict], growth: list[dict]) -> list[dict
             label, "branch-and-bound (certified)")
         out.append({"target": f"{label}: singcheck <= {limit}x the branch-and-bound",
                     "value": ratio, "limit": limit, "met": ratio <= limit})
+    out += peer_targets(paths)
     ratio = median("heart 1", "singcheck (certified)") / median("heart 1",
                                                                 "NumPy sampling, 1e+04")
     out.append({"target": "heart 1: singcheck <= 2x the 10^4-point NumPy scan",
@@ -642,17 +703,7 @@ def ms(x: float) -> str:
     return f"{1000 * x:9.2f}"
 
 
-def main() -> None:
-    order = "every round in the listed order" if FIXED_ORDER else \
-        f"each round in its own order (seed {ROUND_ORDER_SEED})"
-    results = {"machine": machine(), "repeat": REPEAT, "round_order": order}
-    print(f"machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, "
-          f"Python {results['machine']['python']}, load average {os.getloadavg()[0]:.1f} "
-          f"at the start; medians of {REPEAT} round-robin runs, {order}; glibc malloc "
-          "thresholds fixed high (the sampling scans' best case)\n")
-    results["paths"] = rows = []
-    for robot, trajectory, label in PATHS:
-        rows += compare(robot, trajectory, label)
+def print_paths(rows: list[dict]) -> None:
     print(f"{'path':24} {'contender':32} {'CPU ms':>9} {'min CPU':>9} {'wall ms':>9} "
           f"{'vs singcheck':>12}  right answer?")
     for r in rows:
@@ -668,6 +719,20 @@ def main() -> None:
           "/ singcheck's; right answer: singcheck decided; branch-and-bound: same verdict "
           "and singular times as singcheck; sampling: sign changes at exactly singcheck's "
           "singular times)")
+
+
+def main() -> None:
+    order = "every round in the listed order" if FIXED_ORDER else \
+        f"each round in its own order (seed {ROUND_ORDER_SEED})"
+    results = {"machine": machine(), "repeat": REPEAT, "round_order": order}
+    print(f"machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, "
+          f"Python {results['machine']['python']}, load average {os.getloadavg()[0]:.1f} "
+          f"at the start; medians of {REPEAT} round-robin runs, {order}; glibc malloc "
+          "thresholds fixed high (the sampling scans' best case)\n")
+    results["paths"] = rows = []
+    for robot, trajectory, label in PATHS:
+        rows += compare(robot, trajectory, label)
+    print_paths(rows)
     results["robots"] = robots = robot_rows()
     print(f"\nbundled robots (issue 12): certification per path, flint, CPU medians of "
           f"{REPEAT} round-robin runs (children's CPU included), projection cached / not "
@@ -785,6 +850,36 @@ def user_inputs_only() -> None:
     out.write_text(json.dumps(results, indent=2) + "\n")
 
 
+def peer_only() -> None:
+    """``python bench/bench.py peer``: singcheck against the elimination-free peer and
+    the sampling scans on issue 27's paths (5-bar, 3-RPR, infeasible Orthoglide) and
+    heart 1 (without its per-backend rows); the rows merged into results.json's "paths"
+    (a row of the same path and contender replaced), the targets into "peer_targets"."""
+    print(f"load average {os.getloadavg()[0]:.2f} at the start; medians of {REPEAT} "
+          "round-robin runs\n")
+    rows = []
+    for robot, trajectory, label in PATHS:
+        if label in PEER or label == "heart 1":
+            rows += compare(robot, trajectory, label, backends=False)
+    print_paths(rows)
+    goals = peer_targets(rows)
+    print("\ntargets (issue 27), on this run:")
+    for g in goals:
+        print(f"  {'MET    ' if g['met'] else 'NOT MET'}  {g['target']}: {g['value']:.2f}x"
+              f"  (peer agrees with singcheck: {'yes' if g['peer_agrees'] else 'NO'})")
+    print(f"  {sum(g['met'] for g in goals)} of {len(goals)} targets met; load average "
+          f"{os.getloadavg()[0]:.2f} at the end")
+    out = ROOT / "bench" / "results.json"
+    results = json.loads(out.read_text()) if out.exists() else {"machine": machine()}
+    # a row replaces the one of the same path and contender (heart 1's backend rows,
+    # not rerun here, stay)
+    new = {(r["case"], r["contender"]) for r in rows}
+    results["paths"] = [r for r in results.get("paths", [])
+                        if (r["case"], r["contender"]) not in new] + rows
+    results["peer_targets"] = goals
+    out.write_text(json.dumps(results, indent=2) + "\n")
+
+
 if __name__ == "__main__":
     if sys.argv[1:] == ["batch"]:
         batch_only()
@@ -794,5 +889,7 @@ if __name__ == "__main__":
         scaling_only()
     elif sys.argv[1:] == ["inputs"]:
         user_inputs_only()
+    elif sys.argv[1:] == ["peer"]:
+        peer_only()
     else:
         main()

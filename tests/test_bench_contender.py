@@ -112,3 +112,109 @@ def test_the_round_robin_varies_each_rounds_order_reproducibly(monkeypatch):
     assert all((a, 3) in after for a in (0, 1, 4))  # 3 follows others than 2
     monkeypatch.setattr(bench, "FIXED_ORDER", True)
     assert set(rounds(3)) == {(0, 1, 2, 3, 4)}
+
+
+def _contains(ball, root) -> bool:
+    lo = mpmath.mpf(ball.lower().str(40, radius=False))
+    hi = mpmath.mpf(ball.upper().str(40, radius=False))
+    return lo - mpmath.mpf(10) ** -30 <= root <= hi + mpmath.mpf(10) ** -30 and hi - lo <= 1e-9
+
+
+def _elbow(ax, px, py, left: bool):
+    """The 5-bar's elbow B on a leg from A = (ax, 0) (links of length 2 and 2) to the end
+    effector P: one of the two intersections of the circles of radius 2 about A and P,
+    the one further left (or right), and its joint angle atan2(By, Bx - ax)."""
+    dx, dy = px - ax, py
+    dist = mpmath.sqrt(dx**2 + dy**2)
+    h = mpmath.sqrt(4 - (dist / 2) ** 2)
+    mx, my = (ax + px) / 2, py / 2
+    nx, ny = -dy / dist, dx / dist
+    b = sorted([(mx + h * nx, my + h * ny), (mx - h * nx, my - h * ny)])
+    bx, by = b[0] if left else b[1]
+    return bx, by, mpmath.atan2(by, bx - ax)
+
+
+def _five_bar_det_a(px, py):
+    """det A / 4 of the 5-bar (d = 1, l1 = l2 = 2; robots/five-bar.yaml) at P in the mode
+    of its limits, elbow 1 out to the left, elbow 2 to the right: det(P - B1, P - B2),
+    each row ∂/∂(x, y) of |P - Bᵢ|² / 2."""
+    b1x, b1y, th1 = _elbow(-1, px, py, left=True)
+    b2x, b2y, th2 = _elbow(1, px, py, left=False)
+    assert mpmath.pi / 3 < th1 < mpmath.pi and 0 < th2 < 2 * mpmath.pi / 3
+    return (px - b1x) * (py - b2y) - (py - b1y) * (px - b2x)
+
+
+def _three_rpr_det_a(x, y, phi):
+    """det A of the 3-RPR (robots/3-rpr.yaml): rows ∂/∂(x, y, phi) of each leg's squared
+    length; no joint in it (every mode has the same det A)."""
+    c, s = mpmath.cos(phi), mpmath.sin(phi)
+    u, v = x + c - 5, y + s
+    p, q = x - s - 1, y + c - 4
+    return mpmath.det(mpmath.matrix([[2 * x, 2 * y, 0],
+                                     [2 * u, 2 * v, 2 * (-u * s + v * c)],
+                                     [2 * p, 2 * q, 2 * (-p * c - q * s)]]))
+
+
+def test_contender_on_the_five_bar_matches_mpmath():
+    # five-bar-cross: x = 0, y = 3 - 2t on [0, 1]; five-bar-free: x = -1 + 2t, y = 5/2
+    model, spec = _load("five-bar", "five-bar-cross")
+    answer = contender(model, spec)
+    assert answer.verdict == "singular" and answer.feasible == ["+-"]
+    expected = _sign_changes(lambda t: _five_bar_det_a(mpmath.mpf(0), 3 - 2 * t), 0, 1)
+    (found,) = answer.singular_times["+-"]
+    assert len(expected) == 1 and _contains(found, expected[0])
+    assert abs(expected[0] - (3 - mpmath.sqrt(3)) / 2) < mpmath.mpf(10) ** -40
+    model, spec = _load("five-bar", "five-bar-free")
+    answer = contender(model, spec)
+    assert answer.verdict == "singularity-free" and answer.feasible == ["+-"]
+    assert not _sign_changes(lambda t: _five_bar_det_a(-1 + 2 * t, mpmath.mpf(5) / 2), 0, 1)
+
+
+def test_contender_on_the_three_rpr_matches_mpmath():
+    # 3-rpr-cross: (2 + cos t, 2 + sin t, t); 3-rpr-free: (3 - cos t, 1/2 + sin t, t);
+    # each leg -r² + |…|²: its branch '-' is r = +√|…|², the one within [1/2, 5]
+    model, spec = _load("3-rpr", "3-rpr-cross")
+    answer = contender(model, spec)
+    assert answer.verdict == "singular" and answer.feasible == ["---"]
+    expected = _sign_changes(
+        lambda t: _three_rpr_det_a(2 + mpmath.cos(t), 2 + mpmath.sin(t), t), 0, 1)
+    (found,) = answer.singular_times["---"]
+    assert len(expected) == 1 and _contains(found, expected[0])
+    model, spec = _load("3-rpr", "3-rpr-free")
+    answer = contender(model, spec)
+    assert answer.verdict == "singularity-free" and answer.feasible == ["---"]
+    assert not _sign_changes(
+        lambda t: _three_rpr_det_a(3 - mpmath.cos(t), mpmath.mpf(1) / 2 + mpmath.sin(t), t),
+        0, 1)
+
+
+def test_contender_slopes_match_mpmath_derivatives():
+    # F'(t) from the chain rule through the revolute branches' θ' (5-bar) and the pose
+    # angle's cos φ, sin φ (3-RPR) against mpmath's numerical derivative of det A along
+    # the path; the model's det A is the test's up to a constant factor k
+    from contender import BranchAndBound
+    from flint import arb
+
+    cases = (("five-bar", "five-bar-cross", "+-",
+              lambda t: _five_bar_det_a(mpmath.mpf(0), 3 - 2 * t)),
+             ("3-rpr", "3-rpr-cross", "---",
+              lambda t: _three_rpr_det_a(2 + mpmath.cos(t), 2 + mpmath.sin(t), t)))
+    for robot, trajectory, mode, f in cases:
+        model, spec = _load(robot, trajectory)
+        bb = BranchAndBound(model, spec)
+        for t in (mpmath.mpf(3) / 10, mpmath.mpf(7) / 10):
+            value, slope = bb.det_a(arb(str(t)), mode, True)
+            k = float(value.mid()) / float(f(t))
+            assert abs(float(slope.mid()) - k * float(mpmath.diff(f, t))) < 1e-9 * (
+                1 + abs(float(slope.mid())))
+
+
+def test_contender_proves_leaving_the_workspace_infeasible():
+    # x = 3 sin t, y = 0, z = 1 on [0, π/2]: leg 2's ρ₂ = y ± √(4 - x² - z²) has its
+    # branches meet at x = √3 (t = asin(1/√3)) and is complex after it; the box where
+    # they meet stays undecided, the later ones prove the leg infeasible
+    t = mpmath.mpf(3) / 2
+    assert 4 - (3 * mpmath.sin(t)) ** 2 - 1 < 0
+    model, spec = _load("orthoglide", "leaves-workspace")
+    answer = contender(model, spec)
+    assert answer.verdict == "infeasible" and answer.feasible == []

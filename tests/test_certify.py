@@ -193,3 +193,42 @@ def test_a_path_whose_quick_proofs_pass_never_composes_its_legs(orthoglide_proje
     assert a == TRIG.from_dict({(0, 0, 0): 1})
     assert b == -2 * path.coordinates[0] and path.coordinates[0] == fmpq(8, 7) * s**3 \
         or b == -2 * path.coordinates[0]
+
+
+def test_a_ball_program_holds_every_value_and_matches_the_term_by_term_enclosure():
+    """algebra.ball_programs: a compiled group of polynomials (constants, ±1
+    coefficients, powers shared between polynomials, the zero polynomial) gives, at
+    balls of the variables, enclosures that hold the exact rational value at 27 points
+    of the box and are no wider than intervals.evaluate's (the same operations, less a
+    product by ±1); a JointSum holds
+    Σ q_k·ρ^α at exact points too."""
+    import itertools
+    from fractions import Fraction
+
+    from flint import fmpq_mpoly_ctx
+
+    from singcheck.algebra.ball_programs import BallProgram, JointSum
+    from singcheck.algebra.intervals import evaluate
+
+    ctx = fmpq_mpoly_ctx.get(("x", "y", "z"), "lex")
+    x, y, z = ctx.gens()
+    polys = [x**2 - 2 * y + fmpq(1, 3), -x * y * z + fmpq(3, 7) * z**2, ctx.from_dict({}),
+             -y, x**3 * y**2 - z**4 + 5]
+    program = BallProgram(polys)
+    box = [(Fraction(-1, 2), Fraction(3, 4)), (Fraction(2), Fraction(21, 10)),
+           (Fraction(-3, 10), Fraction(1, 10))]
+    balls = [arb(fmpq(a.numerator, a.denominator)).union(arb(fmpq(b.numerator, b.denominator)))
+             for a, b in box]
+    got = program(balls)
+    for g, e in zip(got, [evaluate(p, balls) for p in polys], strict=True):  # no wider
+        assert float(g.rad()) <= float(e.rad()) * (1 + 1e-6) and g.overlaps(e)
+    for point in itertools.product(*[(a, (a + b) / 2, b) for a, b in box]):
+        exact = [fmpq(v.numerator, v.denominator) for v in point]
+        for p, ball in zip(polys, got, strict=True):
+            assert ball.contains(arb(p(*exact))), (p, point)
+    total = JointSum([((0, 1), (1, 2)), ((2, 1),), ()])
+    q = [arb(2), arb(-3), arb(fmpq(1, 3))]
+    joints = [arb(fmpq(1, 2)).union(arb(1)), arb(-1).union(arb(1)), arb(fmpq(1, 5))]
+    enclosure = total(q, joints)
+    for a, b, c in itertools.product((fmpq(1, 2), fmpq(3, 4), 1), (-1, 0, 1), (fmpq(1, 5),)):
+        assert enclosure.contains(arb(2 * a * b**2 - 3 * c + fmpq(1, 3)))

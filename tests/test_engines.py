@@ -105,7 +105,7 @@ def test_a_free_verdict_the_intervals_cannot_confirm_is_unknown(orthoglide, monk
     with the window and its bound."""
     monkeypatch.setattr(interval_engine, "BUDGET", 0)
     monkeypatch.setattr(classification, "first_pass_budget", lambda path, modes: 0)
-    monkeypatch.setattr(interval_engine, "pieces", lambda interval: [
+    monkeypatch.setattr(interval_engine, "pieces", lambda interval, count=6: [
         interval.start.ball().union(interval.end.ball())])
     report = _check(orthoglide, "heart2")
     assert report.verdict == "unknown"
@@ -188,3 +188,81 @@ def test_the_mean_value_form_encloses_det_a_on_every_piece(orthoglide):
             assert enclosure.contains(arb(str(8 * _det_a_plus(t))))
         narrower += enclosure.rad() < plain["+++"].rad()
     assert narrower >= 3
+
+
+def _model_det_at(model, joints: list, X: list) -> mp.mpf:
+    """det A of the robot model (its exact polynomial) at 50 digits: the joints' values
+    (a revolute joint's angle, substituted as its cos and sin) and the pose's (an
+    angle's likewise), each variable by its name."""
+    values = {}
+    for leg, q in zip(model.legs, joints, strict=True):
+        if leg.kind == "revolute":
+            values[f"cos({leg.joint})"], values[f"sin({leg.joint})"] = mp.cos(q), mp.sin(q)
+        else:
+            values[leg.joint] = q
+    for v, x in zip(model.pose, X, strict=True):
+        values[v], values[f"cos({v})"], values[f"sin({v})"] = x, mp.cos(x), mp.sin(x)
+    names = model.context.names()
+    total = mp.mpf(0)
+    for exps, c in model.det_A.terms():
+        term = mp.mpf(int(c.p)) / int(c.q)
+        for name, e in zip(names, exps, strict=True):
+            if e:
+                term *= values[name] ** int(e)
+        total += term
+    return total
+
+
+@pytest.mark.parametrize("name", ["five-bar-cross", "3-rpr-cross", "3-prr-cross"])
+def test_the_mean_value_form_and_its_slope_enclose_det_a_and_its_rate(name, robots):  # noqa: F811
+    """On pieces of a revolute robot's path and of two pose-angle robots' paths, the
+    mean-value enclosure of det A along the feasible mode holds det A, and its slope holds
+    d/dt det A, both at 50 digits at points across the piece: det A is the model's own
+    polynomial evaluated in mpmath at the oracle's inverse kinematics (each leg's branch:
+    the closed-form root nearest the engine's ball at the piece's middle), its rate a
+    central difference with h = 10⁻²⁰.  (The slopes use the closed-form branch rates,
+    ρ' = (−b' + σD'/(2√D))/(2a) and θ' = −(∇ₓf·X')/(σ√Δ).)"""
+    from flint import arb
+
+    from singcheck.certify.interval_engine import mean_value, mode_values
+
+    path = {p.name: p for p in oracles.PATHS}[name]
+    oracle = path.oracle()
+    robot = robots(oracle.robot)
+    report = api.check(robot, api.load_trajectory(TRAJECTORIES / f"{name}.yaml", robot),
+                       regions=False)
+    modes = [m for m in report.working_modes if m.feasible]
+    model = robot.projection.model
+    assert modes
+    checked = 0
+    for lo, hi in [(0.1, 0.2), (0.4, 0.45), (0.7, 0.7001)]:
+        piece = arb(lo).union(arb(hi))
+        _, joints, _ = mode_values(report.path, modes, piece)
+        forms = mean_value(report.path, modes, piece, joints)
+        mid = (mp.mpf(lo) + mp.mpf(hi)) / 2
+        _, at_mid, _ = mode_values(report.path, modes, arb(str(mid)))
+        for mode in modes:
+            if mode.label not in forms:
+                continue
+            value, slope = forms[mode.label]
+            picks = []  # which closed-form root each leg's branch is
+            for leg, ours in zip(oracle.legs, at_mid[mode.label], strict=True):
+                both = leg.branches(path.pose(mid))
+                ball = ours[0] if isinstance(ours, tuple) else ours
+                target = float(ball.mid())
+                picks.append(min((0, 1), key=lambda k, both=both, target=target: abs(
+                    (mp.cos(both[k]) if leg.revolute else both[k]) - target)))
+
+            def det_at(t, picks=picks):
+                X = path.pose(t)
+                q = [leg.branches(X)[k] for leg, k in zip(oracle.legs, picks, strict=True)]
+                return _model_det_at(model, q, X)
+
+            h = mp.mpf(10) ** -20
+            for k in range(5):
+                t = mp.mpf(lo) + (mp.mpf(hi) - mp.mpf(lo)) * k / 4
+                assert value.contains(arb(mp.nstr(det_at(t), 40)))
+                rate = (det_at(t + h) - det_at(t - h)) / (2 * h)
+                assert slope.contains(arb(mp.nstr(rate, 30))), (mode.label, lo, t)
+            checked += 1
+    assert checked >= 3

@@ -217,8 +217,23 @@ def _as_surd(x) -> Surd:
 
 
 def cos_pi(q: Fraction) -> Surd | None:
-    """cos(qπ) exactly when 12q is an integer (the angles with surd cosines we use)."""
+    """cos(qπ) exactly when 12q is an integer (the angles with surd cosines we use).
+    The same Surd object for the same q (a surd is never changed in place): the working
+    modes ask for a 5-bar's limits at every path."""
     q = Fraction(q)
+    hit = _COS_PI.get(q, _MISSING)
+    if hit is _MISSING:
+        if len(_COS_PI) > 4096:
+            _COS_PI.clear()
+        hit = _COS_PI[q] = _cos_pi(q)
+    return hit
+
+
+_COS_PI: dict[Fraction, Surd | None] = {}
+_MISSING = object()
+
+
+def _cos_pi(q: Fraction) -> Surd | None:
     if (12 * q).denominator != 1:
         return None
     j = int(12 * q) % 24
@@ -384,8 +399,11 @@ def norm_radicals(p: fmpq_mpoly) -> fmpq_mpoly:
 
 def radical_balls(ctx: fmpq_mpoly_ctx, signs: dict[int, int] | None = None) -> dict[int, arb]:
     """index → ball of ±√q for every radical variable (``signs``: prime → ±1)."""
+    variables = radical_variables(ctx)
+    if not variables:
+        return {}
     signs = signs or {}
-    return {i: arb(q).sqrt() * signs.get(q, 1) for i, q in radical_variables(ctx)}
+    return {i: arb(q).sqrt() * signs.get(q, 1) for i, q in variables}
 
 
 def expand_trig(coefficients: dict[str, int], pi_part: Fraction,

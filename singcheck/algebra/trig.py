@@ -179,6 +179,23 @@ def evaluate_trig(p: fmpq_mpoly, t: arb, tight: bool = False) -> arb:
     return total
 
 
+def split_of(p: fmpq_mpoly):
+    """For a caller enclosing ``p`` over many balls: a function giving ``_split(p)`` at
+    the current precision, when :func:`evaluate_trig` (not ``tight``) would enclose p by
+    :func:`evaluate_split` (a trig polynomial below :data:`FOURIER_ALWAYS`); else None."""
+    if p.context() is not TRIG or _high_harmonic(p):
+        return None
+    by_precision: dict = {}
+
+    def split():
+        hit = by_precision.get(ctx.prec)
+        if hit is None:
+            hit = by_precision[ctx.prec] = _split(p)
+        return hit
+
+    return split
+
+
 def evaluate_split(split, t: arb, s: arb, c: arb) -> arb:
     """The enclosure :func:`evaluate_trig` (not ``tight``) makes from ``_split(p)`` at
     the current precision, given Arb's balls of sin t and cos t over the ball t: for
@@ -419,12 +436,12 @@ def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | tuple | arb_poly:
     """[(P₀ᵢ, P₁ᵢ) for i = 0 … deg_t p] as ball polynomials at the current precision;
     a polynomial free of t: the pair (P₀, P₁) itself (P₁ None when p is free of s, whose
     term s·P₁(c) is then an exact 0); free of sin and cos: one ball polynomial in t.
-    Memoised per polynomial and precision (the oldest polynomial dropped past
+    Memoised per polynomial and precision (the first one in dropped past
     :data:`_SPLITS_KEPT`)."""
     hit = _SPLITS.get(id(p))
     if hit is not None and hit[0] is p:
         split = hit[1].get(ctx.prec)
-        if split is not None:
+        if split is not None:  # (not moved to the end: first in, first dropped)
             return split
     else:
         hit = (p, {})
@@ -433,7 +450,6 @@ def _split(p: fmpq_mpoly) -> list[tuple[arb_poly, arb_poly]] | tuple | arb_poly:
         exact = hit[1]["exact"] = _exact_split(p)
     split = hit[1][ctx.prec] = _balls_of(exact)
     _SPLITS[id(p)] = hit
-    _SPLITS.move_to_end(id(p))
     if len(_SPLITS) > _SPLITS_KEPT:
         _SPLITS.popitem(last=False)
     return split

@@ -28,11 +28,11 @@ def budget(interval: TimeRange) -> int:
     return max(BUDGET, math.ceil(BUDGET * periods))
 
 
-def pieces(interval: TimeRange) -> list[arb]:
-    """Balls covering the closed range (slightly more at irrational ends)."""
+def pieces(interval: TimeRange, count: int = PIECES) -> list[arb]:
+    """``count`` balls covering the closed range (slightly more at irrational ends)."""
     lo, hi = interval.start.ball().lower(), interval.end.ball().upper()
-    step = (hi - lo) / PIECES
-    edges = [(lo + step * i).mid() for i in range(PIECES)] + [hi]
+    step = (hi - lo) / count
+    edges = [(lo + step * i).mid() for i in range(count)] + [hi]
     edges[0] = lo
     return [a.union(b) for a, b in zip(edges, edges[1:], strict=False)]
 

@@ -39,6 +39,16 @@ MIN_WIDTH = 2.0 ** -26
 #: ... for a piece holding a time the caller expects det A to vanish at (a hint: the
 #: window left there only has to be narrow enough to tell that zero from others)
 HINT_WIDTH = 2.0 ** -14
+#: pieces of the first cover per 2π of range (FIRST_COVER), or PER_HARMONIC per 2π and
+#: per harmonic of the path (a coordinate's degree in sin t, cos t) when that is more;
+#: at least MIN_FIRST_COVER, at most MAX_FIRST_COVER.  Wider pieces failed every test on
+#: the bench's paths (their enclosures hold 0), so the halving starts there rather than
+#: at six pieces (heart 1, 4 harmonics: 5.4 -> 4.3 ms; the [-10π, 10π] heart 1: 52 -> 31
+#: ms; fewer pieces made the helix slower, more made heart 1 slower)
+FIRST_COVER = 24
+PER_HARMONIC = 8
+MIN_FIRST_COVER = 6
+MAX_FIRST_COVER = 256
 #: ball evaluations (all the modes at once) per 2π of range, at least BUDGET
 BUDGET = 20000
 
@@ -136,7 +146,8 @@ def search_det_a(path, modes: list, refine: set[str] | None = None,
     refine = {m.label for m in modes} if refine is None else refine
     found: dict[str, dict[tuple[float, float], tuple[int | None, float]]] = {
         m.label: {} for m in modes}
-    todo = deque((piece, list(modes)) for piece in pieces(interval))
+    first = _first_cover(path, width)
+    todo = deque((piece, list(modes)) for piece in pieces(interval, first))
     while todo:  # breadth first: a spent budget leaves the whole range equally refined
         checkpoint()
         piece, open_modes = todo.popleft()
@@ -175,6 +186,13 @@ def search_det_a(path, modes: list, refine: set[str] | None = None,
             a, b = halves(piece)
             todo += [(a, again), (b, again)]
     return {label: _summarise(label, pieces_found) for label, pieces_found in found.items()}
+
+
+def _first_cover(path, width: float) -> int:
+    """The number of pieces the search starts from (:data:`PER_HARMONIC`)."""
+    harmonic = path.harmonic or 0
+    per_period = max(FIRST_COVER, PER_HARMONIC * harmonic)
+    return min(MAX_FIRST_COVER, max(MIN_FIRST_COVER, round(per_period * width / (2 * math.pi))))
 
 
 def inside_range(path, piece: arb) -> tuple[arb, arb]:
@@ -247,10 +265,21 @@ _DERIVATIVES: dict = {}
 
 
 def _derivative_parts(model):
-    """Per model, once: ∂det A/∂v for every variable v it involves, and per leg its
-    constraint's partial derivatives in the pose variables and in its joint."""
-    from singcheck.algebra.polynomials import coefficient_in, memo_per_object
-    from singcheck.model.robot import REVOLUTE
+    """Per model, once: ∂det A/∂v for every variable v it involves, and per leg what its
+    joint's rate along the path is formed from (:func:`mean_value`):
+
+    * a quadratic prismatic leg a·ρ² + b·ρ + c (a constant): ∇ₓb and ∇ₓD, D = b² − 4ac
+      expanded, and D itself: ρ' = (−b' + σ·D'/(2√D))/(2a) on its branch σ;
+    * a revolute leg P·cos θ + Q·sin θ + R: ∇ₓ of the constraint and Δ = P² + Q² − R²:
+      θ' = −(∇ₓf·X')/(σ√Δ), since ∂f/∂θ = Q·cos θ − P·sin θ = σ√Δ on branch σ;
+    * another leg: ∇ₓf and ∂f/∂ρ: ρ' = −(∇ₓf·X')/(∂f/∂ρ).
+
+    The closed forms are the implicit derivative with ∂f/∂ρ replaced by the value it
+    has on the branch, σ√D (and, for the prismatic leg, ρ itself eliminated from the
+    numerator): the same function, enclosed without the dependency between a wide ball
+    of ρ and the pose's balls (heart 1's slopes: about 35% narrower)."""
+    from singcheck.algebra.polynomials import constant_value, memo_per_object
+    from singcheck.model.robot import REVOLUTE, leg_coefficients, leg_discriminant
 
     def build(model):
         names = model.context.names()
@@ -259,19 +288,51 @@ def _derivative_parts(model):
         pose_range = range(n_joint, n_joint + n_pose)
         det = [(i, model.det_A.derivative(i)) for i, d in enumerate(model.det_A.degrees())
                if d > 0 and i < n_joint + n_pose]
+
+        def grad(q):
+            return [(i, q.derivative(i)) for i in pose_range if q.degrees()[i] > 0]
+
         legs = []
         for leg in model.legs:
             f = leg.constraint
-            dx = [(i, f.derivative(i)) for i in pose_range if f.degrees()[i] > 0]
             idx = [names.index(v) for v in leg.variables]
+            coefficients = leg_coefficients(leg)
             if leg.kind == REVOLUTE:
-                legs.append((REVOLUTE, idx, dx, (coefficient_in(f, idx[0], 1),
-                                                 coefficient_in(f, idx[1], 1))))
+                legs.append((REVOLUTE, idx, grad(f), (leg_discriminant(leg, coefficients),)))
+            elif leg.degree == 2 and coefficients[0].is_constant():
+                disc = leg_discriminant(leg, coefficients)
+                legs.append((QUADRATIC, idx, grad(coefficients[1]),
+                             (grad(disc), disc, 2 * constant_value(coefficients[0]))))
             else:
-                legs.append(("prismatic", idx, dx, f.derivative(idx[0])))
+                legs.append(("prismatic", idx, grad(f), (f.derivative(idx[0]),)))
         return n_joint, det, legs
 
     return memo_per_object(_DERIVATIVES, model, build)
+
+
+QUADRATIC = "quadratic"
+
+
+def _derivative_polys(model) -> list:
+    """:func:`_derivative_parts`' polynomials in the order :func:`mean_value` reads
+    them: per leg its gradient, then (quadratic) ∇ₓD and D, (revolute) Δ, (other)
+    ∂f/∂ρ; then det A's partial derivatives."""
+    _, det_parts, legs = _derivative_parts(model)
+    out = []
+    for kind, _, dx, extra in legs:
+        out += [q for _, q in dx]
+        if kind == QUADRATIC:
+            out += [q for _, q in extra[0]] + [extra[1]]
+        else:
+            out.append(extra[0])
+    return out + [q for _, q in det_parts]
+
+
+def _evaluator(polys: list, point: list, powers: dict):
+    """Each call: the ball of the next polynomial of ``polys`` at ``point``."""
+    from singcheck.algebra.intervals import evaluate
+
+    return (evaluate(q, point, powers) for q in polys).__next__
 
 
 def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
@@ -285,7 +346,7 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
     Every quantity is a ball enclosing its values over ``t``, so the result encloses
     det A over ``t`` (the mean value theorem, on a continuous branch of a feasible mode).
     ``joints``: each mode's joint balls over ``t`` (:func:`mode_values`)."""
-    from singcheck.algebra.intervals import evaluate
+    from singcheck.algebra.ball_programs import ball_program
     from singcheck.algebra.radicals import radical_balls
     from singcheck.model.robot import REVOLUTE
 
@@ -296,9 +357,11 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
     if rates is None:
         return {}
     n_joint, det_parts, legs = _derivative_parts(model)
+    parts = _derivative_polys(model)
+    program = ball_program(model, "mean value", _derivative_polys)
+    variables = path.pose_variables_at(t)  # (before the midpoint's: the caller's, kept)
     m = arb(t.mid())
     _, _, at_mid = mode_values(path, modes, m)
-    variables = path.pose_variables_at(t)
     radicals = [b for _, b in sorted(radical_balls(model.context).items())]
     out = {}
     for mode in modes:
@@ -311,23 +374,45 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
         if not all(isinstance(v, arb) for v in flat):
             continue
         point = flat + list(variables) + radicals
-        powers: dict = {}
+        if program is not None:
+            balls = program(point)  # every partial derivative at once
+            ball = iter(balls).__next__
+        else:
+            powers: dict = {}
+            ball = _evaluator(parts, point, powers)
         speed = [arb(0)] * n_joint + rates
-        for kind, idx, dx, lead in legs:
+        sigmas = _branch_signs(mode)
+        for (kind, idx, dx, extra), sigma in zip(legs, sigmas, strict=True):
             push = arb(0)
-            for i, p in dx:
-                push += evaluate(p, point, powers) * speed[i]
-            if kind == REVOLUTE:
+            for i, _ in dx:
+                push += ball() * speed[i]
+            if kind == QUADRATIC:  # ρ' = (−b' + σ·D'/(2√D))/(2a)
+                d_rate = arb(0)
+                for i, _ in extra[0]:
+                    d_rate += ball() * speed[i]
+                disc = ball()
+                if not disc > 0 or sigma is None:
+                    break
+                speed[idx[0]] = (-push + sigma * d_rate / (2 * disc.sqrt())) / extra[2]
+            elif kind == REVOLUTE:  # θ' = −(∇ₓf·X')/(σ√Δ)
+                disc = ball()
+                if not disc > 0 or sigma is None:
+                    break
                 c, s = point[idx[0]], point[idx[1]]
-                a, b = (evaluate(q, point, powers) for q in lead)
-                rate = -push / (b * c - a * s)
+                rate = -push / (sigma * disc.sqrt())
                 speed[idx[0]], speed[idx[1]] = -s * rate, c * rate
             else:
-                speed[idx[0]] = -push / evaluate(lead, point, powers)
-        slope = arb(0)
-        for i, p in det_parts:
-            slope += evaluate(p, point, powers) * speed[i]
-        value = mid + slope * (t - m)
-        if value.is_finite():
-            out[mode.label] = (value, slope)
+                speed[idx[0]] = -push / ball()
+        else:
+            slope = arb(0)
+            for i, _ in det_parts:
+                slope += ball() * speed[i]
+            value = mid + slope * (t - m)
+            if value.is_finite():
+                out[mode.label] = (value, slope)
     return out
+
+
+def _branch_signs(mode) -> list[int | None]:
+    """σ = ±1 of each leg's branch in the mode (None for a linear leg's only one)."""
+    return [1 if b.label == "+" else -1 if b.label == "-" else None for b in mode.branches]

@@ -25,6 +25,7 @@ from functools import cached_property
 
 from flint import acb, acb_mat, arb, arb_mat, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx
 
+from singcheck.algebra.ball_programs import ball_program, joint_sum
 from singcheck.algebra.composition import (
     MAX_COMPOSE_WORK,
     PIECE_WORK,
@@ -56,7 +57,13 @@ from singcheck.algebra.radicals import (
     sin_pi,
     surd_polynomial,
 )
-from singcheck.algebra.trig import TRIG, cos_multiple, reduce_trig, sin_multiple
+from singcheck.algebra.trig import (
+    TRIG,
+    cos_multiple,
+    evaluate_split,
+    reduce_trig,
+    sin_multiple,
+)
 from singcheck.budget import checkpoint
 from singcheck.elimination.projection import (
     RobotProjection,
@@ -483,34 +490,86 @@ class PathModel:
     degenerate: tuple[fmpq_mpoly, ...] = ()  # W of each revolute leg along the path
     exact_refused: str = ""  # why μ was not computed ("" when it was)
 
+    #: (t, precision, pose, variables) of the last :meth:`pose_and_variables_at` (set
+    #: per instance; this class attribute is only the empty start)
+    _last_pose = (None, 0, (), ())
+
     def pose_at(self, t: arb) -> list[arb]:
         """The pose coordinates (an angle in radians, its π offset included)."""
         return self.pose_and_variables_at(t)[0]
 
     def pose_variables_at(self, t: arb) -> list[arb]:
         """Balls of the model's pose variables (cos φ, sin φ for an angle)."""
-        return [evaluate_path(x, t) for x in self.coordinates]
+        return self.pose_and_variables_at(t)[1]
 
     def pose_and_variables_at(self, t: arb) -> tuple[list[arb], list[arb]]:
         """:meth:`pose_at` and :meth:`pose_variables_at` together, each polynomial
         evaluated once: a coordinate that is not an angle is its own pose variable (the
-        same polynomial object, hence the same ball)."""
-        seen: dict[int, arb] = {}
+        same polynomial object, hence the same ball).  The last ball's answer is kept
+        (the interval engine asks for the same ball's pose for the enclosure, then for
+        its mean-value form); it is replaced whole, never edited, and the lists handed
+        out are copies."""
+        last = self._last_pose
+        if last[0] is t and last[1] == ctx.prec:
+            return list(last[2]), list(last[3])
+        pose, variables = self._pose_and_variables(t)
+        object.__setattr__(self, "_last_pose", (t, ctx.prec, pose, variables))
+        return list(pose), list(variables)
 
-        def value(x: fmpq_mpoly) -> arb:
-            hit = seen.get(id(x))
-            if hit is None:
-                hit = seen[id(x)] = evaluate_path(x, t)
-            return hit
+    def _pose_and_variables(self, t: arb) -> tuple[list[arb], list[arb]]:
+        plan, pose_at, variables_at, offsets = self._pose_plan
+        s = c = None
+        balls = []
+        for x, split in plan:  # each distinct coordinate polynomial once
+            if split is None:
+                balls.append(evaluate_path(x, t))
+                continue
+            if s is None:
+                s, c = t.sin_cos()
+            balls.append(evaluate_split(split(), t, s, c))
+        pose = [balls[i] for i in pose_at]
+        for i, offset in offsets:
+            pose[i] = pose[i] + arb.pi() * offset
+        return pose, [balls[i] for i in variables_at]
 
-        pose = []
+    @cached_property
+    def harmonic(self) -> int | None:
+        """The highest harmonic of the path: the largest degree in (sin t, cos t) of its
+        coordinates (0 for a path polynomial in t); None when a coordinate is not a trig
+        polynomial (angle functions, square roots, expression trees)."""
+        degrees = []
+        for x in self.coordinates:
+            trig = _in_trig(x)
+            if trig is None:
+                return None
+            d = trig.degrees()
+            degrees.append(int(max(d[1], 0) + max(d[2], 0)))
+        return max(degrees, default=0)
+
+    @cached_property
+    def _pose_plan(self):
+        """How :meth:`pose_and_variables_at` encloses the pose, once per path: each
+        distinct coordinate polynomial with, for a trig polynomial of low degree, its
+        ball split (:func:`~singcheck.algebra.trig.evaluate_split`, at the current
+        precision: the enclosure :func:`evaluate_path` makes, without its look-ups);
+        the pose's and the pose variables' positions among them; the angle offsets."""
+        from singcheck.algebra.trig import split_of
+
+        plan, where = [], {}
+
+        def at(x: fmpq_mpoly) -> int:
+            if id(x) not in where:
+                where[id(x)] = len(plan)
+                trig = _in_trig(x)
+                plan.append((x, split_of(trig) if trig is not None else None))
+            return where[id(x)]
+
+        pose_at = [at(x) for x in self.phi]
+        variables_at = [at(x) for x in self.coordinates]
         offsets = self.trajectory.angle_offsets
-        for v, x in zip(self.projection.model.pose, self.phi, strict=True):
-            ball = value(x)
-            if v in offsets:
-                ball = ball + arb.pi() * fraction_ball(offsets[v])
-            pose.append(ball)
-        return pose, [value(x) for x in self.coordinates]
+        shifts = [(i, fraction_ball(offsets[v]))
+                  for i, v in enumerate(self.projection.model.pose) if v in offsets]
+        return plan, pose_at, variables_at, shifts
 
     def pose_rates_at(self, t: arb, angle_functions: bool = True) -> list[arb] | None:
         """d/dt of each pose variable over the ball ``t`` (None, without
@@ -562,9 +621,16 @@ class PathModel:
         n_joint = len(model.joint_variables)
         point = [arb(0)] * n_joint + list(pose)
         point += [b for _, b in sorted(radical_balls(model.context, signs).items())]
+        program = ball_program(model, "det A by joints",
+                               lambda m: [q for _, q in _det_a_by_joints(m)])
+        revolute = model.angle_joints  # a revolute joint's ball is a (cos θ, sin θ) pair
+        if program is not None:
+            q = program(point)
+            total = joint_sum(model, lambda m: [alpha for alpha, _ in _det_a_by_joints(m)])
+            return {label: total(q, _flat_joints(joints) if revolute else joints)
+                    for label, joints in joints_by_mode.items()}
         powers: dict = {}
         terms = [(alpha, evaluate(q, point, powers)) for alpha, q in split]
-        revolute = model.angle_joints  # a revolute joint's ball is a (cos θ, sin θ) pair
         out = {}
         for label, joints in joints_by_mode.items():
             flat = _flat_joints(joints) if revolute else joints
@@ -600,8 +666,30 @@ class PathModel:
         :func:`branches_at_pose`)."""
         model = self.projection.model
         point = _pose_point(model, pose)
-        powers: dict = {}  # the pose's powers, shared by the legs
-        return [_branches_at_point(model, leg.leg, point, powers) for leg in self.legs]
+        program, slices = self._legs_program
+        if program is None:
+            powers: dict = {}  # the pose's powers, shared by the legs
+            return [_branches_at_point(model, leg.leg, point, powers) for leg in self.legs]
+        balls = program(point)  # every leg's coefficients and discriminant at once
+        return [_branches_from(leg, balls[a:b]) for leg, a, b in slices]
+
+    @cached_property
+    def _legs_program(self):
+        """(the compiled program of every leg's :func:`_branch_polys`, [(leg, start, end)]
+        of its balls), or (None, None) when too large; once per path."""
+        model = self.projection.model
+        legs = [leg.leg for leg in self.legs]
+        if len(legs) != len(model.legs) or any(
+                a is not b for a, b in zip(legs, model.legs, strict=True)):
+            return None, None
+        program = ball_program(model, "legs", lambda m: [q for leg in m.legs
+                                                         for q in _branch_polys(leg)])
+        slices, at = [], 0
+        for leg in legs:
+            n = len(_branch_polys(leg))
+            slices.append((leg, at, at + n))
+            at += n
+        return program, slices
 
     def conjugate_branches(self, t: arb, pose: list[arb], signs: dict[int, int]):
         """Per leg, the branches of the conjugate robot (its square roots' signs flipped
@@ -711,15 +799,32 @@ _ZERO = arb(0)
 
 def _branches_at_point(model: RobotModel, leg: Leg, point: list,
                        powers: dict | None = None) -> dict:
-    coefficients = _leg_coefficients(leg)
-    disc = _model_discriminant(leg)
-    if leg.kind != REVOLUTE and leg.degree == 2:  # (-b ± √D)/(2a): c is in D already
-        values = [evaluate(coefficients[0], point, powers),
-                  evaluate(coefficients[1], point, powers), None]
-    else:
-        values = [evaluate(c, point, powers) for c in coefficients]
-    return branch_values(leg, values,
-                         evaluate(disc, point, powers) if disc is not None else None)
+    return _branches_from(leg, [evaluate(q, point, powers) for q in _branch_polys(leg)])
+
+
+_BRANCH_POLYS: dict = {}
+
+
+def _branch_polys(leg: Leg) -> tuple[fmpq_mpoly, ...]:
+    """The polynomials whose balls give the leg's branches (:func:`branch_values`): a
+    quadratic prismatic leg's a, b and D (c is in D already), another leg's coefficients
+    and its discriminant when it has one; once per leg."""
+    def build(leg):
+        coefficients = _leg_coefficients(leg)
+        disc = _model_discriminant(leg)
+        if leg.kind != REVOLUTE and leg.degree == 2:  # (-b ± √D)/(2a)
+            return (coefficients[0], coefficients[1], disc)
+        return tuple(coefficients) + ((disc,) if disc is not None else ())
+
+    return memo_per_object(_BRANCH_POLYS, leg, build)
+
+
+def _branches_from(leg: Leg, balls: list) -> dict:
+    """:func:`branch_values` from the balls of :func:`_branch_polys` (in its order)."""
+    if leg.kind != REVOLUTE and leg.degree == 2:
+        return branch_values(leg, [balls[0], balls[1], None], balls[2])
+    n = len(_leg_coefficients(leg))
+    return branch_values(leg, list(balls[:n]), balls[n] if len(balls) > n else None)
 
 
 def leg_polynomials(leg: Leg) -> tuple[fmpq_mpoly, fmpq_mpoly, fmpq_mpoly]:
@@ -1103,8 +1208,20 @@ _DEGENERATE: dict = {}
 
 
 def _legs_from_pose(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]) -> bool:
-    """:attr:`PathModel.legs_from_pose`."""
-    return model.polynomial and all(x.context() is TRIG for x in coordinates)
+    """:attr:`PathModel.legs_from_pose`: a robot free of square roots, along coordinates
+    that are plain trig polynomials (in t, sin t, cos t alone, even in a path ring with
+    more variables: a 5-bar's limit at π/3 brings √3 into it)."""
+    return not model.spec.radicals and all(_in_trig(x) is not None for x in coordinates)
+
+
+def _in_trig(x: fmpq_mpoly) -> fmpq_mpoly | None:
+    """``x`` in the ring TRIG of t, sin t, cos t, when it involves nothing else."""
+    if x.context() is TRIG:
+        return x
+    names, degrees = x.context().names(), x.degrees()
+    if names[:3] != ("t", "s", "c") or any(d > 0 for d in degrees[3:]):
+        return None
+    return restrict(x, TRIG)
 
 
 def _legs_along(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]

@@ -62,6 +62,9 @@ from singcheck.report.plots import numpy_polynomial  # noqa: E402
 from singcheck.spec.files import load_robot, load_trajectory, parse_trajectory  # noqa: E402
 
 REPEAT = int(os.environ.get("BENCH_REPEAT", "15"))
+#: the engine singcheck is timed with: ``auto``, what ``singcheck run`` does (the interval
+#: engine first, the exact one corroborating it; both run on every path below)
+ENGINE = os.environ.get("BENCH_ENGINE", "auto")
 #: the seed of the rounds' orders (:func:`interleaved`); BENCH_FIXED_ORDER=1 runs every
 #: round in the listed order instead, as the bench did before (for comparison)
 ROUND_ORDER_SEED = 17
@@ -242,7 +245,7 @@ def compare(robot: str, trajectory: str, label: str, backends: bool = True) -> l
     on heart 1 with ``backends``, singcheck with each CAS's projection)."""
     projection, spec = load(robot, trajectory)
     model = projection.model
-    report = certify_path(build_path(projection, spec))
+    report = certify_path(build_path(projection, spec, ENGINE))
     answer = contender(model, spec)
     mode = next((m.label for m in report.modes if m.feasible), None)
     truth = truth_of(report, mode) if mode is not None else []
@@ -253,7 +256,7 @@ def compare(robot: str, trajectory: str, label: str, backends: bool = True) -> l
     else:
         scan = SamplingScan(build_path(projection, spec), mode)
         width = scan.range[1] - scan.range[0]
-    timings = interleaved([lambda: certify_path(build_path(projection, spec)),
+    timings = interleaved([lambda: certify_path(build_path(projection, spec, ENGINE)),
                            lambda: contender(model, spec),
                            *[lambda n=n: scan(n) for n in sizes]])
     right = agrees(answer, report)
@@ -289,7 +292,7 @@ def backend_rows(model, spec, truth) -> list[dict]:
             continue
 
         def once(backend=backend):
-            return certify_path(build_path(project_robot(model, backend), spec))
+            return certify_path(build_path(project_robot(model, backend), spec, ENGINE))
 
         report = once()
         mode = next(m.label for m in report.modes if m.feasible)
@@ -492,9 +495,9 @@ def growth_rows() -> list[dict]:
             paths = write(Path(out) / str(k), 3, harmonics=k, seed=k)
             specs = [load_trajectory(p, model.spec) for p in paths]
             ours, theirs = interleaved(
-                [lambda ss=specs: [certify_path(build_path(projection, s)) for s in ss],
+                [lambda ss=specs: [certify_path(build_path(projection, s, ENGINE)) for s in ss],
                  lambda ss=specs: [contender(model, s) for s in ss]], 9)
-            reports = [certify_path(build_path(projection, s)) for s in specs]
+            reports = [certify_path(build_path(projection, s, ENGINE)) for s in specs]
             answers = [contender(model, s) for s in specs]
             right = sum(agrees(a, r) for a, r in zip(answers, reports, strict=True))
             # the contender's unknown (a graze, a limit touched at a singular point) is no
@@ -515,7 +518,7 @@ def growth_rows() -> list[dict]:
         proj_t = times(lambda m=m, backend=backend: project_robot(m, backend), 3)
         projection = project_robot(m, backend)
         spec = load_trajectory(ROOT / "trajectories" / f"{trajectory}.yaml", m.spec)
-        cert_t = times(lambda p=projection, s=spec: certify_path(build_path(p, s)), 3)
+        cert_t = times(lambda p=projection, s=spec: certify_path(build_path(p, s, ENGINE)), 3)
         rows.append({"axis": "robot", "size": len(m.joints), "robot": robot,
                      "trajectory": trajectory,
                      "xi_degree": int(projection.singularity_surface.total_degree()),
@@ -659,10 +662,11 @@ def robot_rows() -> list[dict]:
         repeat = max(3, REPEAT // 3) if robot == "gough-stewart" else REPEAT
         for name in paths:
             spec = load_trajectory(ROOT / "trajectories" / f"{name}.yaml", model.spec)
-            report = certify_path(build_path(projection, spec))
+            report = certify_path(build_path(projection, spec, ENGINE))
             cached, uncached, unforked = interleaved(
-                [lambda p=projection, s=spec: certify_path(build_path(p, s)),
-                 *(lambda s=spec, m=model, b=b: certify_path(build_path(project_robot(m, b), s))
+                [lambda p=projection, s=spec: certify_path(build_path(p, s, ENGINE)),
+                 *(lambda s=spec, m=model, b=b: certify_path(
+                     build_path(project_robot(m, b), s, ENGINE))
                    for b in (backend, FlintBackend()))],
                 repeat)
             c, u = stats(cached), stats(uncached)

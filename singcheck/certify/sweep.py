@@ -17,9 +17,12 @@ path: a path whose quick proofs all pass never composes its legs.
 A fact is proven when it holds on every ball of a cover of the range (a piece where it
 fails is halved until the budget of evaluations is spent), hence on the whole range.
 A fact the sweep does not prove is left to :mod:`.working_modes`, which then isolates
-the roots that decide it.  Swept: prismatic quadratic legs of a robot free of square
-roots and angles, along a path whose coordinates are plain trig polynomials; the
-others keep the leg-by-leg proofs.
+the roots that decide it.  Swept: prismatic quadratic legs and revolute legs (their
+(cos θ, sin θ) branches from P·cos θ + Q·sin θ + R = 0 where Δ = P² + Q² − R² > 0,
+:func:`~singcheck.certify.path.branch_values`, inside the limits as
+:func:`~singcheck.certify.path.inside_limits` decides) of a robot free of square roots,
+along a path whose coordinates are plain trig polynomials; the others keep the
+leg-by-leg proofs.
 """
 
 from __future__ import annotations
@@ -38,7 +41,13 @@ from singcheck.certify.covers import (
     pieces,
     within_one_period,
 )
-from singcheck.certify.path import inside_limits, leg_polynomials, limit_balls
+from singcheck.certify.path import (
+    _branches_at_point,
+    _in_trig,
+    inside_limits,
+    leg_polynomials,
+    limit_balls,
+)
 from singcheck.model.robot import REVOLUTE
 
 #: a fact: (leg index, None) for "D > 0", (leg index, label) for "the branch is inside"
@@ -60,12 +69,12 @@ def sweep_quick_proofs(path, limits_of: dict, starts: list[dict]
         return set(), set()
     facts: list[Fact] = []
     for i, leg in enumerate(path.legs):
-        if leg.leg.kind == REVOLUTE or leg.leg.degree != 2:
+        if leg.leg.kind != REVOLUTE and leg.leg.degree != 2:
             continue
         facts.append((i, None))
         limits = limits_of.get(leg.leg.joint)
         if limits is not None:
-            facts += [(i, label) for label in leg.labels if isinstance(starts[i][label], arb)
+            facts += [(i, label) for label in leg.labels if _real(starts[i][label])
                       and inside_limits(leg.leg, starts[i][label], limits) is True]
     groups: list[tuple[object, list[Fact]]] = []  # (range, facts of the legs covering it)
     ranges: dict[int, object] = {}
@@ -83,6 +92,13 @@ def sweep_quick_proofs(path, limits_of: dict, starts: list[dict]
     for rng, members in groups:
         proven |= _walk(path, members, pieces(rng), budget(rng), limits_of)
     return proven, set(facts)
+
+
+def _real(branch) -> bool:
+    """A branch enclosed as real: a ball, or a revolute joint's (cos θ, sin θ) balls."""
+    if isinstance(branch, tuple):
+        return all(isinstance(v, arb) for v in branch)
+    return isinstance(branch, arb)
 
 
 def _leg_range(path, i: int):
@@ -106,12 +122,15 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
         if i not in legs:
             leg = path.legs[i].leg
             limits = limits_of.get(leg.joint)
+            if leg.kind == REVOLUTE:  # its (cos θ, sin θ) branches from the pose's balls
+                legs[i] = (REVOLUTE, leg, None, limits)
+                continue
             a, b, d = leg_polynomials(leg)
             # a constant leading coefficient (the Orthoglide's 1): 2a once for all pieces
             legs[i] = (2 * evaluate(a, ()) if a.is_constant() else a, b, d,
                        limit_balls(limits) if limits else None)
     coordinates = [(x, ball_split(x), x.degrees()[1] + x.degrees()[2] >= TIGHT_COORDINATE)
-                   for x in path.coordinates]
+                   for x in map(_in_trig, path.coordinates)]  # (legs_from_pose: in TRIG)
     head = [arb(0)] * len(model.joint_variables)
     work = [(piece, facts) for piece in todo]
     queued = dict.fromkeys(facts, len(todo))
@@ -134,6 +153,15 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
             spent[f] += 1
             i, label = f
             a, b, d, limits = legs[i]
+            if a is REVOLUTE:
+                hit = values.get(i)
+                if hit is None:
+                    both = _branches_at_point(model, b, point, powers)
+                    hit = values[i] = [both, all(_real(v) for v in both.values())]
+                if not hit[1] or (label is not None and
+                                  inside_limits(b, hit[0][label], limits) is not True):
+                    still.append(f)
+                continue
             hit = values.get(i)
             if hit is None:
                 dv = evaluate(d, point, powers)

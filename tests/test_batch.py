@@ -1039,3 +1039,31 @@ def test_names_stay_in_memory_when_the_disk_fails(monkeypatch):
     assert names.db is None and len(names) == 6  # the 3 on disk came back
     assert names.claim("p3", "b.yaml", 9) == ("a.yaml", 3)
     assert names.claim("p6", "a.yaml", 6) is None and names.db is None and len(names) == 7
+
+
+@pytest.mark.slow
+def test_a_long_streamed_batch_leaves_the_parent_as_it_was(tmp_path, monkeypatch,
+                                                          orthoglide_robot):
+    """The whole parent of a streamed --jobs 2 batch (the stream cut into spans, the
+    lines the workers wrote gathered, unordered as jsonl runs it): 4,000 more paths
+    leave its traced memory as it was (each kept some 170 bytes before issue 32)."""
+    import tracemalloc
+
+    from singcheck import api
+    from singcheck.report.trajectory import JsonLine, robot_json
+    from singcheck.spec.files import read_documents
+
+    def untraced_worker():  # the workers do not trace: only this process is measured
+        tracemalloc.stop()
+        real()
+
+    real = api._worker_signals
+    monkeypatch.setattr(api, "_worker_signals", untraced_worker)
+    stream = _straight_lines(tmp_path / "long.yaml", 5000 + 200)
+    batch = api.check_batch(orthoglide_robot, read_documents([stream], spans=True), jobs=2,
+                            regions=False, ordered=False,
+                            line=JsonLine(robot_json(orthoglide_robot.projection)))
+    verdicts = set()
+    grown, count = _traced_growth((verdicts.add(r["verdict"]) for r in batch), (1000, 5000))
+    assert count == 5200 and verdicts <= {"singular", "singularity-free", "infeasible"}
+    assert grown < 256 * 1024, grown  # the 4,000 names were about 680 KB

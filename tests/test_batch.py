@@ -932,3 +932,138 @@ def test_a_dask_task_that_killed_its_workers_is_those_paths_error(orthoglide_rob
     assert "KilledWorker" in docs[0]["error"]["message"]
     assert [(d["name"], d["error"]["kind"]) for d in docs] == [
         ("p0", "worker-died"), ("p1", "worker-died"), ("p2", "internal")]
+
+
+# -- issue 32: the parent's memory stays flat however many paths -----------------------
+
+
+def _straight_lines(path, count: int, first: int = 0):
+    """``count`` straight-line documents named line-FIRST … (cheap to certify), each 8
+    lines long."""
+    path.write_text("".join(f"---\nname: line-{i}\nparameter: t\nrange: [0, 1]\npose:\n"
+                            f"  x: {i % 7}/10 + t/{i % 5 + 2}\n  y: {i % 3 + 1}/4\n  z: 1\n"
+                            for i in range(first, first + count)))
+    return path
+
+
+def _traced_growth(items, marks: tuple[int, int]) -> tuple[int, int]:
+    """The memory tracemalloc traces in this process after the first and the second mark
+    of ``items`` (each one dropped once seen), and how many there were."""
+    import gc
+    import tracemalloc
+
+    at, count = {}, 0
+    tracemalloc.start()
+    try:
+        for count, _ in enumerate(items, 1):
+            if count in marks:
+                gc.collect()
+                at[count] = tracemalloc.get_traced_memory()[0]
+    finally:
+        tracemalloc.stop()
+    return at[marks[1]] - at[marks[0]], count
+
+
+def test_the_parent_keeps_no_name_per_path_of_a_long_stream(tmp_path):
+    """The documents of a stream are cut in this process, their names kept for their
+    uniqueness: past the first NAMES_IN_MEMORY they go to disk, and 6,000 more
+    documents leave this process's memory as it was (it grew by some 170 bytes a name)."""
+    from singcheck.spec import files
+
+    stream = _straight_lines(tmp_path / "long.yaml", 8000 + 10)
+    grown, count = _traced_growth(files.read_documents([stream], spans=True), (2000, 8000))
+    assert count == 8010
+    assert grown < 64 * 1024, grown  # 6,000 names were about 1 MB
+    assert files.NAMES_IN_MEMORY < 2000  # (else the marks measure the names in memory)
+
+
+def _error(document) -> str | None:
+    error = getattr(document, "error", None)  # a span has none: it is not composed here
+    return error and error.message
+
+
+def test_a_name_repeated_past_the_names_kept_in_memory_is_found(tmp_path, monkeypatch):
+    """The names past NAMES_IN_MEMORY (on disk) are unique in the run as the first ones:
+    the same documents, and the same errors naming where the name was first used,
+    whichever holds the first use."""
+    from singcheck.spec import files
+
+    stream = _mixed_stream(tmp_path / "mixed.yaml")
+    again = _straight_lines(tmp_path / "again.yaml", 3, first=60)  # line-60 … on disk
+    kept = [(d.name, _error(d))
+            for d in files.read_documents([stream, again], spans=True)]
+    monkeypatch.setattr(files, "NAMES_IN_MEMORY", 5)  # line-7 and line-60 … on disk
+    spilled = [(d.name, _error(d))
+               for d in files.read_documents([stream, again], spans=True)]
+    assert spilled == kept
+    repeated = [message for _, message in kept if message and "already used" in message]
+    assert len(repeated) == 4
+    assert f"already used by {stream}:{8 * 7 + 2}" in repeated[0]
+    assert f"already used by {stream}:{8 * 60 + 2}" in repeated[1]
+
+
+def test_names_stay_in_memory_when_the_disk_fails(monkeypatch):
+    """A database that cannot be made, or that fails once it holds names: every name
+    stays checked, in memory (as before issue 32)."""
+    import sqlite3
+
+    from singcheck.spec.files import _Names
+
+    def failing(names):
+        raise sqlite3.OperationalError("unable to open database file")
+
+    names = _Names(in_memory=2)
+    monkeypatch.setattr(_Names, "_open", failing)
+    assert [names.claim(f"p{i}", "a.yaml", i) for i in range(5)] == [None] * 5
+    assert names.claim("p3", "b.yaml", 9) == ("a.yaml", 3) and len(names) == 5
+    monkeypatch.undo()
+
+    names = _Names(in_memory=2)
+    assert [names.claim(f"p{i}", "a.yaml", i) for i in range(5)] == [None] * 5
+    assert len(names) == 2 and names.claim("p4", "b.yaml", 9) == ("a.yaml", 4)
+
+    class Full:  # the disk filled up: no row written any more, those written still read
+        def __init__(self, db):
+            self.db, self.total_changes = db, db.total_changes
+
+        def execute(self, sql, *args):
+            if sql.startswith("INSERT"):
+                raise sqlite3.OperationalError("database or disk is full")
+            return self.db.execute(sql, *args)
+
+        def close(self):
+            self.db.close()
+
+    names.db = Full(names.db)
+    assert names.claim("p5", "a.yaml", 5) is None
+    assert names.db is None and len(names) == 6  # the 3 on disk came back
+    assert names.claim("p3", "b.yaml", 9) == ("a.yaml", 3)
+    assert names.claim("p6", "a.yaml", 6) is None and names.db is None and len(names) == 7
+
+
+@pytest.mark.slow
+def test_a_long_streamed_batch_leaves_the_parent_as_it_was(tmp_path, monkeypatch,
+                                                          orthoglide_robot):
+    """The whole parent of a streamed --jobs 2 batch (the stream cut into spans, the
+    lines the workers wrote gathered, unordered as jsonl runs it): 4,000 more paths
+    leave its traced memory as it was (each kept some 170 bytes before issue 32)."""
+    import tracemalloc
+
+    from singcheck import api
+    from singcheck.report.trajectory import JsonLine, robot_json
+    from singcheck.spec.files import read_documents
+
+    def untraced_worker():  # the workers do not trace: only this process is measured
+        tracemalloc.stop()
+        real()
+
+    real = api._worker_signals
+    monkeypatch.setattr(api, "_worker_signals", untraced_worker)
+    stream = _straight_lines(tmp_path / "long.yaml", 5000 + 200)
+    batch = api.check_batch(orthoglide_robot, read_documents([stream], spans=True), jobs=2,
+                            regions=False, ordered=False,
+                            line=JsonLine(robot_json(orthoglide_robot.projection)))
+    verdicts = set()
+    grown, count = _traced_growth((verdicts.add(r["verdict"]) for r in batch), (1000, 5000))
+    assert count == 5200 and verdicts <= {"singular", "singularity-free", "infeasible"}
+    assert grown < 256 * 1024, grown  # the 4,000 names were about 680 KB

@@ -946,23 +946,127 @@ def _all_documents(paths: list[str], interpolation: str | None,
 
 
 def _unique(documents: Iterator[Document]) -> Iterator[Document]:
-    """Names unique in a run: each name with where it was first seen (a dict of the
-    names, O(number of trajectories) short strings, is the one thing that grows)."""
-    seen: dict[str, tuple[str, int | None]] = {}
-    for document in documents:
-        name = document.name
-        if getattr(document, "error", None) is None and name is not None:
-            if name in seen:
-                if isinstance(document, Span):
-                    document = document.head()
-                path, line = seen[name]
-                document = replace(document, error=document.located(SpecError(
-                    f"trajectory name {name!r} is already used by {path}:{line or '?'} "
-                    "(names must be unique in a run)", path=document.path,
-                    line=document.name_line, key="name")))
-            else:
-                seen[name] = (document.path, document.name_line)
-        yield document
+    """Names unique in a run: each name with where it was first seen (:class:`_Names`:
+    the first :data:`NAMES_IN_MEMORY` in memory, the others on disk, so that the memory
+    of a long batch does not grow with its number of trajectories)."""
+    names = _Names()
+    try:
+        for document in documents:
+            name = document.name
+            if getattr(document, "error", None) is None and name is not None:
+                used = names.claim(name, document.path, document.name_line)
+                if used is not None:
+                    if isinstance(document, Span):
+                        document = document.head()
+                    path, line = used
+                    document = replace(document, error=document.located(SpecError(
+                        f"trajectory name {name!r} is already used by {path}:{line or '?'} "
+                        "(names must be unique in a run)", path=document.path,
+                        line=document.name_line, key="name")))
+            yield document
+    finally:
+        names.close()
+
+
+#: the names of a run kept in memory (about 170 bytes each); past them, the names go to
+#: a private temporary SQLite database on disk (:class:`_Names`)
+NAMES_IN_MEMORY = 1024
+
+
+class _Names:
+    """The trajectory names a run has used, each with where it was first seen (path,
+    line): the first ``in_memory`` in a dict, the others in a private temporary SQLite
+    database (a file deleted when it is closed, its page cache bounded to
+    :data:`_NAMES_CACHE_KIB`), so that a batch of 100,000 paths holds no more of them in
+    memory than one of 1,000 (issue 32).  Where the database cannot be made or written
+    (no temporary directory, a full disk), the names stay in the dict, as before."""
+
+    def __init__(self, in_memory: int | None = None) -> None:
+        self.kept: dict[str, tuple[str, int | None]] = {}
+        self.in_memory = NAMES_IN_MEMORY if in_memory is None else in_memory
+        self.db = None  # the database, once the dict is full
+        self.spill = True  # False once the database failed: the dict keeps them all
+        self.path_ids: dict[str, int] = {}  # the files of the run, numbered for the db
+        self.paths: list[str] = []
+
+    def __len__(self) -> int:
+        """The names kept in memory."""
+        return len(self.kept)
+
+    def claim(self, name: str, path: str, line: int | None) -> tuple[str, int | None] | None:
+        """Where ``name`` was first used in the run; None when it was not (it is now,
+        at ``path``:``line``)."""
+        used = self.kept.get(name)
+        if used is not None:
+            return used
+        if self.spill and len(self.kept) >= self.in_memory:
+            import sqlite3
+
+            try:
+                return self._claim_on_disk(name, path, line)
+            except sqlite3.Error:  # the names come back to memory: none is lost
+                self._back_to_memory()
+                used = self.kept.get(name)
+                if used is not None:
+                    return used
+        self.kept[name] = (path, line)
+        return None
+
+    def _claim_on_disk(self, name: str, path: str, line: int | None):
+        db = self.db or self._open()
+        path_id = self.path_ids.get(path)
+        if path_id is None:
+            path_id = self.path_ids[path] = len(self.paths)
+            self.paths.append(path)
+        before = db.total_changes
+        db.execute("INSERT OR IGNORE INTO names VALUES (?, ?, ?)", (name, path_id, line))
+        if db.total_changes != before:
+            return None
+        used_id, used_line = db.execute("SELECT path, line FROM names WHERE name = ?",
+                                        (name,)).fetchone()
+        return self.paths[used_id], used_line
+
+    def _open(self):
+        import sqlite3
+
+        # "": a private database in a temporary file, deleted when it is closed; one
+        # transaction that is never committed (no journal, no sync: nothing to recover)
+        db = sqlite3.connect("", isolation_level=None, check_same_thread=False)
+        try:
+            for pragma in ("journal_mode = OFF", "synchronous = OFF",
+                           f"cache_size = -{_NAMES_CACHE_KIB}"):
+                db.execute(f"PRAGMA {pragma}")
+            db.execute("CREATE TABLE names (name TEXT PRIMARY KEY, path INTEGER, "
+                       "line INTEGER) WITHOUT ROWID")
+            db.execute("BEGIN")
+        except sqlite3.Error:
+            db.close()
+            raise
+        self.db = db
+        return db
+
+    def _back_to_memory(self) -> None:
+        """The database failed: what it holds back in the dict, never to spill again."""
+        import sqlite3
+
+        self.spill = False
+        if self.db is None:
+            return
+        try:
+            for name, path_id, line in self.db.execute("SELECT name, path, line FROM names"):
+                self.kept.setdefault(name, (self.paths[path_id], line))
+        except sqlite3.Error:  # unreadable too: the names in it are no longer checked
+            pass
+        self.close()
+
+    def close(self) -> None:
+        if self.db is not None:
+            self.db.close()
+            self.db = None
+
+
+#: the page cache of :class:`_Names`'s database, in KiB
+_NAMES_CACHE_KIB = 1024
 
 
 def load_trajectories(paths: Iterable[str | os.PathLike], robot: RobotSpec,

@@ -505,7 +505,8 @@ def growth_rows() -> list[dict]:
             undecided = sum(a.verdict == "unknown" != r.verdict
                             for a, r in zip(answers, reports, strict=True))
             rows.append({"axis": "harmonics", "size": k,
-                         "mu_degree": max(int(r.path.mu.total_degree()) for r in reports),
+                         "mu_degree": max(int(build_path(projection, s).mu.total_degree())
+                                 for s in specs),  # (auto's report may hold no μ)
                          "median_s": cpu_median(ours) / 3,
                          "contender_median_s": cpu_median(theirs) / 3,
                          "contender_agrees": f"{right}/3" + (f", {undecided} unknown to it"

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import statistics
 import subprocess
 import sys
@@ -60,6 +61,72 @@ def _run(cmd: list[str], stream: Path, env: dict) -> dict:
             "parent_peak_rss_mb": max(parent_rss, default=None)}
 
 
+class _Cluster:
+    """A Dask cluster of its own processes (``dask scheduler``, ``dask worker``), started
+    once and warmed by one run, then stopped (SIGSTOP) while the ``--jobs`` runs go and
+    resumed (SIGCONT) for its own: a long-lived cluster's warm workers, and none of its
+    CPU taken from the other runs.  (A LocalCluster kept in this process, idle during
+    the ``--jobs`` runs, took CPU from them: jobs 2 ÷ jobs 1 read 1.59 with it, 1.88
+    without; one started per Dask run counted its workers' imports: Dask ÷ jobs 2 read
+    0.78 instead of 0.95.)"""
+
+    def __init__(self, workers: int, exe: list[str], stream: Path, env: dict) -> None:
+        import socket
+
+        with socket.socket() as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        self.address = f"tcp://127.0.0.1:{port}"
+        dask = str(Path(sys.executable).with_name("dask"))
+        quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                     start_new_session=True, env=env)
+        self.procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port",
+                                        str(port), "--dashboard-address", "127.0.0.1:0"],
+                                       **quiet)]
+        self.procs.append(subprocess.Popen([dask, "worker", self.address, "--nworkers",
+                                            str(workers), "--nthreads", "1",
+                                            "--dashboard-address", "127.0.0.1:0"], **quiet))
+        self.run(exe, stream, env)  # connect and warm the workers (not recorded)
+        self.pause()
+
+    def _signal(self, sig) -> None:
+        for p in self.procs:
+            try:
+                os.killpg(p.pid, sig)
+            except ProcessLookupError:
+                pass
+
+    def pause(self) -> None:
+        self._signal(signal.SIGSTOP)
+
+    def run(self, exe: list[str], stream: Path, env: dict) -> dict:
+        self._signal(signal.SIGCONT)
+        try:
+            for _ in range(300):  # the workers registered (the first time)
+                probe = subprocess.run([sys.executable, "-c", _WORKERS, self.address],
+                                       capture_output=True, text=True, env=env)
+                if probe.stdout.strip().isdigit() and int(probe.stdout) > 0:
+                    break
+                time.sleep(0.2)
+            return _run([*exe, "--scheduler", self.address], stream, env)
+        finally:
+            self.pause()
+
+    def close(self) -> None:
+        self._signal(signal.SIGCONT)
+        self._signal(signal.SIGTERM)
+        for p in self.procs:
+            try:
+                p.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+
+
+_WORKERS = ("import sys; from distributed import Client; "
+            "c = Client(sys.argv[1], timeout=30); print(len(c.scheduler_info()['workers']));"
+            " c.close()")
+
+
 def _sample_parent(box: list, rss: list) -> None:
     """The CPU seconds (user + system) of the ``singcheck`` process alone, without its
     workers, sampled every 50 ms until ``box`` gets a second item (the last sample
@@ -92,26 +159,27 @@ def scaling_rows(paths: int = 2000, rounds: int = 3, workers: int | str = 2) -> 
     exe = [sys.executable, "-m", "singcheck", "run", "robots/orthoglide.yaml", "-", "-q",
            "--format", "jsonl", "--no-regions", "--backend", "flint"]
     runners = [(f"--jobs {n}", ["--jobs", str(n)]) for n in sorted({1, *counts})]
-    cluster = None
     try:
-        from distributed import LocalCluster
+        import distributed  # noqa: F401
 
-        cluster = LocalCluster(n_workers=top, threads_per_worker=1, processes=True,
-                               host="127.0.0.1", dashboard_address="127.0.0.1:0")
-        runners.append((f"dask {top} workers", ["--scheduler", cluster.scheduler_address]))
+        runners.append((f"dask {top} workers", None))  # the cluster below
     except ImportError:  # the dask extra is missing: no cluster run
         pass
     runs: list[dict] = []
+    cluster = None
     try:
         with tempfile.TemporaryDirectory() as tmp:
             env = {**os.environ, "SINGCHECK_CACHE_DIR": tmp}
             subprocess.run([*exe[:5], "trajectories/heart1.yaml", "-q", *exe[-2:]], cwd=ROOT,
                            env=env, capture_output=True)  # warm the projection cache
             stream = write_stream(Path(tmp) / f"paths-{paths}.yaml", paths)
+            if runners[-1][1] is None:
+                cluster = _Cluster(top, exe, stream, env)
             for r in range(rounds):
                 order = runners[r % len(runners):] + runners[:r % len(runners)]
                 for what, extra in order:
-                    row = _run([*exe, *extra], stream, env)
+                    row = cluster.run(exe, stream, env) if extra is None else \
+                        _run([*exe, *extra], stream, env)
                     runs.append({"round": r, "runner": what, "paths": paths,
                                  "paths_per_s": paths / row["wall_s"],
                                  "load_average": os.getloadavg()[0], **row})
@@ -126,7 +194,7 @@ def scaling_rows(paths: int = 2000, rounds: int = 3, workers: int | str = 2) -> 
 
     ratios = {f"--jobs {n} / --jobs 1": per_round(f"--jobs {n}", "--jobs 1")
               for n in counts if n > 1}
-    if cluster is not None:
+    if any(extra is None for _, extra in runners):
         ratios[f"dask {top} workers / --jobs {top}"] = per_round(
             f"dask {top} workers", f"--jobs {top}")
     return {"paths": paths, "rounds": rounds, "workers": top if len(counts) == 1 else counts,

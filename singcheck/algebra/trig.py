@@ -185,15 +185,7 @@ def split_of(p: fmpq_mpoly):
     :func:`evaluate_split` (a trig polynomial below :data:`FOURIER_ALWAYS`); else None."""
     if p.context() is not TRIG or _high_harmonic(p):
         return None
-    by_precision: dict = {}
-
-    def split():
-        hit = by_precision.get(ctx.prec)
-        if hit is None:
-            hit = by_precision[ctx.prec] = _split(p)
-        return hit
-
-    return split
+    return lambda: _split(p)  # (memoised there, per polynomial and precision)
 
 
 def evaluate_split(split, t: arb, s: arb, c: arb) -> arb:

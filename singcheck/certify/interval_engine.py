@@ -357,7 +357,6 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
     if rates is None:
         return {}
     n_joint, det_parts, legs = _derivative_parts(model)
-    parts = _derivative_polys(model)
     program = ball_program(model, "mean value", _derivative_polys)
     variables = path.pose_variables_at(t)  # (before the midpoint's: the caller's, kept)
     m = arb(t.mid())
@@ -377,9 +376,8 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
         if program is not None:
             balls = program(point)  # every partial derivative at once
             ball = iter(balls).__next__
-        else:
-            powers: dict = {}
-            ball = _evaluator(parts, point, powers)
+        else:  # too many terms to compile: term by term
+            ball = _evaluator(_derivative_polys(model), point, {})
         speed = [arb(0)] * n_joint + rates
         sigmas = _branch_signs(mode)
         for (kind, idx, dx, extra), sigma in zip(legs, sigmas, strict=True):

@@ -538,13 +538,18 @@ class PathModel:
         coordinates (0 for a path polynomial in t); None when a coordinate is not a trig
         polynomial (angle functions, square roots, expression trees)."""
         degrees = []
-        for x in self.coordinates:
-            trig = _in_trig(x)
+        for trig in self.trig_coordinates:
             if trig is None:
                 return None
             d = trig.degrees()
             degrees.append(int(max(d[1], 0) + max(d[2], 0)))
         return max(degrees, default=0)
+
+    @cached_property
+    def trig_coordinates(self) -> tuple[fmpq_mpoly | None, ...]:
+        """Each pose variable's polynomial in the ring TRIG of t, sin t, cos t, or None
+        where it involves anything else (:func:`_in_trig`), once per path."""
+        return tuple(_in_trig(x) for x in self.coordinates)
 
     @cached_property
     def _pose_plan(self):
@@ -677,15 +682,11 @@ class PathModel:
     def _legs_program(self):
         """(the compiled program of every leg's :func:`_branch_polys`, [(leg, start, end)]
         of its balls), or (None, None) when too large; once per path."""
-        model = self.projection.model
-        legs = [leg.leg for leg in self.legs]
-        if len(legs) != len(model.legs) or any(
-                a is not b for a, b in zip(legs, model.legs, strict=True)):
-            return None, None
+        model = self.projection.model  # (self.legs are model.legs along the path)
         program = ball_program(model, "legs", lambda m: [q for leg in m.legs
                                                          for q in _branch_polys(leg)])
         slices, at = [], 0
-        for leg in legs:
+        for leg in model.legs:
             n = len(_branch_polys(leg))
             slices.append((leg, at, at + n))
             at += n

@@ -43,7 +43,6 @@ from singcheck.certify.covers import (
 )
 from singcheck.certify.path import (
     _branches_at_point,
-    _in_trig,
     inside_limits,
     leg_polynomials,
     limit_balls,
@@ -130,7 +129,7 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
             legs[i] = (2 * evaluate(a, ()) if a.is_constant() else a, b, d,
                        limit_balls(limits) if limits else None)
     coordinates = [(x, ball_split(x), x.degrees()[1] + x.degrees()[2] >= TIGHT_COORDINATE)
-                   for x in map(_in_trig, path.coordinates)]  # (legs_from_pose: in TRIG)
+                   for x in path.trig_coordinates]  # (legs_from_pose: all in TRIG)
     head = [arb(0)] * len(model.joint_variables)
     work = [(piece, facts) for piece in todo]
     queued = dict.fromkeys(facts, len(todo))

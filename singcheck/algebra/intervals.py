@@ -46,6 +46,9 @@ def power(x: Ball, e: int) -> Ball:
         for _ in range(e - 1):
             out = out * x
         return out
+    if e == 2:  # [min |x|², max |x|²]: Arb's bounds of |x| (the commonest power, fast)
+        a, b = x.abs_lower(), x.abs_upper()
+        return (a * a).union(b * b)
     lo, hi = x.lower(), x.upper()  # (x·x would be m² ± (2|m|r + r²): 2r² wider)
     if e % 2 == 1 or lo >= 0:
         return _point_power(lo, e).union(_point_power(hi, e))

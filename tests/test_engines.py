@@ -18,7 +18,7 @@ from singcheck.certify import classification, interval_engine
 from singcheck.certify.interval_engine import search_det_a
 from singcheck.roots.enclosures import RootIsolation
 from tests import robot_oracles as oracles
-from tests.conftest import ROBOTS, TRAJECTORIES
+from tests.conftest import ROBOTS, ROOT, TRAJECTORIES
 from tests.test_robots import _agrees, robots  # noqa: F401 (the fixture)
 
 
@@ -45,6 +45,59 @@ def _det_a_plus(t) -> mp.mpf:
         rho = X[i] + mp.sqrt(4 - sum(v * v for j, v in enumerate(X) if j != i))
         rows.append([X[j] - (rho if j == i else 0) for j in range(3)])
     return mp.det(mp.matrix(rows))
+
+
+_X8 = [(571, 700), (-3, 20), (-67, 140), (3, 100), (-1, 10), (-1, 100), (-1, 25), (9, 50)]
+_Y8 = [(1397, 1400), (-323, 1400), (-9, 50), (17, 100), (-1, 10), (7, 100), (1, 5), (1, 20)]
+
+
+def _heart_8h(t) -> tuple[list, mp.mpf]:
+    """The pose of bench/paths/heart-8h.yaml at t and det A of the Orthoglide's +++ mode
+    there, at 50 digits, from the geometry (as :func:`_det_a_plus`)."""
+    mp.mp.dps = 50
+    x = sum(mp.mpf(a) / b * mp.sin(k * t) for k, (a, b) in enumerate(_X8, 1))
+    y = sum(mp.mpf(a) / b * mp.cos(k * t) for k, (a, b) in enumerate(_Y8, 1))
+    X = [x, y, mp.mpf(1)]
+    rows = []
+    for i in range(3):
+        rho = X[i] + mp.sqrt(4 - sum(v * v for j, v in enumerate(X) if j != i))
+        rows.append([X[j] - (rho if j == i else 0) for j in range(3)])
+    return X, mp.det(mp.matrix(rows))
+
+
+def test_the_mode_program_encloses_pose_and_det_a_on_wide_and_narrow_balls(orthoglide):
+    """The compiled walk of the interval engine (:mod:`singcheck.certify.mode_programs`:
+    the pose in its Fourier form on a wide ball, Horner's in cos t on a narrow one) holds
+    the 8-harmonic heart's pose and det A along +++ at 50 digits across each ball, and
+    its balls are the general walk's or narrower."""
+    from flint import arb
+
+    from singcheck.algebra.trig import evaluate_trig
+    from singcheck.certify import mode_programs
+    from singcheck.certify.path import build_path
+
+    spec = api.load_trajectory(ROOT / "bench" / "paths" / "heart-8h.yaml", orthoglide)
+    path = build_path(orthoglide.projection, spec, "auto")
+    program = mode_programs.mode_program(path)
+    assert program is not None and program.harmonics == list(range(1, 9))
+    report = api.check(orthoglide, spec, regions=False)
+    modes = [m for m in report.working_modes if m.feasible]
+    assert [m.label for m in modes] == ["+++"]
+    fourier = 0
+    for lo, hi in [(-3.0, -2.9), (-0.4, -0.1), (0.5, 0.52), (1.0, 1.0 + 1e-6), (2.5, 2.8)]:
+        piece = arb(lo).union(arb(hi))
+        pose, _, values = program(path, piece, modes)
+        walk_pose, _ = path._pose_and_variables(piece)  # the general walk's pose
+        if piece.rad() > mode_programs.FOURIER_WIDE:  # narrower than Horner's in cos t
+            fourier += pose[0].rad() < evaluate_trig(path.trig_coordinates[0], piece).rad()
+        for k in range(7):
+            t = mp.mpf(lo) + (mp.mpf(hi) - mp.mpf(lo)) * k / 6
+            X, d = _heart_8h(t)
+            assert all(ball.contains(arb(str(v))) for ball, v in zip(pose, X, strict=True))
+            assert values["+++"].contains(arb(str(8 * d)))
+        for ours, theirs in zip(pose, walk_pose, strict=True):
+            assert ours.rad() <= theirs.rad() * (1 + 1e-12)
+    assert fourier >= 3
 
 
 def test_the_interval_engine_proves_heart_1_crossings_where_det_a_changes_sign(orthoglide):

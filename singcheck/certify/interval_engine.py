@@ -33,6 +33,7 @@ from flint import arb
 from singcheck.algebra.intervals import excludes_zero, sign
 from singcheck.budget import checkpoint
 from singcheck.certify.covers import halves, pieces
+from singcheck.certify.mode_programs import mode_program
 
 #: the narrowest piece that is halved again, relative to the range's length
 MIN_WIDTH = 2.0 ** -26
@@ -45,7 +46,7 @@ HINT_WIDTH = 2.0 ** -14
 #: the bench's paths (their enclosures hold 0), so the halving starts there rather than
 #: at six pieces (heart 1, 4 harmonics: 5.4 -> 4.3 ms; the [-10π, 10π] heart 1: 52 -> 31
 #: ms; fewer pieces made the helix slower, more made heart 1 slower)
-FIRST_COVER = 24
+FIRST_COVER = 16
 PER_HARMONIC = 8
 MIN_FIRST_COVER = 6
 MAX_FIRST_COVER = 256
@@ -106,6 +107,9 @@ def mode_values(path, modes: list, t: arb):
     """(pose, joints per mode, det A per mode) enclosed over the ball ``t``: the pose and
     the legs' branches once for all the modes, det A's pose part once (a mode whose
     branches are not all real there gets None)."""
+    program = mode_program(path)
+    if program is not None:  # the same enclosures, walked by a plan made once
+        return program(path, t, modes)
     pose, variables = path.pose_and_variables_at(t)
     per_leg = path.leg_branches_at(t, variables)
     values: dict = {}
@@ -353,7 +357,8 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
     model = path.projection.model
     if len(model.det_A) > 5000:
         return {}
-    rates = path.pose_rates_at(t, angle_functions=False)
+    fast = mode_program(path)
+    rates = fast.rates(t) if fast is not None else path.pose_rates_at(t, angle_functions=False)
     if rates is None:
         return {}
     n_joint, det_parts, legs = _derivative_parts(model)

@@ -58,9 +58,11 @@ from singcheck.algebra.radicals import (
     surd_polynomial,
 )
 from singcheck.algebra.trig import (
+    FOURIER_WIDE,
     TRIG,
     cos_multiple,
     evaluate_split,
+    fourier_enclosure,
     reduce_trig,
     sin_multiple,
 )
@@ -520,10 +522,16 @@ class PathModel:
         plan, pose_at, variables_at, offsets = self._pose_plan
         s = c = None
         balls = []
-        for x, split in plan:  # each distinct coordinate polynomial once
+        wide = t.rad() > FOURIER_WIDE
+        for x, split, trig in plan:  # each distinct coordinate polynomial once
             if split is None:
                 balls.append(evaluate_path(x, t))
                 continue
+            if wide:
+                f = fourier_enclosure(trig, t)
+                if f is not None:
+                    balls.append(f)
+                    continue
             if s is None:
                 s, c = t.sin_cos()
             balls.append(evaluate_split(split(), t, s, c))
@@ -556,8 +564,9 @@ class PathModel:
         """How :meth:`pose_and_variables_at` encloses the pose, once per path: each
         distinct coordinate polynomial with, for a trig polynomial of low degree, its
         ball split (:func:`~singcheck.algebra.trig.evaluate_split`, at the current
-        precision: the enclosure :func:`evaluate_path` makes, without its look-ups);
-        the pose's and the pose variables' positions among them; the angle offsets."""
+        precision: the enclosure :func:`evaluate_path` makes, without its look-ups)
+        and its restriction to TRIG (None for another); the pose's and the pose
+        variables' positions among them; the angle offsets."""
         from singcheck.algebra.trig import split_of
 
         plan, where = [], {}
@@ -566,7 +575,7 @@ class PathModel:
             if id(x) not in where:
                 where[id(x)] = len(plan)
                 trig = _in_trig(x)
-                plan.append((x, split_of(trig) if trig is not None else None))
+                plan.append((x, split_of(trig) if trig is not None else None, trig))
             return where[id(x)]
 
         pose_at = [at(x) for x in self.phi]
@@ -589,6 +598,8 @@ class PathModel:
             return [opaque_rate(name, t) for name in opaque]
         if functions and not angle_functions:
             return None
+        if t.rad() > FOURIER_WIDE:
+            return [_wide_enclosure(d, t) for d in _coordinate_derivatives(self)]
         return [evaluate_path(d, t) for d in _coordinate_derivatives(self)]
 
     @cached_property
@@ -699,6 +710,16 @@ class PathModel:
         return [branches_at_pose(model, leg.leg, pose, signs) for leg in self.legs]
 
 
+def _wide_enclosure(p: fmpq_mpoly, t: arb) -> arb:
+    """A path polynomial enclosed over a wide ball t: a trig polynomial in its Fourier
+    form (:data:`FOURIER_WIDE`), anything else by :func:`evaluate_path`."""
+    if p.context() is TRIG:
+        f = fourier_enclosure(p, t)
+        if f is not None:
+            return f
+    return evaluate_path(p, t)
+
+
 _COORDINATE_DERIVATIVES: dict = {}
 
 
@@ -796,7 +817,6 @@ def _pose_point(model: RobotModel, pose: list, signs=None) -> list:
 
 
 _ZERO = arb(0)
-
 
 def _branches_at_point(model: RobotModel, leg: Leg, point: list,
                        powers: dict | None = None) -> dict:

@@ -1,0 +1,252 @@
+"""det A along several working modes over a ball of t, in one pass with its plan made once.
+
+:func:`~singcheck.certify.interval_engine.mode_values` encloses, on each ball T of the
+parameter, the pose φ(T), each leg's branches and det A per mode.  Asked a hundred times
+per path, its cost was mostly the walk between the pieces (the pose's memo, the robot's
+point rebuilt with its square roots, the compiled programs looked up, a dict per leg and
+per mode), not the ball arithmetic.  A :class:`ModeProgram` is that walk made once per
+path and list of modes: each coordinate's enclosure picked (a constant's ball, the
+Horner split in cos t, or on a wide ball the Fourier form), the legs' and det A's
+compiled :class:`~singcheck.algebra.ball_programs.BallProgram`, and per mode the
+indices of its branches.
+
+Rigour: it performs the operations :func:`mode_values` performs — the same enclosures
+of the pose (:mod:`singcheck.algebra.trig`), the same programs, the same branch
+formulas (:func:`~singcheck.certify.path.branch_values`) and the same joint sums — so
+each ball it returns encloses what that function's does.  The Fourier form on a wide
+ball is the tighter of the two rigorous forms :func:`~singcheck.algebra.trig.evaluate_trig`
+offers (each sin kT, cos kT enclosed by Arb)."""
+
+from __future__ import annotations
+
+from flint import arb, ctx
+
+from singcheck.algebra.ball_programs import ball_program, joint_sum
+from singcheck.algebra.radicals import radical_balls
+from singcheck.algebra.trig import FOURIER_DEGREE, FOURIER_WIDE, _fourier
+
+
+class ModeProgram:
+    """``program(t, modes)`` = (pose, joints per mode, det A per mode) over the ball t, as
+    :func:`~singcheck.certify.interval_engine.mode_values` returns them; built by
+    :func:`mode_program` for a path whose legs are enclosed from the pose."""
+
+    __slots__ = ("path", "prec", "plan", "pose_at", "variables_at", "offsets", "harmonics",
+                 "legs", "legs_program", "det_program", "det_sum", "modes", "prefix",
+                 "radicals", "rate_plan", "last")
+
+    def __init__(self, path, legs_program, det_program, det_sum) -> None:
+        from singcheck.certify.path import _branch_polys
+
+        model = path.projection.model
+        plan, self.pose_at, self.variables_at, self.offsets = path._pose_plan
+        self.path, self.prec = path, ctx.prec
+        self.plan = [_coordinate_step(x, split) for x, split, _ in plan]
+        self.rate_plan = _rate_plan(path)  # (made on the first call of rates())
+        self.harmonics = sorted({k for step in self.plan if step[0] == "fourier"
+                                 for k in step[3]})
+        self.last: tuple = (None, None)  # (t, sin kt and cos kt of its pose)
+        self.legs_program, self.det_program, self.det_sum = legs_program, det_program, det_sum
+        self.legs, at = [], 0
+        for leg in model.legs:
+            n = len(_branch_polys(leg))
+            self.legs.append((leg, at, at + n))
+            at += n
+        self.modes: dict[str, list] = {}  # label -> [(leg, branch label)]
+        self.prefix = [arb(0)] * len(model.joint_variables)
+        self.radicals = [b for _, b in sorted(radical_balls(model.context).items())]
+
+    def _multiples(self, t: arb) -> tuple[bool, dict]:
+        """(whether t is wide, {k: (sin kt, cos kt)}): k = 1 always, the harmonics of the
+        Fourier forms on a wide ball; the last ball's are kept (its rates follow)."""
+        last = self.last
+        if last[0] is t:
+            return last[1]
+        wide = t.rad() > FOURIER_WIDE
+        multiples = {1: t.sin_cos()}
+        if wide:
+            for k in self.harmonics:
+                if k != 1:
+                    multiples[k] = (k * t).sin_cos()
+        self.last = (t, (wide, multiples))
+        return wide, multiples
+
+    def _enclose(self, plan: list, t: arb) -> list[arb]:
+        wide, multiples = self._multiples(t)
+        s, c = multiples[1]
+        balls = []
+        for step in plan:
+            kind = step[0]
+            if kind == "constant":
+                balls.append(step[1])
+            elif kind == "fourier" and wide:
+                balls.append(_fourier_sum(step[2], t, multiples))
+            elif kind == "split" or kind == "fourier":
+                balls.append(_split_value(step[1](), t, s, c))
+            else:
+                from singcheck.algebra.radicals import evaluate_path
+
+                balls.append(evaluate_path(step[1], t))
+        return balls
+
+    def rates(self, t: arb) -> list[arb] | None:
+        """d/dt of each pose variable over the ball t (as
+        :meth:`~singcheck.certify.path.PathModel.pose_rates_at` without angle functions),
+        or None where the path ring has them."""
+        plan = self.rate_plan
+        if plan is _NOT_YET:
+            plan = self.rate_plan = _rate_steps(self.path)
+            self.harmonics = sorted({*self.harmonics, *(k for step in plan or ()
+                                                        if step[0] == "fourier"
+                                                        for k in step[3])})
+            self.last = (None, None)
+        if plan is None:
+            return None
+        return self._enclose(plan, t)
+
+    def pose_and_variables(self, t: arb) -> tuple[list[arb], list[arb]]:
+        """:meth:`~singcheck.certify.path.PathModel._pose_and_variables`, by the plan."""
+        balls = self._enclose(self.plan, t)
+        pose = [balls[i] for i in self.pose_at]
+        for i, offset in self.offsets:
+            pose[i] = pose[i] + arb.pi() * offset
+        return pose, [balls[i] for i in self.variables_at]
+
+    def __call__(self, path, t: arb, modes: list):
+        from singcheck.certify.path import _branches_from
+
+        pose, variables = self.pose_and_variables(t)
+        object.__setattr__(path, "_last_pose", (t, ctx.prec, pose, variables))
+        point = self.prefix + variables + self.radicals
+        balls = self.legs_program(point)
+        per_leg = [_branches_from(leg, balls[a:b]) for leg, a, b in self.legs]
+        q = self.det_program(point)
+        joints, values = {}, {}
+        total = self.det_sum
+        revolute = path.projection.model.angle_joints
+        for mode in modes:
+            label = mode.label
+            picks = self.modes.get(label)
+            if picks is None:
+                picks = self.modes[label] = [(k, b.label) for k, b in enumerate(mode.branches)]
+            js = [per_leg[k][b] for k, b in picks]
+            joints[label] = js
+            if any(j is None for j in js):
+                values[label] = None
+                continue
+            if revolute:
+                flat: list = []
+                for j in js:
+                    flat += list(j) if isinstance(j, tuple) else [j]
+                values[label] = total(q, flat)
+            else:
+                values[label] = total(q, js)
+        return list(pose), joints, values
+
+
+def _coordinate_step(x, split):
+    """How one distinct coordinate polynomial is enclosed: ("constant", ball),
+    ("fourier", split, Fourier terms, harmonics) for a trig polynomial of degree
+    :data:`~singcheck.algebra.trig.FOURIER_DEGREE` or more in (s, c), ("split", split)
+    for another trig polynomial, ("path", x) else."""
+    if split is None:
+        return ("path", x)
+    if x.is_constant():
+        return ("constant", _split_value(split(), arb(0), arb(0), arb(1)))
+    from singcheck.certify.path import _in_trig
+
+    trig = _in_trig(x)
+    degrees = trig.degrees()
+    if degrees[1] + degrees[2] < FOURIER_DEGREE:  # (an upper bound of the reduced one's)
+        return ("split", split)
+    form = _fourier(trig)
+    if form is not None and form[3] >= FOURIER_DEGREE:
+        terms, harmonics, _, _ = form
+        return ("fourier", split, (terms, form[2]), harmonics)
+    return ("split", split)
+
+
+_NOT_YET = object()
+
+
+def _rate_plan(path):
+    """:func:`_rate_steps`, put off until the mean-value form first needs it (most
+    paths' first cover is proven without)."""
+    return _NOT_YET
+
+
+def _rate_steps(path) -> list | None:
+    """The steps of d/dt of each pose variable (:func:`_coordinate_step`), None where
+    the path ring has angle functions of its own (the mean-value form does without)."""
+    from singcheck.algebra.trig import TRIG, split_of
+    from singcheck.certify.path import _coordinate_derivatives
+
+    opaque, functions = path._rates_plan
+    if opaque is not None or functions:
+        return None
+    steps = []
+    for d in _coordinate_derivatives(path):
+        split = split_of(d) if d.context() is TRIG else None
+        steps.append(_coordinate_step(d, split))
+    return steps
+
+
+def _split_value(split, t: arb, s: arb, c: arb) -> arb:
+    from singcheck.algebra.trig import evaluate_split
+
+    return evaluate_split(split, t, s, c)
+
+
+def _fourier_sum(form, t: arb, multiples: dict) -> arb:
+    """Σ tⁱ (a cos kT + b sin kT) with Arb's sin kT, cos kT (``multiples``)."""
+    terms, dt = form
+    powers = [arb(1), t]
+    for _ in range(dt - 1):
+        powers.append(powers[-1] * t)
+    total = arb(0)
+    for i, k, a, b in terms:
+        if k == 0:
+            term = a
+        else:
+            sin_k, cos_k = multiples[k]
+            term = a * cos_k if a is not None else b * sin_k
+            if a is not None and b is not None:
+                term += b * sin_k
+        total += term if i == 0 else term * powers[i]
+    return total
+
+
+_PROGRAMS: dict = {}
+
+
+def mode_program(path) -> ModeProgram | None:
+    """The :class:`ModeProgram` of the path (once per path — its legs along it, which a
+    copy of the path made for the exact engine shares — at the current precision), or
+    None where :func:`mode_values`' general walk is needed: legs not enclosed from the
+    pose, an opaque path, a det A too large to compile."""
+    if not path.legs:  # (the empty tuple is one object: not a key)
+        return None
+    key = (id(path.legs), ctx.prec)
+    hit = _PROGRAMS.get(key)
+    if hit is not None and hit[0] is path.legs:
+        return hit[1]
+    if len(_PROGRAMS) > 64:
+        _PROGRAMS.clear()
+    program = _build(path)
+    _PROGRAMS[key] = (path.legs, program)
+    return program
+
+
+def _build(path) -> ModeProgram | None:
+    from singcheck.certify.path import MATRIX_FORM_ABOVE, _det_a_by_joints
+
+    model = path.projection.model
+    if not path.legs_from_pose or len(model.det_A) > MATRIX_FORM_ABOVE:
+        return None
+    legs_program, _ = path._legs_program
+    det_program = ball_program(model, "det A by joints",
+                               lambda m: [q for _, q in _det_a_by_joints(m)])
+    if legs_program is None or det_program is None:
+        return None
+    det_sum = joint_sum(model, lambda m: [alpha for alpha, _ in _det_a_by_joints(m)])
+    return ModeProgram(path, legs_program, det_program, det_sum)

@@ -77,13 +77,18 @@ class _Cluster:
             s.bind(("127.0.0.1", 0))
             port = s.getsockname()[1]
         self.address = f"tcp://127.0.0.1:{port}"
-        dask = str(Path(sys.executable).with_name("dask"))
+        dask = Path(sys.executable).with_name("dask")
+        if dask.exists():
+            scheduler, worker = [str(dask), "scheduler"], [str(dask), "worker"]
+        else:  # installed without its scripts (pip --target on a lent machine)
+            scheduler = [sys.executable, "-m", "distributed.cli.dask_scheduler"]
+            worker = [sys.executable, "-m", "distributed.cli.dask_worker"]
         quiet = dict(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                      start_new_session=True, env=env)
-        self.procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port",
+        self.procs = [subprocess.Popen([*scheduler, "--host", "127.0.0.1", "--port",
                                         str(port), "--dashboard-address", "127.0.0.1:0"],
                                        **quiet)]
-        self.procs.append(subprocess.Popen([dask, "worker", self.address, "--nworkers",
+        self.procs.append(subprocess.Popen([*worker, self.address, "--nworkers",
                                             str(workers), "--nthreads", "1",
                                             "--dashboard-address", "127.0.0.1:0"], **quiet))
         self.run(exe, stream, env)  # connect and warm the workers (not recorded)

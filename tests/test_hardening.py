@@ -1467,3 +1467,65 @@ def test_plot_reads_a_trajectory_within_its_time_limit(tmp_path, cache_env):
     assert "unknown: time limit (1 s) reached (while reading it" in done.stderr
     assert done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
     assert time.monotonic() - start < 1 + 4  # the start-up, the cached projection
+
+
+# -- a robot singular at every pose in some mode: the elimination ideal is zero --------------
+
+_ONE_RAIL = """\
+name: linear-delta-one-rail
+joints: [r1, r2, r3]
+pose: [x, y, z]
+parameters: {{R: 1, l: 3/2, s3: sqrt(3)}}
+constraints:
+  - (x - R)^2 + y^2 + (z - r1)^2 - l^2
+  - (x + R/2)^2 + (y + s3/2*R)^2 + (z - r2)^2 - l^2
+  - (x + R/2)^2 + (y + s3/2*R)^2 + (z - r3)^2 - l^2
+joint_limits: {{r1: [1/4, 3], r2: [1/4, 3], r3: {r3}}}
+"""
+
+
+def _one_rail_det(t, signs: str):
+    """det A of the one-rail linear Delta along linear-delta-free.yaml at t in the mode
+    ``signs`` (each leg's branch r = z ± √(l² - d²)), at 50 digits from the geometry:
+    the rows (x - aᵢ, y - bᵢ, z - rᵢ), times 8."""
+    import mpmath as mp
+
+    mp.mp.dps = 50
+    s3 = mp.sqrt(3)
+    x, y, z = -mp.mpf(1) / 4 + t / 2, mp.mpf(1) / 4, t / 4
+    rails = [(1, 0), (-mp.mpf(1) / 2, -s3 / 2), (-mp.mpf(1) / 2, -s3 / 2)]
+    rows, joints = [], []
+    for (a, b), sign in zip(rails, signs, strict=True):
+        h = mp.sqrt(mp.mpf(9) / 4 - (x - a) ** 2 - (y - b) ** 2)
+        r = z + h if sign == "+" else z - h
+        joints.append(r)
+        rows.append([x - a, y - b, z - r])
+    return 8 * mp.det(mp.matrix(rows)), joints
+
+
+@pytest.mark.parametrize("r3, verdict, mode", [("[1/4, 3]", "singular", "+++"),
+                                              ("[-3, -1/4]", "singularity-free", "++-")])
+def test_a_robot_singular_everywhere_in_some_mode_gets_a_verdict(tmp_path, r3, verdict, mode):
+    """Legs 2 and 3 on one rail (the fuzz's mutation of the linear Delta, found on 16
+    cores): whichever the pose, the modes with r2 = r3 are singular, so eliminating the
+    joints leaves the zero ideal.  That was exit 4 ("came back empty"); the robot is
+    well formed, and each path now gets its verdict per mode.  The oracle (50 digits):
+    in the one feasible mode the joints stay inside the limits, and det A is 0 all along
+    (r2 = r3) when both legs take the same branch, bounded away from 0 otherwise."""
+    from singcheck import api
+
+    robot_file = tmp_path / "one-rail.yaml"
+    robot_file.write_text(_ONE_RAIL.format(r3=r3))
+    robot = api.load_robot(robot_file, backend="flint")
+    assert "whole workspace" in robot.projection.not_expanded
+    report = api.check(robot, api.load_trajectory(TRAJECTORIES / "linear-delta-free.yaml",
+                                                  robot), regions=False)
+    assert report.verdict == verdict
+    assert [m.label for m in report.working_modes if m.feasible] == [mode]
+    lo, hi = (0.25, 3) if r3 == "[1/4, 3]" else (-3, -0.25)
+    import mpmath as mp
+
+    for k in range(11):
+        det, (r1, r2, r3_) = _one_rail_det(mp.mpf(k) / 10, mode)
+        assert 0.25 < r1 < 3 and 0.25 < r2 < 3 and lo < r3_ < hi
+        assert abs(det) < mp.mpf(10) ** -40 if verdict == "singular" else abs(det) > 0.1

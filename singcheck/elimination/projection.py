@@ -142,10 +142,21 @@ def to_pose(model: RobotModel, p: fmpq_mpoly, pose_ctx: fmpq_mpoly_ctx) -> fmpq_
     return restrict(norm_radicals(p), pose_ctx)
 
 
+class ZeroIdeal(BackendError):
+    """The elimination ideal is zero: its surface is the whole space (every pose is
+    singular in some working mode: two legs on one rail, say), not "no surface"."""
+
+
+#: the projection's ``method`` reason when the singularity surface is the whole workspace
+WHOLE_WORKSPACE = ("the singularity surface is the whole workspace (the elimination ideal "
+                   "is zero): some working mode is singular at every pose, so μ is "
+                   "formed along each path and each mode is decided on its own")
+
+
 def _single(result, label: str) -> fmpq_mpoly:
     polys = [p for p in result.polynomials if not p.is_zero()]
     if not polys:
-        raise BackendError(f"{result.backend}: the {label} came back empty (zero ideal)")
+        raise ZeroIdeal(f"{result.backend}: the {label} came back empty (zero ideal)")
     if len(polys) == 1:
         return polys[0]
     # not a hypersurface: keep the gcd, whose zero set contains the projection
@@ -396,11 +407,17 @@ def project_robot(model: RobotModel, backend: EliminationBackend,
                 model, raw, result.backend, raw if result.is_norm else None, timeout)]
 
         request = singularity_surface_request(model)
-        if isinstance(backend, CachedBackend):  # cache only what passes the re-check
-            result = backend.eliminate(request, check=check)
-        else:
-            result = backend.eliminate(request)
-            check(result)
+        try:
+            if isinstance(backend, CachedBackend):  # cache only what passes the re-check
+                result = backend.eliminate(request, check=check)
+            else:
+                result = backend.eliminate(request)
+                check(result)
+        except ZeroIdeal:  # ξ ≡ 0: no surface to restrict to a path, μ along each path
+            return RobotProjection(model, pose_ctx, None, None,
+                                   workspace_boundary(model, pose_ctx),
+                                   joint_limit_surfaces(model, pose_ctx), backend.name,
+                                   "eliminated along each path", WHOLE_WORKSPACE)
         raw = _single(result, "singularity surface")
         name, method = result.backend, result.method
         if checked and checked[0] is raw:

@@ -19,7 +19,7 @@ offers (each sin kT, cos kT enclosed by Arb)."""
 
 from __future__ import annotations
 
-from flint import arb, ctx
+from flint import arb, arb_poly, ctx
 
 from singcheck.algebra.ball_programs import ball_program, joint_sum
 from singcheck.algebra.radicals import radical_balls
@@ -33,7 +33,7 @@ class ModeProgram:
 
     __slots__ = ("path", "prec", "plan", "pose_at", "variables_at", "offsets", "harmonics",
                  "legs", "legs_program", "det_program", "det_sum", "modes", "prefix",
-                 "radicals", "rate_plan", "last")
+                 "radicals", "rate_plan", "last", "walk")
 
     def __init__(self, path, legs_program, det_program, det_sum) -> None:
         from singcheck.certify.path import _branch_polys
@@ -55,6 +55,7 @@ class ModeProgram:
         self.modes: dict[str, list] = {}  # label -> [(leg, branch label)]
         self.prefix = [arb(0)] * len(model.joint_variables)
         self.radicals = [b for _, b in sorted(radical_balls(model.context).items())]
+        self.walk = _compiled_walk(self)
 
     def _multiples(self, t: arb) -> tuple[bool, dict]:
         """(whether t is wide, {k: (sin kt, cos kt)}): k = 1 always, the harmonics of the
@@ -113,14 +114,9 @@ class ModeProgram:
         return pose, [balls[i] for i in self.variables_at]
 
     def __call__(self, path, t: arb, modes: list):
-        from singcheck.certify.path import _branches_from
-
-        pose, variables = self.pose_and_variables(t)
+        pose, variables, per_leg, q, multiples = self.walk(t)
+        self.last = (t, multiples)
         object.__setattr__(path, "_last_pose", (t, ctx.prec, pose, variables))
-        point = self.prefix + variables + self.radicals
-        balls = self.legs_program(point)
-        per_leg = [_branches_from(leg, balls[a:b]) for leg, a, b in self.legs]
-        q = self.det_program(point)
         joints, values = {}, {}
         total = self.det_sum
         revolute = path.projection.model.angle_joints
@@ -208,12 +204,102 @@ def _fourier_sum(form, t: arb, multiples: dict) -> arb:
         if k == 0:
             term = a
         else:
-            sin_k, cos_k = multiples[k]
+            sc = multiples.get(k)
+            if sc is None:  # (a rate's harmonic the pose lacks)
+                sc = multiples[k] = (k * t).sin_cos()
+            sin_k, cos_k = sc
             term = a * cos_k if a is not None else b * sin_k
             if a is not None and b is not None:
                 term += b * sin_k
         total += term if i == 0 else term * powers[i]
     return total
+
+
+def _compiled_walk(program: ModeProgram):
+    """``walk(t)`` = (pose, pose variables, per leg its branches, det A's pose
+    coefficients, (wide, sin kt and cos kt)) over the ball t: the steps of
+    :meth:`ModeProgram.pose_and_variables`, the legs' program and
+    :func:`~singcheck.certify.path._branches_from` written out as one Python function
+    for this path (each coordinate's enclosure, each quadratic leg's two branches
+    (-b ± √D)/(2a) inline, the others by ``_branches_from``), compiled once.
+
+    The same operations on the same balls, so the same enclosures (module docstring).
+    Safety, as for :class:`~singcheck.algebra.ball_programs.BallProgram`: the source is
+    made from the plan's kinds and positions alone; every polynomial, ball and function
+    it uses is passed in the list K, and nothing a user wrote reaches ``compile``."""
+    from singcheck.algebra.radicals import evaluate_path
+    from singcheck.algebra.trig import evaluate_split
+    from singcheck.certify.path import _branches_from
+    from singcheck.model.robot import REVOLUTE
+
+    K: list = []
+
+    def const(value) -> str:
+        K.append(value)
+        return f"K[{len(K) - 1}]"
+
+    def split_expr(split) -> str:
+        if type(split) is tuple:
+            p0, p1 = split
+            return f"{const(p0)}(c)" if p1 is None else f"{const(p0)}(c) + s * {const(p1)}(c)"
+        if isinstance(split, arb_poly):
+            return f"{const(split)}(t)"
+        return f"{const(evaluate_split)}({const(split)}, t, s, c)"
+
+    lines = ["def walk(t):", "    wide = t.rad() > FW", "    s, c = t.sin_cos()",
+             "    M = {1: (s, c)}"]
+    if program.harmonics:
+        lines.append("    if wide:")
+        lines += [f"        M[{k}] = ({k} * t).sin_cos()" for k in program.harmonics if k != 1]
+        if all(k == 1 for k in program.harmonics):
+            lines.append("        pass")
+    for i, step in enumerate(program.plan):
+        kind = step[0]
+        if kind == "constant":
+            lines.append(f"    v{i} = {const(step[1])}")
+        elif kind == "path":
+            lines.append(f"    v{i} = {const(evaluate_path)}({const(step[1])}, t)")
+        elif kind == "fourier":
+            lines.append(f"    v{i} = {const(_fourier_sum)}({const(step[2])}, t, M) if wide "
+                         f"else {split_expr(step[1]())}")
+        else:
+            lines.append(f"    v{i} = {split_expr(step[1]())}")
+    pose = [f"v{i}" for i in program.pose_at]
+    for i, offset in program.offsets:
+        pose[i] = f"{pose[i]} + {const(arb.pi() * offset)}"
+    variables = [f"v{i}" for i in program.variables_at]
+    point = ["Z"] * len(program.prefix) + variables + [const(b) for b in program.radicals]
+    lines.append(f"    point = [{', '.join(point)}]")
+    lines.append(f"    L = {const(program.legs_program)}(point)")
+    legs = []
+    for k, (leg, a, b) in enumerate(program.legs):
+        if leg.kind != REVOLUTE and leg.degree == 2:  # (-b ± √D)/(2a), as branch_values
+            lines += [f"    a{k}, b{k}, d{k} = L[{a}], L[{a + 1}], L[{a + 2}]",
+                      f"    if d{k} > 0:",
+                      f"        r{k} = d{k}.sqrt()",
+                      f"        g{k} = {{'+': (-b{k} + r{k}) / (2 * a{k}), "
+                      f"'-': (-b{k} - r{k}) / (2 * a{k})}}",
+                      "    else:",
+                      f"        g{k} = BR({const(leg)}, L[{a}:{b}])"]
+        else:
+            lines.append(f"    g{k} = BR({const(leg)}, L[{a}:{b}])")
+        legs.append(f"g{k}")
+    lines.append(f"    q = {const(program.det_program)}(point)")
+    lines.append(f"    return [{', '.join(pose)}], [{', '.join(variables)}], "
+                 f"[{', '.join(legs)}], q, (wide, M)")
+    source = "\n".join(lines) + "\n"
+    code = _CODE.get(source)  # (paths of one robot and shape share it: only K differs)
+    if code is None:
+        if len(_CODE) > 256:
+            _CODE.clear()
+        code = _CODE[source] = compile(source, "<mode walk>", "exec")
+    namespace = {"K": K, "FW": FOURIER_WIDE, "Z": _ZERO, "BR": _branches_from}
+    exec(code, namespace)  # noqa: S102 - see above
+    return namespace["walk"]
+
+
+_CODE: dict[str, object] = {}
+_ZERO = arb(0)
 
 
 _PROGRAMS: dict = {}

@@ -378,13 +378,16 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
         if not all(isinstance(v, arb) for v in flat):
             continue
         point = flat + list(variables) + radicals
-        if program is not None:
-            balls = program(point)  # every partial derivative at once
-            ball = iter(balls).__next__
-        else:  # too many terms to compile: term by term
-            ball = _evaluator(_derivative_polys(model), point, {})
-        speed = [arb(0)] * n_joint + rates
+        speed = [_ZERO] * n_joint + rates
         sigmas = _branch_signs(mode)
+        if program is not None:  # every partial derivative at once, then the rates
+            slope = _assembler(model)(program(point), speed, sigmas, point)
+            if slope is not None:
+                value = mid + slope * (t - m)
+                if value.is_finite():
+                    out[mode.label] = (value, slope)
+            continue
+        ball = _evaluator(_derivative_polys(model), point, {})  # too many terms: one by one
         for (kind, idx, dx, extra), sigma in zip(legs, sigmas, strict=True):
             push = arb(0)
             for i, _ in dx:
@@ -414,6 +417,69 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
             if value.is_finite():
                 out[mode.label] = (value, slope)
     return out
+
+
+_ZERO = arb(0)
+_ASSEMBLERS: dict = {}
+_ASSEMBLY_CODE: dict = {}
+
+
+def _assembler(model):
+    """``assemble(B, speed, sigmas, point)``: the loop of :func:`mean_value` over the legs
+    and det A's partial derivatives, written out once per model as one Python function
+    (B: the balls of :func:`_derivative_polys` in order; ``speed``: the pose variables'
+    rates, the joints' filled in here; None where a branch's discriminant is not proven
+    > 0).  The same ball operations as the loop, so the same enclosure; the source is
+    made from the variables' indices and the legs' kinds alone (each 2a is passed in)."""
+    from singcheck.algebra.polynomials import memo_per_object
+    from singcheck.model.robot import REVOLUTE
+
+    def build(model):
+        _, det_parts, legs = _derivative_parts(model)
+        at = 0
+        lines = ["def assemble(B, speed, sg, point):"]
+        twice_a = []
+
+        def dot(indices) -> str:
+            nonlocal at
+            terms = []
+            for i in indices:
+                terms.append(f"B[{at}] * speed[{i}]")
+                at += 1
+            return " + ".join(terms) if terms else "ZERO"
+
+        for k, (kind, idx, dx, extra) in enumerate(legs):
+            lines.append(f"    push = {dot([i for i, _ in dx])}")
+            if kind == QUADRATIC:  # ρ' = (−b' + σ·D'/(2√D))/(2a)
+                lines.append(f"    d_rate = {dot([i for i, _ in extra[0]])}")
+                twice_a.append(extra[2])
+                lines += [f"    disc = B[{at}]",
+                          f"    if not disc > 0 or sg[{k}] is None:", "        return None",
+                          f"    speed[{idx[0]}] = (-push + sg[{k}] * d_rate / "
+                          f"(2 * disc.sqrt())) / A[{len(twice_a) - 1}]"]
+                at += 1
+            elif kind == REVOLUTE:  # θ' = −(∇ₓf·X')/(σ√Δ)
+                lines += [f"    disc = B[{at}]",
+                          f"    if not disc > 0 or sg[{k}] is None:", "        return None",
+                          f"    rate = -push / (sg[{k}] * disc.sqrt())",
+                          f"    speed[{idx[0]}] = -point[{idx[1]}] * rate",
+                          f"    speed[{idx[1]}] = point[{idx[0]}] * rate"]
+                at += 1
+            else:
+                lines.append(f"    speed[{idx[0]}] = -push / B[{at}]")
+                at += 1
+        lines.append(f"    return {dot([i for i, _ in det_parts])}")
+        source = "\n".join(lines) + "\n"
+        code = _ASSEMBLY_CODE.get(source)
+        if code is None:
+            if len(_ASSEMBLY_CODE) > 64:
+                _ASSEMBLY_CODE.clear()
+            code = _ASSEMBLY_CODE[source] = compile(source, "<rates>", "exec")
+        namespace = {"A": twice_a, "ZERO": _ZERO}
+        exec(code, namespace)  # noqa: S102 - indices and kinds only, see above
+        return namespace["assemble"]
+
+    return memo_per_object(_ASSEMBLERS, model, build)
 
 
 def _branch_signs(mode) -> list[int | None]:

@@ -146,6 +146,13 @@ def _record(kind: str, what: dict, robot_text: str, trajectory_text: str,
                             "csv": csv}) + "\n")
 
 
+def _exit_message(e: SystemExit) -> str:
+    """What the error behind an exit said (exit 4's backend failure, exit 70's bug), for
+    the campaign's failure record: the exception ``exit_codes`` turned into the exit."""
+    cause = e.__context__ or e.__cause__
+    return f"{type(cause).__name__}: {cause}"[:500] if cause is not None else ""
+
+
 def _cpu() -> float:
     """CPU seconds of this process and its reaped children (the forks of a check)."""
     t = os.times()
@@ -192,12 +199,15 @@ def _outcome(robot_text: str, trajectory_text: str, csv: str | None = None) -> i
             code = int(_worst(codes))
     except SystemExit as e:
         code = int(e.code)
+        why = _exit_message(e)
+    else:
+        why = ""
     end = time.monotonic()
     COUNTS[f"exit {code}"] += 1
     COUNTS["cases"] += 1
     if COUNTS["cases"] % 25 == 0:
         _report()
-    assert code in (0, 1, 2, 3), code
+    assert code in (0, 1, 2, 3), f"{code}: {why}"
     if loaded is None:
         loaded, cpu = end, _cpu()
     past = int((end - loaded - BUDGET) * 1000)

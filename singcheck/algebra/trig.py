@@ -319,7 +319,13 @@ def _fourier_value(p: fmpq_mpoly, t: arb, low: int = 0) -> arb | None:
     if form is None or form[3] < (low or _FOURIER_MIN_DEGREE):
         return None
     terms, harmonics, dt, _ = form
-    sc = {k: _sin_cos_multiple(t, k) for k in harmonics}
+    return fourier_sum(terms, dt, t, {k: _sin_cos_multiple(t, k) for k in harmonics})
+
+
+def fourier_sum(terms: list, dt: int, t: arb, multiples: dict) -> arb:
+    """Σ tⁱ (a cos kT + b sin kT) over the Fourier terms (i, k, a, b) of
+    :func:`_fourier` (degree ``dt`` in t), with Arb's balls of sin kT and cos kT from
+    ``multiples`` (k → (sin kT, cos kT); a missing k is enclosed and added)."""
     powers = [arb(1), t]
     for _ in range(dt - 1):
         powers.append(powers[-1] * t)
@@ -328,7 +334,10 @@ def _fourier_value(p: fmpq_mpoly, t: arb, low: int = 0) -> arb | None:
         if k == 0:
             term = a
         else:
-            sin_k, cos_k = sc[k]
+            sc = multiples.get(k)
+            if sc is None:
+                sc = multiples[k] = (k * t).sin_cos()
+            sin_k, cos_k = sc
             term = a * cos_k if a is not None else b * sin_k
             if a is not None and b is not None:
                 term += b * sin_k

@@ -23,7 +23,7 @@ from flint import arb, arb_poly, ctx
 
 from singcheck.algebra.ball_programs import ball_program, joint_sum
 from singcheck.algebra.radicals import radical_balls
-from singcheck.algebra.trig import FOURIER_DEGREE, FOURIER_WIDE, _fourier
+from singcheck.algebra.trig import FOURIER_DEGREE, FOURIER_WIDE, _fourier, fourier_sum
 
 
 class ModeProgram:
@@ -196,23 +196,7 @@ def _split_value(split, t: arb, s: arb, c: arb) -> arb:
 def _fourier_sum(form, t: arb, multiples: dict) -> arb:
     """Σ tⁱ (a cos kT + b sin kT) with Arb's sin kT, cos kT (``multiples``)."""
     terms, dt = form
-    powers = [arb(1), t]
-    for _ in range(dt - 1):
-        powers.append(powers[-1] * t)
-    total = arb(0)
-    for i, k, a, b in terms:
-        if k == 0:
-            term = a
-        else:
-            sc = multiples.get(k)
-            if sc is None:  # (a rate's harmonic the pose lacks)
-                sc = multiples[k] = (k * t).sin_cos()
-            sin_k, cos_k = sc
-            term = a * cos_k if a is not None else b * sin_k
-            if a is not None and b is not None:
-                term += b * sin_k
-        total += term if i == 0 else term * powers[i]
-    return total
+    return fourier_sum(terms, dt, t, multiples)
 
 
 def _compiled_walk(program: ModeProgram):

@@ -340,13 +340,17 @@ def test_a_signal_mid_batch_leaves_valid_jsonl_lines(tmp_path, sig, group):
     import sys
     import time
 
+    def as_a_foreground_job():  # (a suite started in the background inherits
+        # SIGINT ignored, as POSIX shells give background jobs: Ctrl-C is the foreground's)
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+
     paths = _generated(tmp_path, 40)
     proc = subprocess.Popen([sys.executable, "-m", "singcheck", "run", ORTHO, *paths,
                              str(DATA / "slow.yaml"), "--format", "jsonl", "--jobs", "2",
                              "--backend", "flint", "--no-regions"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=ROOT,
                             env={**os.environ, "SINGCHECK_CACHE_DIR": str(tmp_path)},
-                            start_new_session=group)
+                            start_new_session=group, preexec_fn=as_a_foreground_job)
     first = proc.stdout.readline()  # a result streamed: the batch is under way
     time.sleep(0.5)
     if group:

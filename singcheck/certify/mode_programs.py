@@ -5,17 +5,18 @@ parameter, the pose φ(T), each leg's branches and det A per mode.  Asked a hund
 per path, its cost was mostly the walk between the pieces (the pose's memo, the robot's
 point rebuilt with its square roots, the compiled programs looked up, a dict per leg and
 per mode), not the ball arithmetic.  A :class:`ModeProgram` is that walk made once per
-path and list of modes: each coordinate's enclosure picked (a constant's ball, the
-Horner split in cos t, or on a wide ball the Fourier form), the legs' and det A's
-compiled :class:`~singcheck.algebra.ball_programs.BallProgram`, and per mode the
+path: each coordinate's enclosure picked (a constant's ball, the Horner split in cos t,
+or on a wide ball the Fourier form), the legs' and det A's compiled
+:class:`~singcheck.algebra.ball_programs.BallProgram`, each quadratic leg's branches,
+all written out as one compiled function (:func:`_compiled_walk`); per mode, the
 indices of its branches.
 
 Rigour: it performs the operations :func:`mode_values` performs — the same enclosures
 of the pose (:mod:`singcheck.algebra.trig`), the same programs, the same branch
 formulas (:func:`~singcheck.certify.path.branch_values`) and the same joint sums — so
 each ball it returns encloses what that function's does.  The Fourier form on a wide
-ball is the tighter of the two rigorous forms :func:`~singcheck.algebra.trig.evaluate_trig`
-offers (each sin kT, cos kT enclosed by Arb)."""
+ball is one of the two rigorous forms :func:`~singcheck.algebra.trig.evaluate_trig`
+offers (each sin kT, cos kT enclosed by Arb), the tighter one at a high degree."""
 
 from __future__ import annotations
 
@@ -27,8 +28,8 @@ from singcheck.algebra.trig import FOURIER_DEGREE, FOURIER_WIDE, _fourier, fouri
 
 
 class ModeProgram:
-    """``program(t, modes)`` = (pose, joints per mode, det A per mode) over the ball t, as
-    :func:`~singcheck.certify.interval_engine.mode_values` returns them; built by
+    """``program(path, t, modes)`` = (pose, joints per mode, det A per mode) over the ball
+    t, as :func:`~singcheck.certify.interval_engine.mode_values` returns them; built by
     :func:`mode_program` for a path whose legs are enclosed from the pose."""
 
     __slots__ = ("path", "prec", "plan", "pose_at", "variables_at", "offsets", "harmonics",
@@ -104,14 +105,6 @@ class ModeProgram:
         if plan is None:
             return None
         return self._enclose(plan, t)
-
-    def pose_and_variables(self, t: arb) -> tuple[list[arb], list[arb]]:
-        """:meth:`~singcheck.certify.path.PathModel._pose_and_variables`, by the plan."""
-        balls = self._enclose(self.plan, t)
-        pose = [balls[i] for i in self.pose_at]
-        for i, offset in self.offsets:
-            pose[i] = pose[i] + arb.pi() * offset
-        return pose, [balls[i] for i in self.variables_at]
 
     def __call__(self, path, t: arb, modes: list):
         pose, variables, per_leg, q, multiples = self.walk(t)
@@ -201,11 +194,11 @@ def _fourier_sum(form, t: arb, multiples: dict) -> arb:
 
 def _compiled_walk(program: ModeProgram):
     """``walk(t)`` = (pose, pose variables, per leg its branches, det A's pose
-    coefficients, (wide, sin kt and cos kt)) over the ball t: the steps of
-    :meth:`ModeProgram.pose_and_variables`, the legs' program and
+    coefficients, (wide, sin kt and cos kt)) over the ball t: each coordinate's step
+    (as :meth:`ModeProgram._enclose` takes them), the legs' program and
     :func:`~singcheck.certify.path._branches_from` written out as one Python function
-    for this path (each coordinate's enclosure, each quadratic leg's two branches
-    (-b ± √D)/(2a) inline, the others by ``_branches_from``), compiled once.
+    for this path (each quadratic leg's two branches (-b ± √D)/(2a) inline, the other
+    legs' by ``_branches_from``), compiled once per shape.
 
     The same operations on the same balls, so the same enclosures (module docstring).
     Safety, as for :class:`~singcheck.algebra.ball_programs.BallProgram`: the source is

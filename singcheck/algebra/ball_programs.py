@@ -89,6 +89,20 @@ def _source(polys: tuple[fmpq_mpoly, ...]) -> tuple[str, list[fmpq]]:
 
 
 _PROGRAMS: dict = {}
+_CODE: dict[tuple[str, str], object] = {}
+
+
+def generated_function(source: str, name: str, namespace: dict):
+    """The function ``name`` defined by ``source`` (generated code, never a spec's text),
+    executed in ``namespace``; the compiled code is kept by its source (paths of one
+    robot and shape share it: only the namespace's values differ)."""
+    code = _CODE.get((source, name))
+    if code is None:
+        if len(_CODE) > 256:
+            _CODE.clear()
+        code = _CODE[source, name] = compile(source, f"<{name}>", "exec")
+    exec(code, namespace)  # noqa: S102 - generated from indices and kinds alone
+    return namespace[name]
 
 
 def ball_program(owner, purpose: str, polys) -> BallProgram | None:

@@ -422,7 +422,6 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
 
 _ZERO = arb(0)
 _ASSEMBLERS: dict = {}
-_ASSEMBLY_CODE: dict = {}
 
 
 def _assembler(model):
@@ -432,6 +431,7 @@ def _assembler(model):
     rates, the joints' filled in here; None where a branch's discriminant is not proven
     > 0).  The same ball operations as the loop, so the same enclosure; the source is
     made from the variables' indices and the legs' kinds alone (each 2a is passed in)."""
+    from singcheck.algebra.ball_programs import generated_function
     from singcheck.algebra.polynomials import memo_per_object
     from singcheck.model.robot import REVOLUTE
 
@@ -470,15 +470,8 @@ def _assembler(model):
                 lines.append(f"    speed[{idx[0]}] = -push / B[{at}]")
                 at += 1
         lines.append(f"    return {dot([i for i, _ in det_parts])}")
-        source = "\n".join(lines) + "\n"
-        code = _ASSEMBLY_CODE.get(source)
-        if code is None:
-            if len(_ASSEMBLY_CODE) > 64:
-                _ASSEMBLY_CODE.clear()
-            code = _ASSEMBLY_CODE[source] = compile(source, "<rates>", "exec")
-        namespace = {"A": twice_a, "ZERO": _ZERO}
-        exec(code, namespace)  # noqa: S102 - indices and kinds only, see above
-        return namespace["assemble"]
+        return generated_function("\n".join(lines) + "\n", "assemble",
+                                  {"A": twice_a, "ZERO": _ZERO})
 
     return memo_per_object(_ASSEMBLERS, model, build)
 

@@ -22,9 +22,15 @@ from __future__ import annotations
 
 from flint import arb, arb_poly, ctx
 
-from singcheck.algebra.ball_programs import ball_program, joint_sum
+from singcheck.algebra.ball_programs import ball_program, generated_function, joint_sum
 from singcheck.algebra.radicals import radical_balls
-from singcheck.algebra.trig import FOURIER_DEGREE, FOURIER_WIDE, _fourier, fourier_sum
+from singcheck.algebra.trig import (
+    FOURIER_DEGREE,
+    FOURIER_WIDE,
+    _fourier,
+    evaluate_split,
+    fourier_sum,
+)
 
 
 class ModeProgram:
@@ -32,27 +38,21 @@ class ModeProgram:
     t, as :func:`~singcheck.certify.interval_engine.mode_values` returns them; built by
     :func:`mode_program` for a path whose legs are enclosed from the pose."""
 
-    __slots__ = ("path", "prec", "plan", "pose_at", "variables_at", "offsets", "harmonics",
+    __slots__ = ("path", "plan", "pose_at", "variables_at", "offsets", "harmonics",
                  "legs", "legs_program", "det_program", "det_sum", "modes", "prefix",
                  "radicals", "rate_plan", "last", "walk")
 
     def __init__(self, path, legs_program, det_program, det_sum) -> None:
-        from singcheck.certify.path import _branch_polys
-
         model = path.projection.model
         plan, self.pose_at, self.variables_at, self.offsets = path._pose_plan
-        self.path, self.prec = path, ctx.prec
+        self.path = path
         self.plan = [_coordinate_step(x, split) for x, split, _ in plan]
         self.rate_plan = _rate_plan(path)  # (made on the first call of rates())
         self.harmonics = sorted({k for step in self.plan if step[0] == "fourier"
                                  for k in step[3]})
         self.last: tuple = (None, None)  # (t, sin kt and cos kt of its pose)
         self.legs_program, self.det_program, self.det_sum = legs_program, det_program, det_sum
-        self.legs, at = [], 0
-        for leg in model.legs:
-            n = len(_branch_polys(leg))
-            self.legs.append((leg, at, at + n))
-            at += n
+        self.legs = path._legs_program[1]  # [(leg, start, end) of its balls]
         self.modes: dict[str, list] = {}  # label -> [(leg, branch label)]
         self.prefix = [arb(0)] * len(model.joint_variables)
         self.radicals = [b for _, b in sorted(radical_balls(model.context).items())]
@@ -84,7 +84,7 @@ class ModeProgram:
             elif kind == "fourier" and wide:
                 balls.append(_fourier_sum(step[2], t, multiples))
             elif kind == "split" or kind == "fourier":
-                balls.append(_split_value(step[1](), t, s, c))
+                balls.append(evaluate_split(step[1](), t, s, c))
             else:
                 from singcheck.algebra.radicals import evaluate_path
 
@@ -141,7 +141,7 @@ def _coordinate_step(x, split):
     if split is None:
         return ("path", x)
     if x.is_constant():
-        return ("constant", _split_value(split(), arb(0), arb(0), arb(1)))
+        return ("constant", evaluate_split(split(), arb(0), arb(0), arb(1)))
     from singcheck.certify.path import _in_trig
 
     trig = _in_trig(x)
@@ -180,12 +180,6 @@ def _rate_steps(path) -> list | None:
     return steps
 
 
-def _split_value(split, t: arb, s: arb, c: arb) -> arb:
-    from singcheck.algebra.trig import evaluate_split
-
-    return evaluate_split(split, t, s, c)
-
-
 def _fourier_sum(form, t: arb, multiples: dict) -> arb:
     """Σ tⁱ (a cos kT + b sin kT) with Arb's sin kT, cos kT (``multiples``)."""
     terms, dt = form
@@ -205,7 +199,6 @@ def _compiled_walk(program: ModeProgram):
     made from the plan's kinds and positions alone; every polynomial, ball and function
     it uses is passed in the list K, and nothing a user wrote reaches ``compile``."""
     from singcheck.algebra.radicals import evaluate_path
-    from singcheck.algebra.trig import evaluate_split
     from singcheck.certify.path import _branches_from
     from singcheck.model.robot import REVOLUTE
 
@@ -264,18 +257,10 @@ def _compiled_walk(program: ModeProgram):
     lines.append(f"    q = {const(program.det_program)}(point)")
     lines.append(f"    return [{', '.join(pose)}], [{', '.join(variables)}], "
                  f"[{', '.join(legs)}], q, (wide, M)")
-    source = "\n".join(lines) + "\n"
-    code = _CODE.get(source)  # (paths of one robot and shape share it: only K differs)
-    if code is None:
-        if len(_CODE) > 256:
-            _CODE.clear()
-        code = _CODE[source] = compile(source, "<mode walk>", "exec")
-    namespace = {"K": K, "FW": FOURIER_WIDE, "Z": _ZERO, "BR": _branches_from}
-    exec(code, namespace)  # noqa: S102 - see above
-    return namespace["walk"]
+    return generated_function("\n".join(lines) + "\n", "walk",
+                              {"K": K, "FW": FOURIER_WIDE, "Z": _ZERO, "BR": _branches_from})
 
 
-_CODE: dict[str, object] = {}
 _ZERO = arb(0)
 
 

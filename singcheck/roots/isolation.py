@@ -99,15 +99,18 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
 
 
 
-def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
+def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float,
+           irreducible: bool = False) -> RootIsolation:
     """t mixed with sin t, cos t: each irreducible factor of p in Q[t, s, c] by its own
     method (a factor free of t or of s, c exactly; the rest by branch-and-bound), so that
     a repeated factor costs one isolation and pure factors keep their exact roots.
+    ``irreducible``: p is such a factor already (not factored again: FLINT's
+    multivariate factorization is most of the exact engine's time on the helix).
 
     Roots of different factors are merged: balls that overlap are refined apart; a root
     two factors share (proven only for the same exact point) is kept once; two balls
     that stay overlapping otherwise become an undecided stretch."""
-    _, factors = p.factor()
+    _, factors = (1, [(p, 1)]) if irreducible else p.factor()
     if len(factors) == 1 and factors[0][1] == 1:
         return _through_norm(p, interval, tolerance) or branch_and_bound(p, interval, tolerance)
     roots: list[tuple[RealRoot, int]] = []
@@ -116,7 +119,7 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolatio
         if f.is_constant():
             continue
         checkpoint()
-        iso = isolate_real_roots(f, interval, tolerance)
+        iso = isolate_real_roots(f, interval, tolerance, irreducible=True)
         roots += [(r, int(mult)) for r in iso.roots]
         undecided += list(iso.undecided)
     merged, apart = _merge_apart(
@@ -362,14 +365,18 @@ def _vanishes_at(p: fmpq_mpoly, root: RealRoot) -> bool | None:
 
 
 def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
-                       tolerance: float = 1e-9, exact_zero=None) -> RootIsolation:
+                       tolerance: float = 1e-9, exact_zero=None,
+                       irreducible: bool = False) -> RootIsolation:
     """Every real root of ``poly(t, sin t, cos t)`` on the closed range, certified.
 
     A polynomial with square roots among its coefficients (a :func:`path_ring`
     element) goes through :func:`_with_radicals`; ``exact_zero(p, root)`` (True, False,
     or None when it cannot say) decides exactly whether p vanishes at a root of its norm
     where balls cannot tell p from a conjugate (the caller's exact arithmetic:
-    :func:`singcheck.certify.exact.vanishes_at_root`)."""
+    :func:`singcheck.certify.exact.vanishes_at_root`).  ``irreducible``: poly is an
+    irreducible factor (from a factorization here), taken as it is when reducing it
+    modulo s² + c² = 1 leaves it unchanged (a reduced polynomial's factors are reduced:
+    their degrees in s add up to at most 1)."""
     if poly.context() is not TRIG:
         if radical_variables(poly.context()):
             return _with_radicals(poly, interval, tolerance, exact_zero)
@@ -379,7 +386,7 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
         if not any(p.degrees()[3:]):
             return isolate_real_roots(restrict(p, TRIG), interval, tolerance)
         if angle_circle(p) is not None:  # t and one pose angle g(t) + qπ, g ∈ Q[t]
-            return _mixed(p, interval, tolerance)
+            return _mixed(p, interval, tolerance, irreducible and p == poly)
         # angle functions: t mixed with them (two arguments: the windows the
         # branch-and-bound leaves, a structural tangency, through the norm over both sines)
         return _windows_through_double_norm(p, branch_and_bound(p, interval, tolerance),
@@ -388,7 +395,7 @@ def isolate_real_roots(poly: fmpq_mpoly, interval: TimeRange,
     if p.is_zero():
         raise IdenticallyZeroError("the function is identically zero along the path")
     if uses_t(p) and uses_trig(p):
-        return _mixed(p, interval, tolerance)
+        return _mixed(p, interval, tolerance, irreducible and p == poly)
     if uses_trig(p):
         return _half_angle(p, interval, tolerance)
     return _exact_univariate(p, interval, tolerance)

@@ -191,8 +191,10 @@ def _compiled_walk(program: ModeProgram):
     coefficients, (wide, sin kt and cos kt)) over the ball t: each coordinate's step
     (as :meth:`ModeProgram._enclose` takes them), the legs' program and
     :func:`~singcheck.certify.path._branches_from` written out as one Python function
-    for this path (each quadratic leg's two branches (-b ± √D)/(2a) inline, the other
-    legs' by ``_branches_from``), compiled once per shape.
+    for this path (each quadratic leg's two branches (-b ± √D)/(2a) and each revolute
+    leg's (cos θ, sin θ) = ((-P·R ± Q·√Δ)/W, (-Q·R ∓ P·√Δ)/W) inline where the
+    discriminant is proven > 0, the rest by ``_branches_from``), compiled once per
+    shape.
 
     The same operations on the same balls, so the same enclosures (module docstring).
     Safety, as for :class:`~singcheck.algebra.ball_programs.BallProgram`: the source is
@@ -249,6 +251,17 @@ def _compiled_walk(program: ModeProgram):
                       f"        r{k} = d{k}.sqrt()",
                       f"        g{k} = {{'+': (-b{k} + r{k}) / (2 * a{k}), "
                       f"'-': (-b{k} - r{k}) / (2 * a{k})}}",
+                      "    else:",
+                      f"        g{k} = BR({const(leg)}, L[{a}:{b}])"]
+        elif leg.kind == REVOLUTE and b - a == 4:  # (cos θ, sin θ), as branch_values
+            lines += [f"    a{k}, b{k}, c{k}, d{k} = L[{a}], L[{a + 1}], L[{a + 2}], L[{a + 3}]",
+                      f"    w{k} = a{k} * a{k} + b{k} * b{k}",
+                      f"    if d{k} > 0:",
+                      f"        r{k} = d{k}.sqrt()",
+                      f"        g{k} = {{" + ", ".join(
+                          f"'{label}': ((-a{k} * c{k} + {sigma} * b{k} * r{k}) / w{k}, "
+                          f"(-b{k} * c{k} - {sigma} * a{k} * r{k}) / w{k})"
+                          for label, sigma in (("+", 1), ("-", -1))) + "}",
                       "    else:",
                       f"        g{k} = BR({const(leg)}, L[{a}:{b}])"]
         else:

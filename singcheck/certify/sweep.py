@@ -43,6 +43,7 @@ from singcheck.certify.covers import (
 )
 from singcheck.certify.path import (
     _branches_at_point,
+    _branches_from,
     inside_limits,
     leg_polynomials,
     limit_balls,
@@ -128,6 +129,10 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
             # a constant leading coefficient (the Orthoglide's 1): 2a once for all pieces
             legs[i] = (2 * evaluate(a, ()) if a.is_constant() else a, b, d,
                        limit_balls(limits) if limits else None)
+    # every leg's a, b, D (or P, Q, R, Δ) by the path's compiled program, once a piece
+    program, slices = path._legs_program
+    if program is not None and any(slices[i][0] is not path.legs[i].leg for i in legs):
+        program = None
     coordinates = [(x, ball_split(x), x.degrees()[1] + x.degrees()[2] >= TIGHT_COORDINATE)
                    for x in path.trig_coordinates]  # (legs_from_pose: all in TRIG)
     head = [arb(0)] * len(model.joint_variables)
@@ -143,6 +148,7 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
         point = head + [evaluate_trig(x, piece, tight=True) if wide and high else
                         evaluate_split(split, piece, s, c) for x, split, high in coordinates]
         powers: dict = {}
+        balls = program(point) if program is not None else None
         values: dict[int, list] = {}  # leg -> [D, D > 0, 2a, -b (when asked for)]
         still = []
         for f in pending:
@@ -155,7 +161,8 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
             if a is REVOLUTE:
                 hit = values.get(i)
                 if hit is None:
-                    both = _branches_at_point(model, b, point, powers)
+                    both = _branches_from(b, balls[slices[i][1]:slices[i][2]]) \
+                        if balls is not None else _branches_at_point(model, b, point, powers)
                     hit = values[i] = [both, all(_real(v) for v in both.values())]
                 if not hit[1] or (label is not None and
                                   inside_limits(b, hit[0][label], limits) is not True):
@@ -163,7 +170,7 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
                 continue
             hit = values.get(i)
             if hit is None:
-                dv = evaluate(d, point, powers)
+                dv = evaluate(d, point, powers) if balls is None else balls[slices[i][1] + 2]
                 hit = values[i] = [dv, dv > 0, None, None]
             if not hit[1]:
                 still.append(f)
@@ -171,8 +178,13 @@ def _walk(path, facts: list[Fact], todo: list[arb], allowed: int,
             if label is None:
                 continue
             if hit[2] is None:
-                hit[2] = a if isinstance(a, arb) else 2 * evaluate(a, point, powers)
-                hit[3] = -evaluate(b, point, powers)
+                if balls is None:
+                    hit[2] = a if isinstance(a, arb) else 2 * evaluate(a, point, powers)
+                    hit[3] = -evaluate(b, point, powers)
+                else:  # (the program's a, b, D: the same sums as evaluate's)
+                    at = slices[i][1]
+                    hit[2] = a if isinstance(a, arb) else 2 * balls[at]
+                    hit[3] = -balls[at + 1]
             root = hit[0].sqrt()
             rho = (hit[3] + root if label == "+" else hit[3] - root) / hit[2]
             if not (rho > limits[0] and rho < limits[1]):

@@ -80,6 +80,79 @@ def _remote_check(robot: Robot, chunk: list, options: dict, region_cache: bool,
     return [formatted(check_item(robot, item, **options), line) for item in chunk]
 
 
+#: the periodic diagnostics of a worker and of its nanny that a batch pauses while it
+#: runs (restored when it ends): the statistical profiler (every 10 ms, it stops the
+#: task's thread to read its stack), the event loop's tick measure (20 ms) and the system
+#: monitor (500 ms).  Each wakes the process's event loop, which takes the GIL from the
+#: task; on 2 cores with 2 workers these cost the cluster about 10% of its throughput
+#: against ``--jobs 2`` (docs/speed.md).  None of them guards anything.
+DIAGNOSTICS = ("profile", "profile-cycle", "tick", "ticks", "monitor")
+#: periodic guards slowed (not stopped) during a batch, to this many ms: the memory
+#: monitor (spill, pause, restart past the memory limit) polls every 100 ms by default;
+#: every second still catches a runaway worker long before its memory is spent
+SLOWED = {"memory_monitor": 1000}
+
+
+def _pause_diagnostics(dask_worker) -> None:
+    """On a worker or its nanny (``Client.run`` passes either as ``dask_worker``, on its
+    event loop): pause :data:`DIAGNOSTICS` and slow :data:`SLOWED` for a batch; nested
+    batches (two clients at once) count, and the last one to end restores them
+    (:func:`_resume_diagnostics`)."""
+    server = dask_worker
+    depth = getattr(server, "_singcheck_batches", 0)
+    server._singcheck_batches = depth + 1
+    if depth:
+        return
+    saved = {}
+    for name in DIAGNOSTICS:
+        pc = server.periodic_callbacks.get(name)
+        if pc is not None and pc.is_running():
+            pc.stop()
+            saved[name] = None
+    for name, ms in SLOWED.items():
+        pc = server.periodic_callbacks.get(name)
+        if pc is not None and pc.callback_time < ms:
+            saved[name] = pc.callback_time
+            pc.callback_time = ms
+    server._singcheck_saved = saved
+
+
+def _resume_diagnostics(dask_worker) -> None:
+    """Undo :func:`_pause_diagnostics` once the last batch on this worker or nanny
+    has ended."""
+    server = dask_worker
+    depth = getattr(server, "_singcheck_batches", 0) - 1
+    server._singcheck_batches = max(depth, 0)
+    if depth > 0:
+        return
+    from time import time
+
+    saved = getattr(server, "_singcheck_saved", {})
+    if "tick" in saved and hasattr(server, "_last_tick"):
+        # the pause is not the event loop being unresponsive: measure from now on
+        server._last_tick = server._last_tick_cycle = time()
+        server._last_tick_counter = getattr(server, "_tick_counter", 0)
+    for name, old in saved.items():
+        pc = server.periodic_callbacks.get(name)
+        if pc is None:
+            continue
+        if old is None:
+            pc.start()
+        else:
+            pc.callback_time = old
+    server._singcheck_saved = {}
+
+
+def _on_workers(client, function) -> None:
+    """Run ``function`` on every worker and every nanny; a cluster that refuses
+    (``Client.run`` disabled, a worker gone) only keeps its diagnostics running."""
+    for nanny in (False, True):
+        try:
+            client.run(function, nanny=nanny, on_error="ignore")
+        except Exception:  # noqa: BLE001 - an optimisation, never the batch's failure
+            pass
+
+
 #: trajectories per task: on a 2-worker LocalCluster a task cost about 14 ms of CPU
 #: beyond its trajectories' own (a heart-like path: about 5 ms), so a long batch goes 64
 #: to a task, a short one in at least TASKS_PER_WORKER tasks per worker thread
@@ -106,6 +179,7 @@ def check_on_cluster(address: str, robot: Robot,
 
     register()
     client = _client(address)
+    quiet = False
     try:
         workers = client.scheduler_info()["workers"]
         threads = sum(w.get("nthreads", 1) for w in workers.values())
@@ -119,12 +193,16 @@ def check_on_cluster(address: str, robot: Robot,
         # once more, about 0.3 s of every run on 2 cores)
         shipped = client.scatter(replace(robot, region_cache=None), broadcast=True,
                                  hash=False)
+        _on_workers(client, _pause_diagnostics)
+        quiet = True
         window = max(8, TASKS_PER_WORKER * threads)  # tasks in flight
         size = CHUNK if len(head) == LOOKAHEAD else max(1, min(CHUNK, -(-len(head) // window)))
         yield from _results(_Submitter(client, shipped, chain(head, items), options,
                                        robot.region_cache is not None, window, size, line,
                                        threads), ordered)
     finally:
+        if quiet:
+            _on_workers(client, _resume_diagnostics)
         client.close()  # the tasks still queued or running are cancelled with it
 
 

@@ -443,6 +443,52 @@ def test_the_dask_run_gives_the_local_verdicts(local_cluster, tmp_path, orthogli
         {n: d["verdict"] for n, d in local.items()}
 
 
+def _diagnostics(dask_worker) -> dict:
+    """On a worker or nanny: which periodic diagnostics run, and the memory monitor's
+    period (ms)."""
+    from singcheck.cluster import DIAGNOSTICS
+
+    callbacks = dask_worker.periodic_callbacks
+    out = {n: callbacks[n].is_running() for n in DIAGNOSTICS if n in callbacks}
+    if "memory_monitor" in callbacks:
+        out["memory_monitor"] = callbacks["memory_monitor"].callback_time
+    return out
+
+
+def test_a_dask_batch_pauses_the_workers_diagnostics_and_restores_them(
+        local_cluster, tmp_path, orthoglide_robot):
+    """While a batch runs, every worker's and nanny's profiler, tick and system monitor
+    are paused and the memory monitor polls every second (not 100 ms); once the batch
+    has ended, or is stopped early, they are as they were."""
+    from distributed import Client
+
+    from singcheck.cluster import check_on_cluster
+    from singcheck.spec.files import load_trajectories
+
+    specs = list(load_trajectories(_generated(tmp_path, 12), orthoglide_robot.spec))
+    with Client(local_cluster.scheduler_address) as client:
+        def every(nanny: bool) -> list[dict]:
+            return list(client.run(_diagnostics, nanny=nanny).values())
+
+        before = every(False) + every(True)
+        assert len(before) == 4 and all(d["profile"] for d in before[:2])
+        assert all(d["tick"] and d["monitor"] and d["memory_monitor"] == 100
+                   for d in before)
+        for stop_early in (False, True):
+            results = check_on_cluster(local_cluster.scheduler_address, orthoglide_robot,
+                                       specs, regions=False)
+            first = next(results)
+            assert first["verdict"] in ("singular", "singularity-free", "infeasible")
+            during = every(False) + every(True)
+            assert all(not any(v for k, v in d.items() if k != "memory_monitor")
+                       and d["memory_monitor"] == 1000 for d in during), during
+            if stop_early:
+                results.close()  # (the CLI's Ctrl-C, or a consumer that stops)
+            else:
+                assert len(list(results)) == len(specs) - 1
+            assert every(False) + every(True) == before
+
+
 def test_the_region_statement_is_bounded_by_the_time_limit():
     """The helix's region needs the 3-D workspace decomposed (seconds, no cache here):
     with a 0.5 s limit the certified verdict stands and the region statement is left out

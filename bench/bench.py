@@ -113,6 +113,41 @@ def interleaved(fns: list, repeat: int = REPEAT) -> list[list[tuple[float, float
     return out
 
 
+#: runs of one contender in a row per sample of the per-path table (:func:`in_blocks`)
+BLOCK = max(2, int(os.environ.get("BENCH_BLOCK", "5")))
+
+
+def in_blocks(fns: list, repeat: int = REPEAT, size: int = BLOCK
+              ) -> tuple[list[list[tuple[float, float]]], list[list[tuple[float, float]]]]:
+    """(warm, cold): per contender, the (wall, CPU) seconds of each block's runs after
+    its first (their mean: code and data in the caches, as for every path of a batch but
+    the first) and of each block's first run (right after another contender, whose code
+    and arrays — the 10⁵-point scan's 800 kB — evicted them: a lone path's case).  A
+    block is ``size`` runs of one contender in a row; the blocks go round-robin, each
+    round in its own order as in :func:`interleaved`, so a noisy spell of the machine
+    falls on all of them alike.  Single runs alone mixed the two cases: on heart 2
+    singcheck's median read 1.01x the branch-and-bound's, its warm runs 0.84x
+    (docs/speed.md)."""
+    warm: list[list[tuple[float, float]]] = [[] for _ in fns]
+    cold: list[list[tuple[float, float]]] = [[] for _ in fns]
+    orders = random.Random(ROUND_ORDER_SEED)
+    for _ in range(repeat):
+        order = list(range(len(fns)))
+        if not FIXED_ORDER:
+            orders.shuffle(order)
+        for i in order:
+            runs = []
+            for _ in range(size):
+                cpu, start = _cpu(), time.perf_counter()
+                fns[i]()
+                runs.append((time.perf_counter() - start, _cpu() - cpu))
+            cold[i].append(runs[0])
+            rest = runs[1:]
+            warm[i].append((sum(w for w, _ in rest) / len(rest),
+                            sum(c for _, c in rest) / len(rest)))
+    return warm, cold
+
+
 def stats(ts: list) -> dict:
     """Medians and extremes; with (wall, CPU) pairs, the CPU ones as ``cpu_*``."""
     if ts and isinstance(ts[0], tuple):
@@ -256,9 +291,9 @@ def compare(robot: str, trajectory: str, label: str, backends: bool = True) -> l
     else:
         scan = SamplingScan(build_path(projection, spec), mode)
         width = scan.range[1] - scan.range[0]
-    timings = interleaved([lambda: certify_path(build_path(projection, spec, ENGINE)),
-                           lambda: contender(model, spec),
-                           *[lambda n=n: scan(n) for n in sizes]])
+    timings, cold = in_blocks([lambda: certify_path(build_path(projection, spec, ENGINE)),
+                               lambda: contender(model, spec),
+                               *[lambda n=n: scan(n) for n in sizes]])
     right = agrees(answer, report)
     case = {"case": label, "path": f"{robot}/{Path(trajectory).stem}"}
     rows = [{**case, "contender": "singcheck (certified)", **stats(timings[0]),
@@ -274,11 +309,15 @@ def compare(robot: str, trajectory: str, label: str, backends: bool = True) -> l
                      "sign_changes": len(found)})
     if backends and (robot, Path(trajectory).stem) == ("orthoglide", "heart1"):
         rows += [{**case, **r} for r in backend_rows(projection.model, spec, truth)]
-    base = rows[0]["cpu_median_s"]
+    for row, ts in zip(rows, cold, strict=False):  # (the backend rows: no cold runs)
+        row["cold_cpu_median_s"] = cpu_median(ts)
+    base, base_cold = rows[0]["cpu_median_s"], rows[0]["cold_cpu_median_s"]
     for row in rows:
         own = row.get("cpu_median_s", row["median_s"])
         row["ratio_to_singcheck"] = own / base
         row["singcheck_over_it"] = base / own
+        if "cold_cpu_median_s" in row:
+            row["cold_ratio_to_singcheck"] = row["cold_cpu_median_s"] / base_cold
     return rows
 
 
@@ -717,20 +756,25 @@ def ms(x: float) -> str:
 
 def print_paths(rows: list[dict]) -> None:
     print(f"{'path':24} {'contender':32} {'CPU ms':>9} {'min CPU':>9} {'wall ms':>9} "
-          f"{'vs singcheck':>12}  right answer?")
+          f"{'vs singcheck':>12} {'cold CPU ms':>11} {'cold vs':>8}  right answer?")
     for r in rows:
         right = "yes" if r["found"] else "NO"
         if "verdict" in r and r["contender"] != "singcheck (certified)":
             right += f" ({r['verdict']})"
         elif "verdict" in r:
             right += f" ({r['verdict']}, {len(r['singular_times'])} singular times)"
+        cold = (f"{ms(r['cold_cpu_median_s']):>11} {r['cold_ratio_to_singcheck']:7.2f}x"
+                if "cold_cpu_median_s" in r else f"{'':11} {'':8}")
         print(f"{r['case']:24} {r['contender']:32} {ms(r['cpu_median_s'])} "
               f"{ms(r['cpu_min_s'])} {ms(r['median_s'])} {r['ratio_to_singcheck']:11.2f}x"
-              f"  {right}")
-    print("(medians of CPU time and of wall-clock time; vs singcheck: its median CPU time "
-          "/ singcheck's; right answer: singcheck decided; branch-and-bound: same verdict "
-          "and singular times as singcheck; sampling: sign changes at exactly singcheck's "
-          "singular times)")
+              f" {cold}  {right}")
+    print(f"(each sample: a block of {BLOCK} runs of one contender in a row, blocks "
+          "round-robin; CPU and wall: medians over the blocks of the mean of each block's "
+          "runs after its first (warm caches, as for the paths of a batch); cold: the "
+          "median of the blocks' first runs, right after another contender; vs singcheck: "
+          "its median CPU time / singcheck's; right answer: singcheck decided; "
+          "branch-and-bound: same verdict and singular times as singcheck; sampling: sign "
+          "changes at exactly singcheck's singular times)")
 
 
 def main() -> None:
@@ -739,7 +783,8 @@ def main() -> None:
     results = {"machine": machine(), "repeat": REPEAT, "round_order": order}
     print(f"machine: {results['machine']['cpu']}, {results['machine']['cores']} cores, "
           f"Python {results['machine']['python']}, load average {os.getloadavg()[0]:.1f} "
-          f"at the start; medians of {REPEAT} round-robin runs, {order}; glibc malloc "
+          f"at the start; medians of {REPEAT} round-robin runs (per path: of {REPEAT} "
+          f"rounds of blocks of {BLOCK} runs), {order}; glibc malloc "
           "thresholds fixed high (the sampling scans' best case)\n")
     results["paths"] = rows = []
     for robot, trajectory, label in PATHS:

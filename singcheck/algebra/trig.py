@@ -172,7 +172,15 @@ def evaluate_trig(p: fmpq_mpoly, t: arb, tight: bool = False) -> arb:
         return _fourier_value(p, t)
     s, c = _sin_cos_multiple(t, 1)
     total = evaluate_split(split, t, s, c)
-    if tight and t.rad() > _WIDE:
+    return tightened(p, t, total) if tight else total
+
+
+def tightened(p: fmpq_mpoly, t: arb, total: arb) -> arb:
+    """Given ``total`` = :func:`evaluate_trig` (p, t) (not ``tight``): what ``tight``
+    would return, without enclosing p by Horner's rule again — on a wide ball the
+    narrowest of it, the Fourier form's enclosure and their intersection (each holds
+    every value of p over t); on a narrow one ``total`` itself."""
+    if t.rad() > _WIDE and not isinstance(_split(p), arb_poly) and not _high_harmonic(p):
         fourier = _fourier_value(p, t)
         if fourier is not None:  # each of the three balls holds every value: the narrowest
             return min((total, fourier, total.intersection(fourier)), key=lambda b: b.rad())

@@ -36,7 +36,7 @@ from flint import arb, fmpq, fmpq_mpoly, fmpq_poly
 from singcheck.algebra.intervals import excludes_zero, fraction_ball, sign, working_precision
 from singcheck.algebra.radicals import evaluate_path as evaluate_trig
 from singcheck.algebra.radicals import path_derivative as derivative
-from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
+from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange, tightened
 from singcheck.budget import checkpoint
 from singcheck.roots.enclosures import (
     AT_ANGLE_ZERO,
@@ -78,7 +78,7 @@ def _point(p: fmpq_mpoly, t: fmpq) -> arb:
 def _excluded(p, dp, lo: fmpq, hi: fmpq) -> tuple[bool, arb]:
     box = rational_ball(lo, hi)
     naive = evaluate_trig(p, box)
-    if excludes_zero(naive) or excludes_zero(evaluate_trig(p, box, tight=True)):
+    if excludes_zero(naive) or excludes_zero(tightened(p, box, naive)):
         return True, None
     mid = (lo + hi) / 2
     slope = evaluate_trig(dp, box)

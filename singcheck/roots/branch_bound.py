@@ -78,7 +78,9 @@ def _point(p: fmpq_mpoly, t: fmpq) -> arb:
 def _excluded(p, dp, lo: fmpq, hi: fmpq) -> tuple[bool, arb]:
     box = rational_ball(lo, hi)
     naive = evaluate_trig(p, box)
-    if excludes_zero(naive) or excludes_zero(tightened(p, box, naive)):
+    if excludes_zero(naive) or excludes_zero(
+            tightened(p, box, naive) if p.context() is TRIG else
+            evaluate_trig(p, box, tight=True)):  # (a path ring's: Horner per part again)
         return True, None
     mid = (lo + hi) / 2
     slope = evaluate_trig(dp, box)

@@ -61,6 +61,11 @@ def _point_power(p: arb, e: int) -> arb:
     """p^e for an exact ball p, by squaring and multiplying (each step rounded outward)."""
     if e == 2:
         return p * p
+    if e == 3:  # (the loop's products, without its steps)
+        return p * (p * p)
+    if e == 4:
+        q = p * p
+        return q * q
     out, base = arb(1), p
     while e:
         if e & 1:

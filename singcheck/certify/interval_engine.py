@@ -28,12 +28,15 @@ import math
 from collections import deque
 from dataclasses import dataclass, field
 
-from flint import arb
+from flint import arb, ctx
 
+from singcheck.algebra.ball_programs import ball_program
 from singcheck.algebra.intervals import excludes_zero, sign
+from singcheck.algebra.radicals import radical_balls
 from singcheck.budget import checkpoint
 from singcheck.certify.covers import halves, pieces
 from singcheck.certify.mode_programs import mode_program
+from singcheck.model.robot import REVOLUTE
 
 #: the narrowest piece that is halved again, relative to the range's length
 MIN_WIDTH = 2.0 ** -26
@@ -351,14 +354,14 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
     Every quantity is a ball enclosing its values over ``t``, so the result encloses
     det A over ``t`` (the mean value theorem, on a continuous branch of a feasible mode).
     ``joints``: each mode's joint balls over ``t`` (:func:`mode_values`)."""
-    from singcheck.algebra.ball_programs import ball_program
-    from singcheck.algebra.radicals import radical_balls
-    from singcheck.model.robot import REVOLUTE
-
     model = path.projection.model
     if len(model.det_A) > 5000:
         return {}
     fast = mode_program(path)
+    if fast is not None:
+        parts = _compiled_parts(model)
+        if parts is not None:
+            return _compiled_mean_value(fast, parts, path, modes, t, joints)
     rates = fast.rates(t) if fast is not None else path.pose_rates_at(t, angle_functions=False)
     if rates is None:
         return {}
@@ -421,6 +424,59 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
 
 
 _ZERO = arb(0)
+_COMPILED_PARTS: dict = {}
+
+
+def _compiled_parts(model):
+    """(joints' count, the compiled program of :func:`_derivative_polys`, the compiled
+    :func:`_assembler`, the robot's square roots' balls) once per model and precision,
+    None when the program is too large to compile (then the loop of
+    :func:`mean_value`)."""
+    key = (id(model), ctx.prec)
+    hit = _COMPILED_PARTS.get(key)
+    if hit is not None and hit[0] is model:
+        return hit[1]
+    if len(_COMPILED_PARTS) > 64:
+        _COMPILED_PARTS.clear()
+    program = ball_program(model, "mean value", _derivative_polys)
+    parts = None if program is None else (
+        _derivative_parts(model)[0], program, _assembler(model),
+        [b for _, b in sorted(radical_balls(model.context).items())])
+    _COMPILED_PARTS[key] = (model, parts)
+    return parts
+
+
+def _compiled_mean_value(fast, parts, path, modes: list, t: arb, joints: dict) -> dict:
+    """:func:`mean_value` through the path's :class:`ModeProgram` and the model's
+    compiled programs (:func:`_compiled_parts`): the same balls and operations as its
+    loop, the lookups made once."""
+    rates = fast.rates(t)
+    if rates is None:
+        return {}
+    n_joint, program, assemble, radicals = parts
+    variables = path.pose_variables_at(t)  # (before the midpoint's: the caller's, kept)
+    m = arb(t.mid())
+    _, _, at_mid = fast(path, m, modes)
+    head = [_ZERO] * n_joint
+    out = {}
+    for mode in modes:
+        js, mid = joints[mode.label], at_mid[mode.label]
+        if not isinstance(mid, arb) or any(j is None for j in js):
+            continue
+        flat = []
+        for j in js:
+            flat += list(j) if isinstance(j, tuple) else [j]
+        if not all(isinstance(v, arb) for v in flat):
+            continue
+        point = flat + variables + radicals
+        slope = assemble(program(point), head + rates, _branch_signs(mode), point)
+        if slope is not None:
+            value = mid + slope * (t - m)
+            if value.is_finite():
+                out[mode.label] = (value, slope)
+    return out
+
+
 _ASSEMBLERS: dict = {}
 
 

@@ -457,6 +457,29 @@ def limit_balls(limits) -> tuple[arb, arb]:
     return hit[1]
 
 
+_ARCS: dict = {}
+
+
+def _angle_arc(limits) -> tuple[arb, arb, arb] | None:
+    """(cos m, sin m, cos(w/2)) of an angle's limits [lo, hi] (middle m, width w), None
+    when w ≥ 2π (every angle is inside); once per limits object and precision, as
+    :func:`limit_balls`."""
+    key = (id(limits), ctx.prec)
+    hit = _ARCS.get(key)
+    if hit is None or hit[0] is not limits:
+        if len(_ARCS) > 256:
+            _ARCS.clear()
+        lo, hi = (v.ball() for v in limits)
+        width = hi - lo
+        if width >= 2 * arb.pi():
+            arc = None
+        else:
+            mid = (lo + hi) / 2
+            arc = (mid.cos(), mid.sin(), (width / 2).cos())
+        hit = _ARCS[key] = (limits, arc)
+    return hit[1]
+
+
 def inside_limits(leg: Leg, value, limits) -> bool | None:
     """Strictly inside (True), outside (False) or undecided (None).  For an angle θ and
     limits [lo, hi] of width w < 2π with middle m: θ is inside (mod 2π) exactly when
@@ -466,12 +489,11 @@ def inside_limits(leg: Leg, value, limits) -> bool | None:
     if leg.kind == REVOLUTE:
         if not isinstance(value, tuple) or not all(isinstance(v, arb) for v in value):
             return None
-        lo, hi = (v.ball() for v in limits)
-        width = hi - lo
-        if width >= 2 * arb.pi():
+        arc = _angle_arc(limits)
+        if arc is None:
             return True
-        mid = (lo + hi) / 2
-        margin = value[0] * mid.cos() + value[1] * mid.sin() - (width / 2).cos()
+        cos_m, sin_m, cos_half = arc
+        margin = value[0] * cos_m + value[1] * sin_m - cos_half
         return True if margin > 0 else False if margin < 0 else None
     lo, hi = limit_balls(limits)
     if value > lo and value < hi:

@@ -101,18 +101,36 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
 
 def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float,
            irreducible: bool = False) -> RootIsolation:
-    """t mixed with sin t, cos t: each irreducible factor of p in Q[t, s, c] by its own
-    method (a factor free of t or of s, c exactly; the rest by branch-and-bound), so that
-    a repeated factor costs one isolation and pure factors keep their exact roots.
-    ``irreducible``: p is such a factor already (not factored again: FLINT's
-    multivariate factorization is most of the exact engine's time on the helix).
+    """t mixed with sin t, cos t: each factor of p in Q[t, s, c] by its own method (a
+    factor free of t or of s, c exactly; the rest by branch-and-bound), so that a
+    repeated factor costs one isolation and pure factors keep their exact roots.
+
+    The factors are first the cheap ones (:func:`_cheap_factors`: p's content in t, its
+    content in (s, c), and the squarefree factors of what is left); only when those
+    leave a stretch undecided is p factored into irreducibles (FLINT's multivariate
+    factorization: most of the exact engine's time on the helix), so that distinct
+    factors sharing a zero, or a factor that is a square on the circle, are told apart
+    as before.  ``irreducible``: p is such a factor already, taken as it is.
 
     Roots of different factors are merged: balls that overlap are refined apart; a root
     two factors share (proven only for the same exact point) is kept once; two balls
     that stay overlapping otherwise become an undecided stretch."""
-    _, factors = (1, [(p, 1)]) if irreducible else p.factor()
+    if irreducible:
+        return _through_norm(p, interval, tolerance) or branch_and_bound(p, interval, tolerance)
+    cheap = _cheap_factors(p)
+    if cheap is not None:
+        quick = _by_factors(cheap, interval, tolerance)
+        if not quick.undecided:
+            return quick
+    _, factors = p.factor()
     if len(factors) == 1 and factors[0][1] == 1:
         return _through_norm(p, interval, tolerance) or branch_and_bound(p, interval, tolerance)
+    return _by_factors(factors, interval, tolerance)
+
+
+def _by_factors(factors, interval: TimeRange, tolerance: float) -> RootIsolation:
+    """The roots of a product from each factor's (``factors``: (polynomial,
+    multiplicity), each isolated as it is), merged as :func:`_mixed` says."""
     roots: list[tuple[RealRoot, int]] = []
     undecided: list[Undecided] = []
     for f, mult in factors:
@@ -127,6 +145,40 @@ def _mixed(p: fmpq_mpoly, interval: TimeRange, tolerance: float,
                   exact=r.exact) for r, mult in roots], tolerance,
         "two factors of the function have roots that could not be separated")
     return RootIsolation(tuple(merged), tuple(undecided + apart), BRANCH_AND_BOUND)
+
+
+def _cheap_factors(p: fmpq_mpoly) -> list[tuple[fmpq_mpoly, int]] | None:
+    """Factors of a trig polynomial p mixing t with sin t, cos t, without factoring it
+    into irreducibles: its content in t (the gcd of its coefficients as a polynomial in
+    s, c over Q[t]), its content in (s, c) (the gcd of its coefficients in t over
+    Q[s, c]), and the squarefree factors of the quotient (each free of any factor in t
+    or in s, c alone: mixed).  Their product is p up to a constant; None outside the
+    trig ring (a pose angle's ring: the full factorization)."""
+    if p.context() is not TRIG:
+        return None
+    by_trig: dict[tuple[int, int], dict] = {}
+    by_t: dict[int, dict] = {}
+    for (i, j, k), a in p.terms():
+        by_trig.setdefault((j, k), {})[(i, 0, 0)] = a
+        by_t.setdefault(i, {})[(0, j, k)] = a
+    in_t = _gcd_of(by_trig.values())
+    in_trig = _gcd_of(by_t.values())
+    rest, remainder = divmod(p, in_t * in_trig)
+    if not remainder.is_zero():  # (cannot happen: they are coprime divisors of p)
+        return None
+    _, parts = rest.factor_squarefree()
+    return [(in_t, 1), (in_trig, 1), *((f, int(m)) for f, m in parts)]
+
+
+def _gcd_of(groups) -> fmpq_mpoly:
+    """The gcd of the polynomials whose terms are the dicts ``groups`` (in TRIG)."""
+    g = None
+    for terms in groups:
+        q = TRIG.from_dict(terms)
+        g = q if g is None else g.gcd(q)
+        if g.is_constant():
+            return TRIG.from_dict({(0, 0, 0): 1})
+    return g
 
 
 def _merge_apart(roots: list[RealRoot], tolerance: float, why: str

@@ -107,6 +107,37 @@ def test_mixed_t_and_sine_by_branch_and_bound():
     assert_roots(iso, expected)
 
 
+def test_a_product_of_pure_and_repeated_mixed_factors_has_each_root_once():
+    """(t² - 2)·(2 sin t + cos t)·(sin t - t/20)²·(cos t - t/30) on [0, 20]: the cheap
+    factors (contents in t and in sin, cos; squarefree parts) give every root, each
+    once (its multiplicity where it is exact), against 50-digit mpmath roots of each
+    factor."""
+    from singcheck.roots.isolation import _cheap_factors
+
+    p = reduce_trig((T * T - 2) * (2 * S + C) * (S - T / 20) ** 2 * (C - T / 30))
+    parts = _cheap_factors(p)
+    product = 1
+    for q, m in parts:
+        product = product * q ** m
+    assert (reduce_trig(p - product * p.leading_coefficient()
+                        / product.leading_coefficient())).is_zero()
+    iso = isolate_real_roots(p, rng(0, 20))
+    factors = [lambda t: t * t - 2, lambda t: 2 * mpmath.sin(t) + mpmath.cos(t),
+               lambda t: mpmath.sin(t) - t / 20, lambda t: mpmath.cos(t) - t / 30]
+    grid = [mpmath.mpf(i) / 200 for i in range(4001)]
+    expected, multiplicity = [], {}
+    for k, f in enumerate(factors):
+        for a, b in zip(grid, grid[1:], strict=False):
+            if f(a) == 0 or f(a) * f(b) < 0:
+                x = a if f(a) == 0 else mpmath.findroot(f, (a, b), solver="bisect")
+                expected.append(x)
+                multiplicity[float(x)] = 2 if k == 2 else 1
+    assert_roots(iso, expected)
+    known = [(r.multiplicity, multiplicity[k]) for r, k in
+             zip(iso.roots, sorted(multiplicity), strict=True) if r.multiplicity is not None]
+    assert known and all(a == b for a, b in known)  # (a sign change's root: unknown)
+
+
 def test_no_root_is_certified_empty():
     iso = isolate_real_roots(2 + S + T / 100, rng(0, 20))
     assert iso.roots == () and iso.certified

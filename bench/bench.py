@@ -291,8 +291,15 @@ def compare(robot: str, trajectory: str, label: str, backends: bool = True) -> l
     else:
         scan = SamplingScan(build_path(projection, spec), mode)
         width = scan.range[1] - scan.range[0]
-    timings, cold = in_blocks([lambda: certify_path(build_path(projection, spec, ENGINE)),
-                               lambda: contender(model, spec),
+    # each run of singcheck and of the peer gets the path read anew (its own polynomial
+    # objects): what either caches per path object must not carry over to the next run,
+    # as it does not from one path of a batch to the next
+    source = ROOT / trajectory if "/" in trajectory else \
+        ROOT / "trajectories" / f"{trajectory}.yaml"
+    ours, theirs = (iter([load_trajectory(source, model.spec)
+                          for _ in range(REPEAT * BLOCK)]) for _ in range(2))
+    timings, cold = in_blocks([lambda: certify_path(build_path(projection, next(ours), ENGINE)),
+                               lambda: contender(model, next(theirs)),
                                *[lambda n=n: scan(n) for n in sizes]])
     right = agrees(answer, report)
     case = {"case": label, "path": f"{robot}/{Path(trajectory).stem}"}

@@ -46,6 +46,8 @@ def power(x: Ball, e: int) -> Ball:
         for _ in range(e - 1):
             out = out * x
         return out
+    if x.is_exact():  # a point (a constant coordinate): its power, rounded outward
+        return _point_power(x, e)
     if e == 2:  # [min |x|², max |x|²]: Arb's bounds of |x| (the commonest power, fast)
         a, b = x.abs_lower(), x.abs_upper()
         return (a * a).union(b * b)

@@ -540,9 +540,13 @@ def growth_rows() -> list[dict]:
         for k in range(1, 9):
             paths = write(Path(out) / str(k), 3, harmonics=k, seed=k)
             specs = [load_trajectory(p, model.spec) for p in paths]
+            # every run reads its 3 paths anew (as compare() does)
+            mine, peers = (iter([[load_trajectory(p, model.spec) for p in paths]
+                                 for _ in range(9)]) for _ in range(2))
             ours, theirs = interleaved(
-                [lambda ss=specs: [certify_path(build_path(projection, s, ENGINE)) for s in ss],
-                 lambda ss=specs: [contender(model, s) for s in ss]], 9)
+                [lambda m=mine: [certify_path(build_path(projection, s, ENGINE))
+                                 for s in next(m)],
+                 lambda p=peers: [contender(model, s) for s in next(p)]], 9)
             reports = [certify_path(build_path(projection, s, ENGINE)) for s in specs]
             answers = [contender(model, s) for s in specs]
             right = sum(agrees(a, r) for a, r in zip(answers, reports, strict=True))

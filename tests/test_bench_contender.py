@@ -114,6 +114,35 @@ def test_the_round_robin_varies_each_rounds_order_reproducibly(monkeypatch):
     assert set(rounds(3)) == {(0, 1, 2, 3, 4)}
 
 
+def test_blocks_time_a_contenders_runs_in_a_row_and_its_first_run_apart():
+    """bench.in_blocks: each sample is a block of BLOCK runs of one contender in a row;
+    the block's first run is reported as cold, the mean of the others as warm (here a
+    contender whose first run of every block burns ten times the CPU of the others)."""
+    import time
+
+    import bench
+
+    calls: list[int] = []
+
+    def burn(seconds: float) -> None:
+        end = time.process_time() + seconds
+        while time.process_time() < end:
+            pass
+
+    def contender(k: int) -> None:
+        first = not calls or calls[-1] != k
+        calls.append(k)
+        burn(0.02 if first else 0.002)
+
+    warm, cold = bench.in_blocks([lambda: contender(0), lambda: contender(1)], 3, 4)
+    blocks = [tuple(calls[i:i + 4]) for i in range(0, len(calls), 4)]
+    assert len(blocks) == 6 and all(len(set(b)) == 1 for b in blocks)
+    for k in (0, 1):
+        assert len(warm[k]) == len(cold[k]) == 3
+        assert all(c > 5 * w for (_, c), (_, w) in zip(cold[k], warm[k], strict=True))
+        assert all(0.0015 < w < 0.01 for _, w in warm[k])
+
+
 def _contains(ball, root) -> bool:
     lo = mpmath.mpf(ball.lower().str(40, radius=False))
     hi = mpmath.mpf(ball.upper().str(40, radius=False))

@@ -130,7 +130,7 @@ def test_blocks_time_a_contenders_runs_in_a_row_and_its_first_run_apart():
             pass
 
     def contender(k: int) -> None:
-        first = not calls or calls[-1] != k
+        first = calls.count(k) % 4 == 0  # (the first of each of its blocks of 4)
         calls.append(k)
         burn(0.02 if first else 0.002)
 

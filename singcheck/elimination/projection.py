@@ -43,6 +43,7 @@ from singcheck.elimination.requests import (
     norm_chain,
 )
 from singcheck.errors import BackendError, UnsupportedRobotError
+from singcheck.spec.real_constants import exact_engine_refusal
 from singcheck.model.robot import (
     REVOLUTE,
     RobotModel,
@@ -383,6 +384,9 @@ def project_robot(model: RobotModel, backend: EliminationBackend,
     legs are dropped from ξ (each backend's closure may keep them or not): a real pose
     there has no real, separated branches of that leg (Δ = W - d² ≤ 0), so no feasible
     mode passes through it."""
+    refused = exact_engine_refusal(model.spec)
+    if refused:  # parameters outside the exact field: nothing over Q to eliminate
+        return not_projected(model, refused)
     pose_ctx = _pose_context(model)
     xi = None
     if model.joint_free_det_A:
@@ -426,6 +430,32 @@ def project_robot(model: RobotModel, backend: EliminationBackend,
         xi = _without_degenerate_factors(raw, degenerate_set(model))
     return RobotProjection(model, pose_ctx, xi, raw, workspace_boundary(model, pose_ctx),
                            joint_limit_surfaces(model, pose_ctx), name, method)
+
+
+#: the projection's ``method`` for a robot whose parameters leave the exact field
+NOT_PROJECTED = "not computed"
+
+
+def not_projected(model: RobotModel, reason: str) -> RobotProjection:
+    """The projection of a robot with opaque constants (parameters outside the exact
+    field, :mod:`singcheck.spec.real_constants`): ξ, the workspace boundary and the
+    joint-limit surfaces are not computed (they would not be polynomials over Q), and
+    ``not_expanded`` says why; the interval engine alone certifies its paths."""
+    pose_ctx = fmpq_mpoly_ctx.get(model.pose_variables, "lex")
+    return RobotProjection(model, pose_ctx, None, None, (), (), "none",
+                           f"{NOT_PROJECTED}: {reason}", reason)
+
+
+def refuse_elimination(model: RobotModel, what: str) -> None:
+    """An :class:`UnsupportedRobotError` (the spec's ``parameters`` line) when the robot
+    has parameters outside the exact field: ``what`` (an elimination, a region map)
+    cannot be computed for it."""
+    refused = exact_engine_refusal(model.spec)
+    if refused:
+        raise UnsupportedRobotError(f"{what} is not computed: {refused}",
+                                    path=model.spec.path,
+                                    line=model.spec.lines.get("parameters"),
+                                    key="parameters")
 
 
 def joint_space_singularities(model: RobotModel, backend: EliminationBackend) -> fmpq_mpoly:

@@ -66,6 +66,11 @@ class ExprError(ValueError):
         return self.message + (f" (column {self.column})" if self.column else "")
 
 
+class TooLarge(ExprError):
+    """A number past the grammar's size bounds (MAX_BITS): refused, never taken as a ball
+    (the bound is a budget, not a statement about the field)."""
+
+
 @dataclass(frozen=True)
 class Node:
     kind: str  # num | name | neg | add | sub | mul | div | pow | call
@@ -308,18 +313,28 @@ class Constant:
         return " + ".join(parts)
 
 
+class OutsideField:
+    """A constant outside the exact field (a
+    :class:`~singcheck.spec.real_constants.RealConstant`): the exact compilers refuse it,
+    unless a hook gives them a variable standing for it."""
+
+    text: str
+
+
 @dataclass(frozen=True)
 class RealLimit:
     """A prismatic joint's limit that is not rational (``2*sqrt(2)``, ``pi``): an exact
     real ``surd + pi_coefficient·π``, compared by ball arithmetic only (its crossings are
     never isolated exactly; :mod:`singcheck.certify.working_modes`)."""
 
-    value: Constant
+    value: Constant  # or a RealConstant (:mod:`singcheck.spec.real_constants`)
     text: str
 
     def ball(self):
         from flint import arb, fmpq
 
+        if not isinstance(self.value, Constant):  # a RealConstant: its own enclosure
+            return self.value.ball()
         out = self.value.surd.ball()
         q = self.value.pi_coefficient
         if q:
@@ -327,6 +342,8 @@ class RealLimit:
         return out
 
     def __float__(self) -> float:
+        if not isinstance(self.value, Constant):
+            return float(self.value)
         return float(self.value.surd) + float(self.value.pi_coefficient) * 3.141592653589793
 
     def __str__(self) -> str:
@@ -368,7 +385,7 @@ class _Compiler:
     """Evaluate a tree over a ring, with hooks for names, calls, square roots and π."""
 
     def __init__(self, ring, names, call=None, what="expression", surd=None, pi=None,
-                 forbidden=None) -> None:
+                 forbidden=None, opaque=None) -> None:
         self.ring = ring
         self.names = names  # name -> ring element, Fraction, Surd or Constant
         self.call = call  # sin/cos hook
@@ -376,6 +393,9 @@ class _Compiler:
         self.surd = surd  # Surd -> ring element (None: square roots not allowed)
         self.pi = pi  # the ring element standing for π (None: π not allowed)
         self.forbidden = forbidden or {}  # name -> why it cannot be used bare
+        #: parameter name -> the ring's variable standing for its value, for a parameter
+        #: outside the exact field (an opaque constant: :mod:`~singcheck.spec.real_constants`)
+        self.opaque = opaque or {}
 
     def const(self, q: Fraction):
         return self.ring.from_dict({(0,) * self.ring.nvars(): fmpq(q.numerator, q.denominator)}) \
@@ -408,6 +428,15 @@ class _Compiler:
             declared = ", ".join(sorted(self.names)) or "none"
             raise ExprError(f"undeclared name {name!r} (declared: {declared})", node.column)
         value = self.names[name]
+        if isinstance(value, Constant) and value.pi_coefficient and self.pi is None and \
+                name in self.opaque:
+            return self.opaque[name]  # π cannot stay apart here: the value's ball is read
+        if isinstance(value, OutsideField):
+            if name in self.opaque:
+                return self.opaque[name]
+            raise ExprError(f"parameter {name!r} is not an exact algebraic number (it is "
+                            f"{value.text!r}): only the robot's constraints can use it "
+                            "outside sin/cos", node.column)
         if isinstance(value, Constant):
             if value.pi_coefficient:
                 if self.pi is None:
@@ -493,7 +522,7 @@ def _check_power(base, e: int, node: Node) -> None:
     if isinstance(base, Fraction):
         bits = max(abs(base.numerator).bit_length(), base.denominator.bit_length())
         if bits * e > MAX_BITS:
-            raise ExprError(f"the number {_describe(base)}^{e} is too large", node.column)
+            raise TooLarge(f"the number {_describe(base)}^{e} is too large", node.column)
     elif base.total_degree() * e > MAX_DEGREE:
         raise ExprError(f"the expression's degree exceeds {MAX_DEGREE}", node.column)
     elif len(base) > 1 and e > 1:
@@ -509,7 +538,7 @@ def _check_power(base, e: int, node: Node) -> None:
 def _checked(value, node: Node):
     if isinstance(value, Fraction):
         if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) > MAX_BITS:
-            raise ExprError("a number in the expression is too large", node.column)
+            raise TooLarge("a number in the expression is too large", node.column)
     elif isinstance(value, Surd):
         for q in value.terms.values():
             _checked(q, node)
@@ -568,14 +597,17 @@ def _linear_argument(node: Node, angles, parameters) -> tuple[dict[str, int], Fr
 
 def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmpq_mpoly],
                        parameters: dict[str, object],
-                       angles: dict[str, tuple[fmpq_mpoly, fmpq_mpoly]] | None = None
-                       ) -> fmpq_mpoly:
+                       angles: dict[str, tuple[fmpq_mpoly, fmpq_mpoly]] | None = None,
+                       opaque: dict[str, fmpq_mpoly] | None = None) -> fmpq_mpoly:
     """The exact polynomial of ``node`` in ``ctx`` (parameters substituted).
 
     ``angles[v] = (cos(v), sin(v))`` are the ring's variables of each angle v: ``sin`` and
     ``cos`` of integer combinations of angles plus multiples of π/12 are expanded exactly
     and reduced modulo cos² + sin² = 1; a bare angle is refused.  Square roots become
-    the ring's ``sqrt(p)`` variables (reduced modulo sqrt(p)² = p).
+    the ring's ``sqrt(p)`` variables (reduced modulo sqrt(p)² = p).  ``opaque[name]``
+    is the ring's variable standing for a parameter outside the exact field (its value
+    a :class:`~singcheck.spec.real_constants.RealConstant`, or ``a + b·π`` with b ≠ 0,
+    which cannot stay apart outside sin/cos); without it such a parameter is refused.
     """
     angles = angles or {}
 
@@ -590,7 +622,8 @@ def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmp
     forbidden = {v: f"{v!r} is an angle (it appears inside sin/cos): use it only through "
                     f"sin({v}) and cos({v})" for v in angles}
     compiler = _Compiler(ctx, {**parameters, **variables}, call, what="constraint",
-                         surd=lambda v: surd_polynomial(v, ctx), forbidden=forbidden)
+                         surd=lambda v: surd_polynomial(v, ctx), forbidden=forbidden,
+                         opaque=opaque)
     return reduce_relations(compiler.lift(compiler.run(node), node))
 
 
@@ -608,6 +641,9 @@ def compile_value(node: Node, parameters: dict[str, object]) -> Constant:
             raise ExprError(f"{node.value!r} is not allowed here: use numbers, pi, sqrt and "
                             "parameters defined above", node.column)
         v = parameters[node.value]
+        if isinstance(v, OutsideField):
+            raise ExprError(f"parameter {node.value!r} is not an exact algebraic number",
+                            node.column)
         return v if isinstance(v, Constant) else Constant(Surd.rational(v))
     if k == "call":
         arg = compile_value(node.args[0], parameters)
@@ -656,12 +692,17 @@ def compile_value(node: Node, parameters: dict[str, object]) -> Constant:
         base, e = args
         if e.pi_coefficient or not e.surd.is_rational():
             raise ExprError("exponents must be non-negative integers", node.column)
-        n = _exponent(node.args[1], e.surd.rational_value())
+        exponent = e.surd.rational_value()
+        inverse = exponent < 0 and exponent.denominator == 1  # x^(-n) = 1/x^n
+        n = _exponent(node.args[1], -exponent if inverse else exponent)
         if base.pi_coefficient:
             raise ExprError("powers of pi are not allowed: use a + b*pi", node.column)
         if base.surd.is_rational():
             _check_power(base.surd.rational_value(), n, node)
-        return Constant(_checked(base.surd ** n, node))
+        if inverse and not base.surd:
+            raise ExprError("a negative power of zero", node.column)
+        value = _checked(base.surd ** n, node)
+        return Constant(_checked(value.inverse(), node) if inverse else value)
     raise AssertionError(k)  # pragma: no cover
 
 

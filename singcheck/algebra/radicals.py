@@ -413,9 +413,9 @@ def radical_balls(ctx: fmpq_mpoly_ctx, signs: dict[int, int] | None = None) -> d
     return out
 
 
-def opaque_constants(ctx: fmpq_mpoly_ctx) -> list[tuple[int, str]]:
-    """[(index, name)] for every opaque constant (kind ``K``) of ``ctx``, read once per
-    context."""
+def opaque_constants(ctx: fmpq_mpoly_ctx) -> tuple[tuple[int, str], ...]:
+    """((index, name), …) for every opaque constant (kind ``K``) of ``ctx``, read once
+    per context (asked wherever :func:`radical_balls` is)."""
     hit = _OPAQUE_CONSTANTS.get(id(ctx))
     if hit is None or hit[0] is not ctx:
         out = tuple((i, n) for i, n in enumerate(ctx.names())
@@ -423,7 +423,7 @@ def opaque_constants(ctx: fmpq_mpoly_ctx) -> list[tuple[int, str]]:
         if len(_OPAQUE_CONSTANTS) > 256:
             _OPAQUE_CONSTANTS.clear()
         hit = _OPAQUE_CONSTANTS[id(ctx)] = (ctx, out)
-    return list(hit[1])
+    return hit[1]
 
 
 _OPAQUE_CONSTANTS: dict[int, tuple[fmpq_mpoly_ctx, tuple]] = {}

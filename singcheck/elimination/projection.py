@@ -43,7 +43,6 @@ from singcheck.elimination.requests import (
     norm_chain,
 )
 from singcheck.errors import BackendError, UnsupportedRobotError
-from singcheck.spec.real_constants import exact_engine_refusal
 from singcheck.model.robot import (
     REVOLUTE,
     RobotModel,
@@ -51,6 +50,8 @@ from singcheck.model.robot import (
     leg_discriminant,
     revolute_discriminant,
 )
+from singcheck.spec.grammar import RealLimit
+from singcheck.spec.real_constants import exact_engine_refusal
 
 
 @dataclass(frozen=True)
@@ -199,14 +200,17 @@ def algebraic_limit(leg, value) -> bool:
 
 def exact_angle_limit(value) -> bool:
     """Whether an angle joint's limit has exact (algebraic) cos and sin here: qπ with 12q
-    an integer.  Other limits (0.5 rad) are compared by ball arithmetic alone."""
+    an integer.  Other limits (0.5 rad, ``cos(1/3)``: a RealLimit) are compared by ball
+    arithmetic alone."""
+    if isinstance(value, RealLimit):
+        return False
     return not value.rational and cos_pi(value.pi_coefficient) is not None
 
 
 def angle_limit_values(joint: str, value) -> tuple:
     """``(cos L, sin L)`` as exact surds for an angle joint's limit L = qπ, 12q an
     integer (the limits whose crossings are algebraic)."""
-    if value.rational or cos_pi(value.pi_coefficient) is None:
+    if isinstance(value, RealLimit) or value.rational or cos_pi(value.pi_coefficient) is None:
         raise UnsupportedRobotError(
             f"the limit {value} of angle joint {joint} must be a multiple of pi/12 (e.g. "
             "-pi/2, 2*pi/3) so that its sine and cosine are exact")
@@ -272,11 +276,14 @@ def degenerate_set(model: RobotModel) -> tuple[fmpq_mpoly, ...]:
     where W ≠ 0 the leg's joint is integral over the pose and ξ vanishes exactly on the
     singular modes; a real pose has W = 0 only if the leg does not depend on its angle."""
     pose_ctx = _pose_context(model)
+    over_q = not exact_engine_refusal(model.spec)
     out = []
     for leg in model.legs:
         if leg.kind == REVOLUTE:
             a, b, d = leg_coefficients(leg)
-            out.append(to_pose(model, revolute_discriminant(a, b, d) + d * d, pose_ctx))
+            w = revolute_discriminant(a, b, d) + d * d
+            # (a robot with opaque constants: W in its own ring, only enclosed by balls)
+            out.append(to_pose(model, w, pose_ctx) if over_q else w)
     return tuple(out)
 
 
@@ -448,11 +455,11 @@ def not_projected(model: RobotModel, reason: str) -> RobotProjection:
 
 def refuse_elimination(model: RobotModel, what: str) -> None:
     """An :class:`UnsupportedRobotError` (the spec's ``parameters`` line) when the robot
-    has parameters outside the exact field: ``what`` (an elimination, a region map)
-    cannot be computed for it."""
+    has parameters outside the exact field: ``what`` (an elimination, a region map, the
+    exact engine) cannot be computed for it, and the message says why."""
     refused = exact_engine_refusal(model.spec)
     if refused:
-        raise UnsupportedRobotError(f"{what} is not computed: {refused}",
+        raise UnsupportedRobotError(f"{what}: {refused}",
                                     path=model.spec.path,
                                     line=model.spec.lines.get("parameters"),
                                     key="parameters")

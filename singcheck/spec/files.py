@@ -212,6 +212,22 @@ class _Doc:
             return value.surd.rational_value()
         return RealLimit(value, text)
 
+    def angle_limit(self, node, key: str):
+        """An angle joint's limit: ``a + b·π`` exactly (LinearInPi, as ever), else any
+        finite real (``cos(1/3)`` radians) as a :class:`RealLimit`, compared by ball
+        arithmetic only."""
+        try:
+            return self.expression(node, key, compile_constant)
+        except SpecError as e:
+            first = e
+        text = self.text(node, key)
+        try:
+            return RealLimit(real_constant(parse(text), text, {}), text)
+        except ExprError as e:
+            if "not allowed here" in e.message or "unknown function" in e.message:
+                raise first from None  # (the exact grammar's own message)
+            raise self.error(node, key, f"{e} in {_excerpt(text)}") from None
+
     def value(self, node, key: str, parameters: dict) -> Fraction | Constant | RealConstant:
         """A parameter's value: a Fraction when rational, a Constant in the exact field
         (surds, π), else a :class:`~singcheck.spec.real_constants.RealConstant` (any
@@ -463,8 +479,9 @@ def parse_robot(text: str, path: str) -> RobotSpec:
             if not kind(vnode) == "sequence" or len(vnode.value) != 2:
                 raise doc.error(vnode, key, "expected [min, max]")
             if jname in angles:
-                lo, hi = (doc.expression(v, key, compile_constant) for v in vnode.value)
-                if not exactly_less(lo, hi):
+                lo, hi = (doc.angle_limit(v, key) for v in vnode.value)
+                if not (exactly_less(lo, hi) if not isinstance(lo, RealLimit) and
+                        not isinstance(hi, RealLimit) else _below(lo, hi)):
                     raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
             else:
                 lo, hi = (doc.limit(v, key) for v in vnode.value)
@@ -492,8 +509,8 @@ def _below(lo, hi) -> bool:
 
     from singcheck.algebra.intervals import working_precision
 
-    def ball(v):
-        return v.ball() if isinstance(v, RealLimit) else arb(fmpq(v.numerator, v.denominator))
+    def ball(v):  # (a RealLimit, an angle's LinearInPi, a Fraction)
+        return v.ball() if hasattr(v, "ball") else arb(fmpq(v.numerator, v.denominator))
 
     for bits in (64, 256, 1024):
         with working_precision(bits):

@@ -1,0 +1,278 @@
+"""Parameters and joint limits outside the exact field (issue 27): ``l: 2*cos(1/10)``,
+``rho3: [-cos(1), 4]``.  Each answer is checked against an oracle written here from the
+geometry — the Orthoglide's inverse kinematics ρᵢ = Xᵢ ± √(l² − …) and det A at 50
+digits with mpmath — never against singcheck's own output."""
+
+from __future__ import annotations
+
+import json
+from itertools import product
+from pathlib import Path
+
+import mpmath as mp
+import pytest
+
+from singcheck.api import check, load_robot, load_trajectory
+from singcheck.errors import SpecError
+from tests.conftest import ROBOTS, TRAJECTORIES
+from tests.test_cli import singcheck
+
+ORTHO = (ROBOTS / "orthoglide.yaml").read_text()
+LIMITS = (0, 4)  # the Orthoglide's joint limits (every joint), as the spec writes them
+
+
+def _robot(tmp_path: Path, l_text: str = "2", rho3: str = "[0, 4]",
+           name: str = "ortho") -> str:
+    text = ORTHO.replace("parameters: {l: 2}", f"parameters: {{l: {l_text}}}")
+    text = text.replace("rho3: [0, 4]", f"rho3: {rho3}")
+    path = tmp_path / f"{name}.yaml"
+    path.write_text(text)
+    return str(path)
+
+
+# --- the oracle: the Orthoglide's geometry at 50 digits ---------------------------------
+
+def _heart(which: str):
+    """The pose of trajectories/heart1.yaml or heart2.yaml at t (written out here)."""
+    if which == "heart1":
+        k, a, b, c, d = mp.mpf(8) / 7, mp.mpf(13) / 14, mp.mpf(5) / 14, mp.mpf(1) / 10, \
+            mp.mpf(1) / 14
+    else:
+        k, a, b, c, d = mp.mpf(4) / 5, mp.mpf(13) / 20, mp.mpf(1) / 4, mp.mpf(1) / 20, \
+            mp.mpf(1) / 20
+
+    def pose(t):
+        return (k * mp.sin(t) ** 3,
+                a * mp.cos(t) - b * mp.cos(2 * t) - c * mp.cos(3 * t) - d * mp.cos(4 * t),
+                mp.mpf(1))
+
+    return pose
+
+
+def _joints(L, X, signs):
+    """ρᵢ = Xᵢ + σᵢ·√(L² − Σ_{j≠i} X_j²) (leg i: (Xᵢ − ρᵢ)² + Σ_{j≠i} X_j² = L²), or None
+    where a leg has no real branch."""
+    out = []
+    for i, s in enumerate(signs):
+        d = L * L - sum(X[j] ** 2 for j in range(3) if j != i)
+        if d <= 0:
+            return None
+        out.append(X[i] + s * mp.sqrt(d))
+    return out
+
+
+def _det(L, X, signs):
+    """det A / 8 of the Orthoglide in a mode: A's row i is ∂Fᵢ/∂X / 2, with Xᵢ − ρᵢ in
+    column i."""
+    rho = _joints(L, X, signs)
+    rows = [[X[j] - (rho[i] if i == j else 0) for j in range(3)] for i in range(3)]
+    return mp.det(mp.matrix(rows))
+
+
+MODES = list(product((1, -1), repeat=3))
+
+
+def _label(signs) -> str:
+    return "".join("+" if s > 0 else "-" for s in signs)
+
+
+def _feasible_modes(L, pose, limits, n=1500):
+    """The modes whose joints are real and strictly inside their limits at every point of
+    a grid over [-π, π] (with a margin the grid cannot hide: none of them comes near)."""
+    ts = [-mp.pi + 2 * mp.pi * i / n for i in range(n + 1)]
+    out = []
+    for signs in MODES:
+        ok = True
+        for t in ts:
+            rho = _joints(L, pose(t), signs)
+            if rho is None or not all(lo < r < hi for r, (lo, hi) in zip(rho, limits,
+                                                                       strict=True)):
+                ok = False
+                break
+        if ok:
+            out.append(_label(signs))
+    return out
+
+
+def _roots(f, lo, hi, n=4000):
+    """Every sign change of f on a grid over [lo, hi], refined by mpmath.findroot."""
+    ts = [lo + (hi - lo) * i / n for i in range(n + 1)]
+    values = [f(t) for t in ts]
+    out = []
+    points = list(zip(ts, values, strict=True))
+    for (a, fa), (b, fb) in zip(points, points[1:], strict=False):
+        if mp.sign(fa) * mp.sign(fb) < 0:
+            out.append(mp.findroot(f, (a, b), solver="anderson"))
+    return out, min(abs(v) for v in values)
+
+
+L_COS = "2*cos(1/10)"
+
+
+@pytest.fixture(scope="module")
+def cos_robot(tmp_path_factory):
+    return load_robot(_robot(tmp_path_factory.mktemp("robot"), L_COS), backend="flint",
+                      cache=False)
+
+
+@pytest.mark.parametrize("which", ["heart1", "heart2"])
+def test_a_transcendental_leg_length_is_certified_by_the_interval_engine(cos_robot, which):
+    """l = 2·cos(1/10) ≈ 1.990: the oracle finds the feasible mode and the sign changes
+    of its det A; singcheck must be singular exactly there (each oracle root inside a
+    reported interval, one per root) or free where there are none."""
+    mp.mp.dps = 50
+    L = 2 * mp.cos(mp.mpf(1) / 10)
+    pose = _heart(which)
+    feasible = _feasible_modes(L, pose, [LIMITS] * 3)
+    assert feasible == ["+++"]
+    roots, smallest = _roots(lambda t: _det(L, pose(t), (1, 1, 1)), -mp.pi, mp.pi)
+
+    report = check(cos_robot, load_trajectory(str(TRAJECTORIES / f"{which}.yaml"),
+                                              cos_robot), regions=False).certificate
+    assert [m.label for m in report.modes if m.feasible] == feasible
+    singular = [c for c in report.candidates if c.singular_modes]
+    if which == "heart1":
+        assert len(roots) == 2 and report.verdict == "singular"
+        assert len(singular) == len(roots)
+        for c, root in zip(sorted(singular, key=lambda c: float(c.t.mid())), roots,
+                           strict=True):
+            assert c.singular_modes == ["+++"]
+            lo, hi = float(c.t.lower()), float(c.t.upper())
+            assert lo - 1e-12 <= float(root) <= hi + 1e-12, (root, lo, hi)
+            assert hi - lo < 1e-5
+        # l = 2 puts them elsewhere (0.9778, 1.5119): the answer did read the parameter
+        assert all(abs(float(r) - 0.9778) > 5e-3 and abs(float(r) - 1.5119) > 5e-3
+                   for r in roots)
+    else:
+        assert roots == [] and smallest > mp.mpf("0.01")
+        assert report.verdict == "singularity-free" and singular == []
+    check_ = report.corroboration.to_json()
+    assert check_["engine"] == "interval" and check_["status"] == "exact engine not run"
+    assert "outside the exact field" in check_["detail"]
+
+
+def test_the_json_report_names_the_interval_engine_and_the_missing_projection(tmp_path):
+    robot = _robot(tmp_path, L_COS)
+    out = singcheck("run", robot, str(TRAJECTORIES / "heart1.yaml"), "--format", "json",
+                    "-q")
+    assert out.returncode == 1, out.stderr
+    doc = json.loads(out.stdout)
+    assert doc["backend"] == "none" and doc["singularity_surface_degree"] is None
+    assert doc["elimination_method"].startswith("not computed: the parameter l = 2*cos(1/10)")
+    (traj,) = doc["trajectories"]
+    assert traj["verdict"] == "singular" and "workspace" not in traj
+    assert traj["corroboration"]["engine"] == "interval"
+    proofs = {m["proof"] for c in traj["candidates"] for m in c["modes"]}
+    assert proofs == {"sign change of det A along the mode (ball arithmetic)"}
+    jsonschema = pytest.importorskip("jsonschema")
+    schema = json.loads((Path(__file__).parent.parent / "singcheck" / "schemas" /
+                         "report.schema.json").read_text())
+    assert list(jsonschema.Draft202012Validator(schema).iter_errors(doc)) == []
+
+
+@pytest.mark.parametrize("text", ["pi/2 + 1", "sqrt(1 + sqrt(2))", "cos(1)^(-1) + 1/2"])
+def test_other_finite_reals_are_accepted_and_enclosed(tmp_path, text):
+    """π outside sin/cos, nested square roots, a negative power: each is a finite real;
+    the constraint's constant is the value's ball (checked against mpmath)."""
+    from singcheck.algebra.radicals import radical_balls
+
+    mp.mp.dps = 50
+    expected = {"pi/2 + 1": mp.pi / 2 + 1, "sqrt(1 + sqrt(2))": mp.sqrt(1 + mp.sqrt(2)),
+                "cos(1)^(-1) + 1/2": 1 / mp.cos(1) + mp.mpf(1) / 2}[text]
+    robot = load_robot(_robot(tmp_path, text), backend="flint", cache=False)
+    (ball,) = radical_balls(robot.spec.context).values()
+    assert ball.rad() < 1e-15 and abs(float(ball.mid()) - float(expected)) < 1e-14
+    report = check(robot, load_trajectory(str(TRAJECTORIES / "helix.yaml"), robot),
+                   regions=False)
+    assert report.verdict in ("singularity-free", "singular", "infeasible")
+
+
+@pytest.mark.parametrize("l_text", ["2", L_COS])
+@pytest.mark.parametrize("lower, feasible", [("-cos(1)", False), ("-3*cos(1)", True)])
+def test_a_transcendental_joint_limit_decides_a_mode(tmp_path, l_text, lower, feasible):
+    """rho3 ≥ -cos(1) ≈ -0.5403: mode ++- starts at ρ3 ≈ -0.54 below it (infeasible);
+    rho3 ≥ -3·cos(1) ≈ -1.62: ρ3 = 1 − √(l² − x² − y²) ≥ 1 − l > -1.62 all along, and
+    below 4 (feasible).  The oracle computes the joints itself."""
+    mp.mp.dps = 50
+    L = 2 * mp.cos(mp.mpf(1) / 10) if l_text == L_COS else mp.mpf(2)
+    bound = -mp.cos(1) * (3 if feasible else 1)
+    pose = _heart("heart1")
+    rho3 = _joints(L, pose(-mp.pi), (1, 1, -1))[2]
+    assert (rho3 > bound) is feasible and abs(rho3 - bound) > mp.mpf("0.002")
+    oracle = _feasible_modes(L, pose, [LIMITS, LIMITS, (bound, 4)], n=600)
+    assert ("++-" in oracle) is feasible and "+++" in oracle
+
+    robot = load_robot(_robot(tmp_path, l_text, f"[{lower}, 4]"), backend="flint",
+                       cache=False)
+    report = check(robot, load_trajectory(str(TRAJECTORIES / "heart1.yaml"), robot),
+                   regions=False).certificate
+    modes = {m.label: m for m in report.modes}
+    assert sorted(label for label, m in modes.items() if m.feasible) == sorted(oracle)
+    if not feasible:
+        assert f"rho3 is outside [{lower}, 4] from the start" in modes["++-"].reason
+    assert report.verdict == "singular"  # +++ crosses its singularity either way
+
+
+BAD = [
+    ("sqrt(1 - 2*cos(1/10))", "parameters.l", "sqrt of a negative number is not real"),
+    ("1/(cos(1) - cos(1))", "parameters.l", "not proven non-zero"),
+    ("1/(3 - 3)", "parameters.l", "division by zero"),
+    ("(sin(1/2) - sin(1/2))^(-1)", "parameters.l", "not proven non-zero"),
+    ("cos(1)^(1/2)", "parameters.l", "exponents must be integers"),
+    ("exp(1)", "parameters.l", "unknown function 'exp'"),
+]
+
+
+@pytest.mark.parametrize("text, key, phrase", BAD, ids=[b[2] for b in BAD])
+def test_values_that_are_not_finite_reals_are_refused_with_file_and_line(tmp_path, text,
+                                                                         key, phrase):
+    robot = _robot(tmp_path, text)
+    with pytest.raises(SpecError) as err:
+        load_robot(robot, backend="flint", cache=False)
+    assert err.value.line == 7 and err.value.key == key and phrase in err.value.message
+    out = singcheck("run", robot, str(TRAJECTORIES / "heart1.yaml"), "-q")
+    assert out.returncode == 2 and f"{robot}:7: {key}:" in out.stderr
+    assert phrase in out.stderr and "Traceback" not in out.stderr
+
+
+def test_a_limit_that_is_not_real_is_refused(tmp_path):
+    robot = _robot(tmp_path, rho3="[0, sqrt(cos(2))]")
+    out = singcheck("run", robot, str(TRAJECTORIES / "heart1.yaml"), "-q")
+    assert out.returncode == 2 and f"{robot}:12: joint_limits.rho3:" in out.stderr
+    assert "not real" in out.stderr
+
+
+def test_the_exact_engine_refuses_such_a_robot_and_auto_answers(tmp_path):
+    robot = _robot(tmp_path, L_COS)
+    heart = str(TRAJECTORIES / "heart2.yaml")
+    out = singcheck("run", robot, heart, "--engine", "exact", "-q")
+    assert out.returncode == 2, out.stderr
+    line = [x for x in out.stderr.splitlines() if "error" in x]
+    assert len(line) == 1 and f"{robot}:7: parameters:" in line[0]
+    assert "--engine exact cannot certify this robot" in line[0]
+    assert "l = 2*cos(1/10)" in line[0] and "outside the exact field" in line[0]
+    for engine in ("auto", "interval"):
+        out = singcheck("run", robot, heart, "--engine", engine, "-q")
+        assert out.returncode == 0, out.stderr  # free (the oracle above says so)
+    for command in (["workspace", robot], ["project", robot]):
+        out = singcheck(*command, "-q") if command[0] == "workspace" else singcheck(*command)
+        assert out.returncode == 2 and f"{robot}:7: parameters:" in out.stderr
+        assert "Traceback" not in out.stderr
+
+
+def test_the_exact_field_keeps_the_exact_path(tmp_path):
+    """l = 2 (the bundled spec) and a limit 2*sqrt(2) stay in the field: the projection
+    is computed and the exact engine decides (its proof is the elimination's)."""
+    robot = _robot(tmp_path, "4/2", "[0, 2*sqrt(2) + 1]")
+    out = singcheck("run", robot, str(TRAJECTORIES / "heart1.yaml"), "--format", "json",
+                    "--backend", "flint", "--no-regions", "-q")
+    assert out.returncode == 1, out.stderr
+    doc = json.loads(out.stdout)
+    assert doc["singularity_surface_degree"] == 16
+    assert not doc["elimination_method"].startswith("not computed")
+    (traj,) = doc["trajectories"]
+    assert traj["root_isolation"] == "tangent half-angle"  # μ's roots, isolated exactly
+    assert "elimination" in {m["proof"] for c in traj["candidates"] for m in c["modes"]}
+    assert traj["corroboration"]["status"] == "confirmed"
+    spec = load_robot(robot, backend="flint", cache=False).spec
+    assert spec.context.names() == ("rho1", "rho2", "rho3", "x", "y", "z")

@@ -324,8 +324,10 @@ class OutsideField:
 @dataclass(frozen=True)
 class RealLimit:
     """A prismatic joint's limit that is not rational (``2*sqrt(2)``, ``pi``): an exact
-    real ``surd + pi_coefficient·π``, compared by ball arithmetic only (its crossings are
-    never isolated exactly; :mod:`singcheck.certify.working_modes`)."""
+    real ``surd + pi_coefficient·π``, or any other finite real (``3*cos(1/3) + 1``, also
+    an angle joint's: a :class:`~singcheck.spec.real_constants.RealConstant`), compared
+    by ball arithmetic only (its crossings are never isolated exactly;
+    :mod:`singcheck.certify.working_modes`)."""
 
     value: Constant  # or a RealConstant (:mod:`singcheck.spec.real_constants`)
     text: str

@@ -66,15 +66,25 @@ class RealConstant(OutsideField):
 
     def ball(self) -> arb:
         """An enclosure of the value at the working precision (at least ``bits``: the
-        precision its proof needed, so the ball is always finite)."""
+        precision its proof needed, so the ball is always finite); computed once per
+        precision (the interval engine reads it at every evaluation of det A)."""
         prec = ctx.prec
+        key = (id(self), prec)
+        hit = _BALLS.get(key)
+        if hit is not None and hit[0] is self:  # (the entry holds self: id not reused)
+            return hit[1]
         if prec >= self.bits:
-            return _enclose(self.tree, dict(self.constants))
-        ctx.prec = self.bits
-        try:
-            return _enclose(self.tree, dict(self.constants))
-        finally:
-            ctx.prec = prec
+            ball = _enclose(self.tree, dict(self.constants))
+        else:
+            ctx.prec = self.bits
+            try:
+                ball = _enclose(self.tree, dict(self.constants))
+            finally:
+                ctx.prec = prec
+        if len(_BALLS) > 256:
+            _BALLS.clear()
+        _BALLS[key] = (self, ball)
+        return ball
 
     def __float__(self) -> float:  # display only (tables, drawings): never a verdict
         return float(self.ball().mid())
@@ -83,6 +93,10 @@ class RealConstant(OutsideField):
         if not self.constants:
             return self.text
         return f"{self.text} | " + ", ".join(f"{k}={v}" for k, v in self.constants)
+
+
+#: (id of a RealConstant, precision) -> (the constant, its ball)
+_BALLS: dict[tuple[int, int], tuple[RealConstant, arb]] = {}
 
 
 def _enclose(node: Node, constants: dict) -> arb:

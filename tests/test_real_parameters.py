@@ -276,3 +276,99 @@ def test_the_exact_field_keeps_the_exact_path(tmp_path):
     assert traj["corroboration"]["status"] == "confirmed"
     spec = load_robot(robot, backend="flint", cache=False).spec
     assert spec.context.names() == ("rho1", "rho2", "rho3", "x", "y", "z")
+
+
+# --- a revolute robot, a path naming the parameter, an undecided graze -----------------
+
+def _five_bar_oracle(l1):
+    """The 5-bar (RR-RRR) with proximal links l1, written here from its geometry: bases
+    (∓1, 0), distal links 2; each leg a·cos θ + b·sin θ + c = 0; det A ∝ det(P − B1,
+    P − B2) with Bᵢ the elbows."""
+    from tests import robot_oracles as oracles
+
+    bases, l2 = ((-1, 0), (1, 0)), 2
+
+    def abc(i):
+        ax, ay = bases[i]
+
+        def f(X):
+            px, py = X[0] - ax, X[1] - ay
+            return -2 * l1 * px, -2 * l1 * py, px * px + py * py + l1 * l1 - l2 * l2
+
+        return f
+
+    def det_A(q, X):
+        u = [[X[0] - bases[i][0] - l1 * mp.cos(q[i]), X[1] - bases[i][1] - l1 * mp.sin(q[i])]
+             for i in range(2)]
+        return u[0][0] * u[1][1] - u[0][1] * u[1][0]
+
+    legs = (oracles.revolute_leg("th1", abc(0), mp.pi / 3, mp.pi),
+            oracles.revolute_leg("th2", abc(1), mp.mpf(0), 2 * mp.pi / 3))
+    return oracles.Oracle("five-bar", ("x", "y"), legs, det_A)
+
+
+@pytest.mark.parametrize("name, pose", [
+    ("five-bar-cross", lambda t: [mp.mpf(0), 3 - 2 * t]),
+    ("five-bar-free", lambda t: [-1 + 2 * t, mp.mpf(5) / 2]),
+])
+def test_a_revolute_robot_with_a_real_link_length(tmp_path, name, pose):
+    """l1 = 2·cos(1/20): the oracle's feasible modes and singular times (IK in closed
+    form, det A at 50 digits, bisection) are the interval engine's."""
+    from tests import robot_oracles as oracles
+
+    mp.mp.dps = 50
+    l1 = 2 * mp.cos(mp.mpf(1) / 20)
+    path = oracles.Path(name, lambda: _five_bar_oracle(l1), 0, 1, pose, None)
+    truth = oracles.solve(path)
+    robot_file = tmp_path / "five-bar.yaml"
+    robot_file.write_text((ROBOTS / "five-bar.yaml").read_text().replace(
+        "l1: 2,", "l1: 2*cos(1/20),"))
+    robot = load_robot(str(robot_file), backend="flint", cache=False)
+    assert "l1" in str(robot.spec.context.names())  # an opaque constant of the ring
+    report = check(robot, load_trajectory(str(TRAJECTORIES / f"{name}.yaml"), robot),
+                   regions=False)
+    assert report.verdict == truth.verdict == ("singular" if "cross" in name
+                                               else "singularity-free")
+    feasible = [m for m in report.working_modes if m.feasible]
+    assert len(feasible) == len(truth.feasible) == 1
+    times = sorted(feasible[0].singular_times, key=lambda c: float(c.t.mid()))
+    assert len(times) == len(truth.singular_times)
+    for c, t in zip(times, truth.singular_times, strict=True):
+        assert float(c.t.lower()) - 1e-12 <= float(t) <= float(c.t.upper()) + 1e-12
+    if truth.singular_times:  # l1 = 2 crosses at (3 - √3)/2 ≈ 0.634: this one elsewhere
+        assert abs(float(truth.singular_times[0]) - 0.6339746) > 1e-3
+
+
+def test_a_path_may_name_a_real_parameter(tmp_path, cos_robot):
+    """x = l·cos t/4, y = l·sin t/4 + 1/2, z = 1 (l = 2·cos(1/10)): the oracle's det A
+    along +++ keeps one sign; singcheck proves the path free (a path kept as trees)."""
+    mp.mp.dps = 50
+    L = 2 * mp.cos(mp.mpf(1) / 10)
+
+    def pose(t):
+        return L * mp.cos(t) / 4, L * mp.sin(t) / 4 + mp.mpf(1) / 2, mp.mpf(1)
+
+    roots, smallest = _roots(lambda t: _det(L, pose(t), (1, 1, 1)), 0, 2 * mp.pi, 800)
+    assert roots == [] and smallest > mp.mpf("0.1")
+    doc = tmp_path / "circle.yaml"
+    doc.write_text("name: circle\nparameter: t\nrange: [0, 2*pi]\n"
+                   "pose: {x: l*cos(t)/4, y: l*sin(t)/4 + 1/2, z: 1}\n")
+    report = check(cos_robot, load_trajectory(str(doc), cos_robot), regions=False)
+    assert report.verdict == "singularity-free", report.reason
+
+
+def test_a_graze_is_unknown_with_its_window(tmp_path):
+    """The biglide (det A = 4y(q − p)) with a leg of length 2·cos(1/10) on y = t²: det A
+    touches 0 at t = 0 without changing sign, which balls cannot prove: `unknown`, the
+    window holding t = 0 and its bound, and why the exact engine did not run."""
+    text = (ROBOTS / "biglide.yaml").read_text().replace(
+        "constraints:", "parameters: {a: 2*cos(1/10)}\nconstraints:").replace(
+        "(x - p)^2 + y^2 - 4", "(x - p)^2 + y^2 - a^2")
+    (tmp_path / "biglide.yaml").write_text(text)
+    robot = load_robot(str(tmp_path / "biglide.yaml"), backend="flint", cache=False)
+    report = check(robot, load_trajectory(str(TRAJECTORIES / "biglide-graze.yaml"), robot),
+                   regions=False)
+    assert report.verdict == "unknown"
+    assert "|det A| ≤" in report.reason and "outside the exact field" in report.reason
+    windows = report.certificate.undecided
+    assert windows and all(float(t.lower()) <= 0 <= float(t.upper()) for t, _ in windows)

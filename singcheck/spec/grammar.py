@@ -454,7 +454,9 @@ class _Compiler:
             arg = _simplify(self.run(node.args[0]))
             q = _constant_of(arg)
             if q is None:
-                raise ExprError("sqrt takes a rational constant (e.g. sqrt(3), sqrt(3/4))",
+                raise ExprError("sqrt takes a rational constant (e.g. sqrt(3), sqrt(3/4))" +
+                                ("; of a parameter outside the exact field, define it as a "
+                                 "parameter (m: sqrt(l))" if self.opaque else ""),
                                 node.column)
             if q < 0:
                 raise ExprError("sqrt of a negative number is not real", node.column)

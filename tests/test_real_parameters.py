@@ -372,3 +372,26 @@ def test_a_graze_is_unknown_with_its_window(tmp_path):
     assert "|det A| ≤" in report.reason and "outside the exact field" in report.reason
     windows = report.certificate.undecided
     assert windows and all(float(t.lower()) <= 0 <= float(t.upper()) for t, _ in windows)
+
+
+def test_a_batch_on_two_workers_reads_the_real_parameter(tmp_path):
+    """The opaque constant's function travels to each worker with the robot's ring
+    (algebra/pickling): four paths on two workers, each verdict the one the oracle
+    tests above prove (heart 1 singular, heart 2 free), every line naming the interval
+    engine."""
+    robot = _robot(tmp_path, L_COS)
+    paths = [str(TRAJECTORIES / f"{n}.yaml") for n in ("heart1", "heart2", "heart1",
+                                                       "heart2")]
+    copies = []
+    for i, p in enumerate(paths):  # (names must be unique in a batch)
+        text = Path(p).read_text().replace("name: heart", f"name: h{i}-heart")
+        copies.append(tmp_path / f"p{i}.yaml")
+        copies[-1].write_text(text)
+    out = singcheck("run", robot, *map(str, copies), "--format", "jsonl", "--jobs", "2",
+                    "-q")
+    assert out.returncode == 1, out.stderr
+    lines = {d["name"]: d for d in map(json.loads, out.stdout.splitlines())}
+    assert {k: d["verdict"] for k, d in lines.items()} == {
+        "h0-heart1": "singular", "h1-heart2": "singularity-free",
+        "h2-heart1": "singular", "h3-heart2": "singularity-free"}
+    assert all(d["corroboration"]["engine"] == "interval" for d in lines.values())

@@ -395,3 +395,70 @@ def test_a_batch_on_two_workers_reads_the_real_parameter(tmp_path):
         "h0-heart1": "singular", "h1-heart2": "singularity-free",
         "h2-heart1": "singular", "h3-heart2": "singularity-free"}
     assert all(d["corroboration"]["engine"] == "interval" for d in lines.values())
+
+
+def _rpr_oracle(a):
+    """The 3-RPR (bases (0,0), (5,0), (1,4)) with its second platform point at angle a
+    from the x axis, (cos a, sin a), instead of (1, 0): written from the geometry, F_i =
+    |P + R(φ)bᵢ − Aᵢ|² − rᵢ², det A from the gradients in (x, y, φ)."""
+    from tests import robot_oracles as oracles
+
+    bases = ((0, 0), (5, 0), (1, 4))
+    platform = ((mp.mpf(0), mp.mpf(0)), (mp.cos(a), mp.sin(a)), (mp.mpf(0), mp.mpf(1)))
+
+    def parts(i, X):
+        c, s = mp.cos(X[2]), mp.sin(X[2])
+        bx, by = platform[i]
+        rb = (c * bx - s * by, s * bx + c * by)
+        drb = (-s * bx - c * by, c * bx - s * by)  # d(R b)/dφ
+        return (X[0] + rb[0] - bases[i][0], X[1] + rb[1] - bases[i][1]), drb
+
+    def abc(i):
+        def f(X):  # -r² + |u|² = 0
+            u, _ = parts(i, X)
+            return -1, 0, u[0] ** 2 + u[1] ** 2
+
+        return f
+
+    def det_A(q, X):
+        rows = []
+        for i in range(3):
+            u, drb = parts(i, X)
+            rows.append([u[0], u[1], u[0] * drb[0] + u[1] * drb[1]])
+        return oracles.det(rows)
+
+    legs = tuple(oracles.quadratic_leg(f"r{i + 1}", abc(i), mp.mpf(1) / 2, 5)
+                 for i in range(3))
+    return oracles.Oracle("3-rpr", ("x", "y", "phi"), legs, det_A)
+
+
+@pytest.mark.parametrize("name, pose", [
+    ("3-rpr-cross", lambda t: [2 + mp.cos(t), 2 + mp.sin(t), t]),
+    ("3-rpr-free", lambda t: [3 - mp.cos(t), mp.mpf(1) / 2 + mp.sin(t), t]),
+])
+def test_an_angle_plus_a_real_offset_in_a_constraint(tmp_path, name, pose):
+    """cos(phi + a), sin(phi + a) with a = 1/3 rad (not a multiple of π/12): cos a and
+    sin a are opaque constants and the call is expanded around them; the verdict and
+    singular times are the oracle's (the offset moves the crossing from 0.119)."""
+    from tests import robot_oracles as oracles
+
+    mp.mp.dps = 50
+    path = oracles.Path(name, lambda: _rpr_oracle(mp.mpf(1) / 3), 0, 1, pose, None)
+    truth = oracles.solve(path)
+    text = (ROBOTS / "3-rpr.yaml").read_text().replace(
+        "(x + cos(phi) - 5)^2 + (y + sin(phi))^2", "(x + cos(phi + a) - 5)^2 + "
+        "(y + sin(phi + a))^2").replace("constraints:", "parameters: {a: 1/3}\nconstraints:")
+    (tmp_path / "rpr.yaml").write_text(text)
+    robot = load_robot(str(tmp_path / "rpr.yaml"), backend="flint", cache=False)
+    assert "K[[cos(1/3)]]" in robot.spec.context.names()
+    report = check(robot, load_trajectory(str(TRAJECTORIES / f"{name}.yaml"), robot),
+                   regions=False)
+    assert report.verdict == truth.verdict == ("singular" if "cross" in name
+                                               else "singularity-free")
+    feasible = [m for m in report.working_modes if m.feasible]
+    assert len(feasible) == len(truth.feasible) == 1
+    times = sorted(feasible[0].singular_times, key=lambda c: float(c.t.mid()))
+    assert len(times) == len(truth.singular_times)
+    for c, t in zip(times, truth.singular_times, strict=True):
+        assert float(c.t.lower()) - 1e-12 <= float(t) <= float(c.t.upper()) + 1e-12
+        assert abs(float(t) - 0.119047) > 1e-2

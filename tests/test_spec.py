@@ -98,8 +98,8 @@ BAD_ROBOTS = [
     # (text, line, key, phrase)
     (ROBOT.replace("(x - p)^2", "(x - w)^2"), 6, "constraints[0]", "undeclared name 'w'"),
     (ROBOT.replace("(x - p)^2", "sin(x*p)"), 6, "constraints[0]", "integer combination"),
-    (ROBOT.replace("(x - p)^2", "sin(x + 1)"), 6, "constraints[0]", "integer combination"),
-    (ROBOT.replace("(x - p)^2", "cos(x + pi/5)"), 6, "constraints[0]", "multiples of pi/12"),
+    # (sin(x + 1), cos(x + pi/5): an angle plus a real offset, accepted since issue 27)
+    (ROBOT.replace("(x - p)^2", "sin(x/2 + 1)"), 6, "constraints[0]", "integer combination"),
     (ROBOT.replace("(x - p)^2", "cos(p) + p"), 6, "constraints[0]", "is an angle"),
     (ROBOT.replace("(x - p)^2", "sqrt(x)"), 6, "constraints[0]", "sqrt takes a rational"),
     (ROBOT.replace("(x - p)^2", "sqrt(-2)"), 6, "constraints[0]", "not real"),
@@ -114,7 +114,7 @@ BAD_ROBOTS = [
     (ROBOT.replace("{l: 2}", "{l: cos(1)^(1/2)}"), 4, "parameters.l", "must be integers"),
     (ROBOT.replace("{l: 2}", "{l: tan(1)}"), 4, "parameters.l", "unknown function 'tan'"),
     (ROBOT.replace("{p: [0, 4]}", "{p: [0, sqrt(cos(2))]}"), 8, "joint_limits.p", "not real"),
-    (ROBOT.replace("{l: 2}", "{l: 2, a: cos(1)}").replace("(x - p)^2", "cos(x + a)"), 6,
+    (ROBOT.replace("{l: 2}", "{l: 2, a: cos(1)}").replace("(x - p)^2", "cos(a*x)"), 6,
      "constraints[0]", "not an exact algebraic number"),
     (ROBOT.replace("(x - p)^2", "(x - p)/y"), 6, "constraints[0]", "division by a non-constant"),
     (ROBOT.replace("(x - p)^2", "(x - p)^-2"), 6, "constraints[0]", "non-negative integers"),

@@ -36,6 +36,7 @@ from singcheck.spec.plainyaml import compose_all as compose_plain
 from singcheck.spec.plainyaml import kind
 from singcheck.spec.real_constants import (
     RealConstant,
+    angle_offsets,
     opaque_parameter,
     outside_field,
     real_constant,
@@ -439,25 +440,31 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     # a parameter outside the exact field is an opaque constant: a variable of the ring
     # after the square roots, enclosed by balls (:mod:`singcheck.spec.real_constants`)
     outside = {p: opaque_parameter(p, v) for p, v in parameters.items() if outside_field(v)}
+    # sin/cos of an angle plus such a constant (cos(th1 + a), a: 0.1): cos a, sin a are
+    # opaque constants too, and the call is expanded exactly around them
+    offsets = angle_offsets(trees, angles, parameters) if angles else {}
+    offset_names = [n for _, c, s in offsets.values() for n in (c, s)]
     wide = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in primes),
-                               *outside.values()), "lex")
+                               *dict.fromkeys([*outside.values(), *offset_names])), "lex")
     gens = dict(zip(wide.names(), wide.gens(), strict=True))
     variables = {v: gens[v] for v in joints + pose if v not in angles}
     pairs = {v: tuple(gens[n] for n in angle_names(v)) for v in angles}
     opaque = {p: gens[n] for p, n in outside.items()} or None
+    calls = {node: (k, gens[c], gens[s]) for node, (k, c, s) in offsets.items()} or None
     compiled, constraint_lines = [], []
     for i, item in enumerate(cnode.value):
         key = f"constraints[{i}]"
         poly = doc.expression(item, key, lambda n: compile_polynomial(n, wide, variables,
                                                                       parameters, pairs,
-                                                                      opaque))
+                                                                      opaque, calls))
         if poly.is_zero():
             raise doc.error(item, key, "is identically zero")
         compiled.append(poly)
         constraint_lines.append(_line(item))
     used = tuple(p for i, p in radical_variables(wide)
                  if any(f.degrees()[i] > 0 for f in compiled))
-    constants = tuple(n for i, n in enumerate(wide.names()) if n in outside.values()
+    constants = tuple(n for i, n in enumerate(wide.names())
+                      if (n in outside.values() or n in offset_names)
                       and any(f.degrees()[i] > 0 for f in compiled))
     ctx = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in used), *constants),
                              "lex")
@@ -492,7 +499,9 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     drawing = _drawing(doc, top["drawing"][1], ctx,
                        {v: final[v] for v in joints + pose if v not in angles}, parameters,
                        {v: tuple(final[n] for n in angle_names(v)) for v in angles},
-                       {p: final[n] for p, n in outside.items() if n in final}) \
+                       {p: final[n] for p, n in outside.items() if n in final},
+                       {node: (k, final[c], final[s]) for node, (k, c, s) in offsets.items()
+                        if c in final and s in final}) \
         if "drawing" in top else ()
     length = _clearance_length(doc, top["clearance"][1]) if "clearance" in top else None
     return RobotSpec(path, name, description, joints, pose, parameters, ctx,
@@ -537,7 +546,7 @@ def _clearance_length(doc: _Doc, node) -> Fraction:
 
 
 def _drawing(doc: _Doc, node, ctx, variables, parameters,
-             angles=None, opaque=None) -> tuple[DrawingBody, ...]:
+             angles=None, opaque=None, offsets=None) -> tuple[DrawingBody, ...]:
     """The ``drawing`` key: ``body: [item, ...]`` where an item is a point ``[e, e(, e)]``
     or a chain of segments ``[[e, e(, e)], [e, e(, e)], ...]`` (two points: one segment),
     every ``e`` a polynomial in the joints, pose and parameters; one dimension, 2 or 3,
@@ -562,7 +571,7 @@ def _drawing(doc: _Doc, node, ctx, variables, parameters,
             raise doc.error(pnode, key, f"more than {MAX_DRAWING_POINTS} points")
         return tuple(doc.expression(
             v, f"{key}[{i}]", lambda n: compile_polynomial(n, ctx, variables, parameters,
-                                                          angles, opaque))
+                                                          angles, opaque, offsets))
             for i, v in enumerate(pnode.value))
 
     for bname, (knode, bnode) in doc.mapping(node, "drawing").items():

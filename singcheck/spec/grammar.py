@@ -567,7 +567,7 @@ def angles_in(node: Node, names) -> set[str]:
 
 
 _ARGUMENT_FORM = ("the argument of sin/cos must be an integer combination of angles plus a "
-                  "multiple of pi/12 (e.g. cos(2*theta + pi/3))")
+                  "constant (e.g. cos(2*theta + pi/3), sin(theta + a))")
 
 
 def _linear_argument(node: Node, angles, parameters) -> tuple[dict[str, int], Fraction]:
@@ -599,10 +599,44 @@ def _linear_argument(node: Node, angles, parameters) -> tuple[dict[str, int], Fr
     return coefficients, q
 
 
+def angle_offset(node: Node, angles, parameters) -> tuple[dict[str, int], str] | None:
+    """``({angle: k}, c)`` when a sin/cos argument that :func:`_linear_argument` refuses
+    is Σ k·angle + c with integer k and a constant c (``th1 + a``, ``2*phi + 1/3``, with
+    ``a: 2*cos(1/10)`` or ``a: 0.1``): ``c`` written in the grammar (numbers, ``pi``,
+    parameters); None for any other argument.  cos c and sin c are then opaque constants
+    (:mod:`singcheck.spec.real_constants`)."""
+    names = sorted(angles)
+    symbolic = sorted(p for p, v in parameters.items() if not isinstance(v, Fraction))
+    ring = fmpq_mpoly_ctx.get((*names, "pi", *symbolic), "lex")
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    pi = gens.pop("pi")
+    rational = {p: v for p, v in parameters.items() if isinstance(v, Fraction)}
+    try:
+        compiler = _Compiler(ring, {**rational, **gens}, what="sin/cos argument", pi=pi)
+        value = compiler.lift(compiler.run(node), node)
+    except ExprError:
+        return None
+    count = len(names)
+    coefficients: dict[str, int] = {}
+    rest = {}
+    for exps, coeff in value.terms():
+        if any(exps[:count]):
+            if sum(exps[:count]) != 1 or any(exps[count:]) or coeff.q != 1:
+                return None  # not linear in the angles with integer multiples
+            coefficients[names[list(exps[:count]).index(1)]] = int(coeff.p)
+        else:
+            rest[exps[count:]] = coeff
+    if not rest or sum(abs(k) for k in coefficients.values()) > MAX_EXPONENT:
+        return None
+    constant = fmpq_mpoly_ctx.get(("pi", *symbolic), "lex").from_dict(rest)
+    return coefficients, str(constant)
+
+
 def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmpq_mpoly],
                        parameters: dict[str, object],
                        angles: dict[str, tuple[fmpq_mpoly, fmpq_mpoly]] | None = None,
-                       opaque: dict[str, fmpq_mpoly] | None = None) -> fmpq_mpoly:
+                       opaque: dict[str, fmpq_mpoly] | None = None,
+                       offsets: dict | None = None) -> fmpq_mpoly:
     """The exact polynomial of ``node`` in ``ctx`` (parameters substituted).
 
     ``angles[v] = (cos(v), sin(v))`` are the ring's variables of each angle v: ``sin`` and
@@ -612,13 +646,23 @@ def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmp
     is the ring's variable standing for a parameter outside the exact field (its value
     a :class:`~singcheck.spec.real_constants.RealConstant`, or ``a + b·π`` with b ≠ 0,
     which cannot stay apart outside sin/cos); without it such a parameter is refused.
+    ``offsets[call]`` is ``({angle: k}, cos c, sin c)`` for a sin/cos call whose argument
+    is Σ k·angle + c with c outside the exact field (:func:`angle_offset`): cos c and
+    sin c are the ring's variables of those opaque constants, and
+    cos(Σ + c) = cos Σ·cos c − sin Σ·sin c exactly (sin likewise).
     """
     angles = angles or {}
+    offsets = offsets or {}
 
     def constant(value: Surd):
         return compiler.lift(_simplify(value))
 
     def call(n: Node):
+        if n in offsets:
+            coefficients, cos_c, sin_c = offsets[n]
+            c, s = expand_trig(coefficients, Fraction(0), angles, constant)
+            out = c * cos_c - s * sin_c if n.value == "cos" else s * cos_c + c * sin_c
+            return reduce_relations(out)
         coefficients, q = _linear_argument(n.args[0], angles, parameters)
         c, s = expand_trig(coefficients, q, angles, constant)
         return c if n.value == "cos" else s

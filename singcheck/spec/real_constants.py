@@ -259,7 +259,8 @@ class ParameterValue:
 
     @property
     def text(self) -> str:
-        return f"{self.parameter} = {getattr(self.value, 'text', self.value)}"
+        value = str(getattr(self.value, "text", self.value))
+        return value if value == self.parameter else f"{self.parameter} = {value}"
 
     @property
     def constants(self) -> tuple:
@@ -286,6 +287,41 @@ def opaque_parameter(parameter: str, value) -> str:
     return opaque_name("K", ParameterValue(parameter, value))
 
 
+def angle_offsets(trees: list[Node], angles, parameters: dict) -> dict:
+    """{sin/cos call: ({angle: k}, name of cos c, name of sin c)} for each call of the
+    constraint trees whose argument is Σ k·angle + c with a constant c outside the exact
+    field (``cos(th1 + a)`` with ``a: 2*cos(1/10)`` or ``a: 0.1``): cos c and sin c are
+    opaque constants of the robot's ring, proven finite reals like a parameter
+    (:func:`real_constant`).  A call the exact compiler takes is not listed."""
+    from singcheck.spec.grammar import _linear_argument, angle_offset, parse
+
+    out: dict = {}
+
+    def walk(node: Node) -> None:
+        if node.kind == "call" and node.value in ("sin", "cos") and node not in out:
+            try:
+                _linear_argument(node.args[0], angles, parameters)
+            except ExprError:
+                found = angle_offset(node.args[0], angles, parameters)
+                if found is not None:
+                    coefficients, text = found
+                    names = []
+                    for f in ("cos", "sin"):
+                        label = f"{f}({text})"
+                        try:
+                            value = real_constant(parse(label), label, parameters)
+                        except ExprError:
+                            return  # (the compiler then says what is wrong)
+                        names.append(opaque_parameter(label, value))
+                    out[node] = (coefficients, *names)
+        for a in node.args:
+            walk(a)
+
+    for tree in trees:
+        walk(tree)
+    return out
+
+
 def opaque_parameters(spec) -> dict[str, str]:
     """{parameter: its value's text} for each opaque constant of a robot spec's ring (""
     for none): what the report names when it says why the exact engine does not run."""
@@ -305,8 +341,9 @@ def exact_engine_refusal(spec) -> str:
     found = opaque_parameters(spec)
     if not found:
         return ""
-    names = ", ".join(f"{k} = {v}" for k, v in found.items())
-    return (f"the parameter{'s' if len(found) > 1 else ''} {names} "
+    names = ", ".join(k if k == v else f"{k} = {v}" for k, v in found.items())
+    what = "parameter" if all(k != v for k, v in found.items()) else "constant"
+    return (f"the {what}{'s' if len(found) > 1 else ''} {names} "
             f"{'are' if len(found) > 1 else 'is'} outside the exact field (rationals, square "
             "roots, pi, sin/cos of multiples of pi/12), so the robot's polynomials are not "
             "over Q: neither the elimination (singularity surface, regions) nor the exact "

@@ -280,7 +280,7 @@ def test_the_exact_field_keeps_the_exact_path(tmp_path):
 
 # --- a revolute robot, a path naming the parameter, an undecided graze -----------------
 
-def _five_bar_oracle(l1):
+def _five_bar_oracle(l1, lo1=None):
     """The 5-bar (RR-RRR) with proximal links l1, written here from its geometry: bases
     (∓1, 0), distal links 2; each leg a·cos θ + b·sin θ + c = 0; det A ∝ det(P − B1,
     P − B2) with Bᵢ the elbows."""
@@ -302,7 +302,7 @@ def _five_bar_oracle(l1):
              for i in range(2)]
         return u[0][0] * u[1][1] - u[0][1] * u[1][0]
 
-    legs = (oracles.revolute_leg("th1", abc(0), mp.pi / 3, mp.pi),
+    legs = (oracles.revolute_leg("th1", abc(0), mp.pi / 3 if lo1 is None else lo1, mp.pi),
             oracles.revolute_leg("th2", abc(1), mp.mpf(0), 2 * mp.pi / 3))
     return oracles.Oracle("five-bar", ("x", "y"), legs, det_A)
 
@@ -462,3 +462,27 @@ def test_an_angle_plus_a_real_offset_in_a_constraint(tmp_path, name, pose):
     for c, t in zip(times, truth.singular_times, strict=True):
         assert float(c.t.lower()) - 1e-12 <= float(t) <= float(c.t.upper()) + 1e-12
         assert abs(float(t) - 0.119047) > 1e-2
+
+
+@pytest.mark.parametrize("lower, feasible", [("2*cos(1)", True), ("2*cos(1/5)", False)])
+def test_a_real_angle_limit(tmp_path, lower, feasible):
+    """th1 ≥ 2·cos(1) ≈ 1.081 keeps the 5-bar's mode +- on five-bar-cross (its th1
+    stays in [1.908, 2.095], the oracle says); th1 ≥ 2·cos(1/5) ≈ 1.960 cuts it at the
+    start (no mode is left).
+    The robot's parameters stay exact: the exact engine still runs, the limit is
+    compared by balls."""
+    from tests import robot_oracles as oracles
+
+    mp.mp.dps = 50
+    lo1 = 2 * mp.cos(1 if feasible else mp.mpf(1) / 5)
+    path = oracles.Path("five-bar-cross", lambda: _five_bar_oracle(mp.mpf(2), lo1), 0, 1,
+                        lambda t: [mp.mpf(0), 3 - 2 * t], None)
+    truth = oracles.solve(path)
+    (tmp_path / "fb.yaml").write_text((ROBOTS / "five-bar.yaml").read_text().replace(
+        "th1: [pi/3, pi]", f"th1: [{lower}, pi]"))
+    robot = load_robot(str(tmp_path / "fb.yaml"), backend="flint", cache=False)
+    assert robot.projection.expanded  # ξ computed: the parameters are exact
+    report = check(robot, load_trajectory(str(TRAJECTORIES / "five-bar-cross.yaml"), robot),
+                   regions=False)
+    assert report.verdict == truth.verdict == ("singular" if feasible else "infeasible")
+    assert len([m for m in report.working_modes if m.feasible]) == len(truth.feasible)

@@ -3,7 +3,11 @@
 A path coordinate that is not a polynomial in (t, sin t, cos t) over Q (``cos(t - 1)``:
 :mod:`singcheck.spec.real_paths`) stands in the path ring as one variable whose name is
 registered here with the function that encloses it: ``X[[…]]`` for a coordinate,
-``A[[…]]``/``C[[…]]``/``S[[…]]`` for an angle, its cosine and its sine.  Ball evaluation
+``A[[…]]``/``C[[…]]``/``S[[…]]`` for an angle, its cosine and its sine.  A robot's
+parameter whose value is outside the exact field (``l: 2*cos(1/10)``:
+:mod:`singcheck.spec.real_constants`) is ``K[[…]]``, a constant: a variable of the
+robot's ring (and of a path ring it is carried into), whose ball is its value's at
+every t.  Ball evaluation
 (:func:`~singcheck.algebra.radicals.evaluate_path`) reads :func:`opaque_ball`; nothing
 exact (μ, root isolation) ever takes such a ring (:func:`is_opaque` says so).
 
@@ -39,6 +43,18 @@ def register_opaque(name: str, f, kind: str) -> None:
 def opaque_of(name: str) -> tuple[object, str] | None:
     """(function, kind) of an opaque variable's name, None for any other name."""
     return _OPAQUE.get(name) if name.endswith(CLOSE) else None
+
+
+def is_opaque_constant(name: str) -> bool:
+    """Whether ``name`` is a robot's opaque constant (``K[[…]]``)."""
+    hit = opaque_of(name)
+    return hit is not None and hit[1] == "K"
+
+
+def has_opaque_coordinates(ctx) -> bool:
+    """Whether a ring has opaque variables that vary with t (coordinates kept as
+    expression trees; a robot's opaque constants ``K[[…]]`` do not count)."""
+    return any(n.endswith(CLOSE) and not n.startswith("K" + OPEN) for n in ctx.names())
 
 
 def is_opaque(ctx) -> bool:

@@ -34,7 +34,7 @@ from fractions import Fraction
 from flint import arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
 
 from singcheck.algebra.intervals import power
-from singcheck.algebra.opaque import is_opaque, opaque_ball, opaque_of
+from singcheck.algebra.opaque import has_opaque_coordinates, is_opaque, opaque_ball, opaque_of
 from singcheck.algebra.trig import TRIG, evaluate_trig, evaluate_trig_at
 
 MAX_RADICAND_BITS = 64
@@ -398,12 +398,35 @@ def norm_radicals(p: fmpq_mpoly) -> fmpq_mpoly:
 
 
 def radical_balls(ctx: fmpq_mpoly_ctx, signs: dict[int, int] | None = None) -> dict[int, arb]:
-    """index → ball of ±√q for every radical variable (``signs``: prime → ±1)."""
+    """index → ball of ±√q for every radical variable (``signs``: prime → ±1), and of
+    every opaque constant of a robot's ring (a parameter outside the exact field,
+    :mod:`singcheck.spec.real_constants`: its value's ball).  A robot's ring puts them
+    after the joints and the pose, so the sorted balls complete a point of the ring."""
     variables = radical_variables(ctx)
-    if not variables:
+    constants = opaque_constants(ctx)
+    if not variables and not constants:
         return {}
     signs = signs or {}
-    return {i: arb(q).sqrt() * signs.get(q, 1) for i, q in variables}
+    out = {i: arb(q).sqrt() * signs.get(q, 1) for i, q in variables}
+    for i, name in constants:
+        out[i] = opaque_ball(name, arb(0))
+    return out
+
+
+def opaque_constants(ctx: fmpq_mpoly_ctx) -> tuple[tuple[int, str], ...]:
+    """((index, name), …) for every opaque constant (kind ``K``) of ``ctx``, read once
+    per context (asked wherever :func:`radical_balls` is)."""
+    hit = _OPAQUE_CONSTANTS.get(id(ctx))
+    if hit is None or hit[0] is not ctx:
+        out = tuple((i, n) for i, n in enumerate(ctx.names())
+                    if n.startswith("K") and (opaque_of(n) or (None, ""))[1] == "K")
+        if len(_OPAQUE_CONSTANTS) > 256:
+            _OPAQUE_CONSTANTS.clear()
+        hit = _OPAQUE_CONSTANTS[id(ctx)] = (ctx, out)
+    return hit[1]
+
+
+_OPAQUE_CONSTANTS: dict[int, tuple[fmpq_mpoly_ctx, tuple]] = {}
 
 
 def expand_trig(coefficients: dict[str, int], pi_part: Fraction,
@@ -595,7 +618,7 @@ def path_derivative(p: fmpq_mpoly) -> fmpq_mpoly:
     ctx = p.context()
     if ctx is TRIG:
         return derivative(p)
-    if is_opaque(ctx):
+    if has_opaque_coordinates(ctx):  # (an opaque constant's derivative is 0)
         raise ValueError("no derivative of a path given by an expression tree (not "
                          "polynomial in t, sin t, cos t)")
     gens = dict(zip(ctx.names(), ctx.gens(), strict=True))

@@ -35,6 +35,7 @@ from singcheck.algebra.composition import (
     crude_work,
 )
 from singcheck.algebra.intervals import evaluate, fraction_ball, power
+from singcheck.algebra.opaque import has_opaque_coordinates, is_opaque_constant
 from singcheck.algebra.polynomials import (
     coefficient_in,
     constant_value,
@@ -48,6 +49,7 @@ from singcheck.algebra.radicals import (
     evaluate_path,
     into_ring,
     is_opaque,
+    opaque_constants,
     opaque_of,
     path_ring,
     radical_balls,
@@ -86,6 +88,7 @@ from singcheck.model.robot import (
 )
 from singcheck.spec.files import TrajectorySpec
 from singcheck.spec.grammar import MAX_DEGREE
+from singcheck.spec.real_constants import exact_engine_refusal
 
 
 def _reduce(p: fmpq_mpoly) -> fmpq_mpoly:
@@ -176,7 +179,8 @@ def _composition_plan(source, ring, pose: tuple[str, ...]) -> tuple:
     if hit is None or hit[0] is not source or hit[1] is not ring:
         gens = dict(zip(ring.names(), ring.gens(), strict=True))
         plan = tuple(("pose", pose.index(v)) if v in pose else
-                     ("gen", gens[v]) if radical_prime(v) is not None and v in gens else
+                     ("gen", gens[v]) if (radical_prime(v) is not None or
+                                          is_opaque_constant(v)) and v in gens else
                      ("absent", v) for v in source.names())
         if len(_PLANS) > 256:
             _PLANS.clear()
@@ -368,7 +372,7 @@ class LegAlongPath:
         revolute branch is the pair (cos θ, sin θ).  ``tight`` spends more on a wide
         ball (:func:`~singcheck.algebra.trig.evaluate_trig`); ``discriminant``, D's
         enclosure over the same ball (and ``tight``) when the caller has it already."""
-        if self._composer.opaque:  # enclosed from the pose's balls (no composition)
+        if self._composer.balls_only:  # enclosed from the pose's balls (no composition)
             point = self._composer.point(t)
             return _branches_at_point(self._composer.model, self.leg, point)
         if self.leg.kind != REVOLUTE and self.leg.degree == 2:
@@ -385,7 +389,7 @@ class LegAlongPath:
 
     def discriminant_at(self, t: arb, tight: bool = False) -> arb:
         """D's enclosure over the ball ``t`` (from the pose's balls on an opaque path)."""
-        if self._composer.opaque:
+        if self._composer.balls_only:
             return evaluate(_model_discriminant(self.leg), self._composer.point(t))
         return evaluate_path(self.discriminant, t, tight=tight)
 
@@ -693,7 +697,7 @@ class PathModel:
     def leg_branches_at(self, t: arb, variables: list[arb] | None = None) -> list[dict]:
         """Per leg, its branches enclosed over the ball ``t`` (``variables``: the pose
         variables' balls there, when the caller has them)."""
-        if self.legs_from_pose or (self.legs and self.legs[0]._composer.opaque):
+        if self.legs_from_pose or (self.legs and self.legs[0]._composer.balls_only):
             return self.branches_at_pose(variables if variables is not None
                                          else self.pose_variables_at(t))
         return [leg.branches(t) for leg in self.legs]
@@ -1179,7 +1183,10 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec,
         functions += [(n, "sin(" + n[4:]) for n in names if n.startswith("cos(")
                       and angle_function_of(n) is not None
                       and (n, "sin(" + n[4:]) not in functions]
-    ring = path_ring(primes, functions, opaque)
+    # a robot's opaque constants (parameters outside the exact field) are variables of
+    # the path ring too: its legs composed along the path are enclosed, never isolated
+    constants = [name for _, name in opaque_constants(model.context)]
+    ring = path_ring(primes, functions, (*opaque, *constants))
     phi = tuple(into_ring(x, ring) for x in phi)
     coordinates = []
     for v, x in zip(model.pose, phi, strict=True):
@@ -1196,6 +1203,8 @@ def build_path(projection: RobotProjection, trajectory: TrajectorySpec,
         mu = _mu(projection, trajectory, coordinates, where)
     elif engine == INTERVAL:
         refused = "the interval engine alone was asked for (--engine interval)"
+    elif exact_engine_refusal(spec):  # the robot's polynomials are not over Q
+        refused = exact_engine_refusal(spec)
     try:
         legs = _legs_along(model, coordinates)
         degenerate = tuple(compose_pose(w, coordinates, pose_vars)
@@ -1225,6 +1234,11 @@ def _mu(projection: RobotProjection, trajectory: TrajectorySpec,
     """μ(t): ξ(φ(t)) when ξ was expanded, else eliminated along the path; refused (a
     :class:`SpecError` naming the pose) when it, or isolating its roots, is too costly."""
     model = projection.model
+    refused = exact_engine_refusal(model.spec)
+    if refused:  # the robot's polynomials are not over Q: nothing exact to isolate
+        raise UnsupportedRobotError(f"the exact engine cannot certify this robot: {refused} "
+                                    "(use --engine auto or interval)", path=model.spec.path,
+                                    line=model.spec.lines.get("parameters"), key="parameters")
     if trajectory.not_algebraic:
         raise SpecError(f"{trajectory.not_algebraic}: only the interval engine takes it "
                         "(--engine auto or interval)", **where)
@@ -1254,7 +1268,8 @@ def _legs_from_pose(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]) -> b
     """:attr:`PathModel.legs_from_pose`: a robot free of square roots, along coordinates
     that are plain trig polynomials (in t, sin t, cos t alone, even in a path ring with
     more variables: a 5-bar's limit at π/3 brings √3 into it)."""
-    return not model.spec.radicals and all(_in_trig(x) is not None for x in coordinates)
+    return not model.spec.radicals and not is_opaque(model.context) and \
+        all(_in_trig(x) is not None for x in coordinates)
 
 
 def _in_trig(x: fmpq_mpoly) -> fmpq_mpoly | None:
@@ -1275,7 +1290,7 @@ def _legs_along(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
     use them at once, and they are composed now (the same refusal)."""
     composer = _LegComposer(model, coordinates)
     legs = tuple(LegAlongPath(leg, composer) for leg in model.legs)
-    if _legs_from_pose(model, coordinates) or composer.opaque:
+    if _legs_from_pose(model, coordinates) or composer.balls_only:
         composer.check()
     else:
         for leg in legs:
@@ -1296,7 +1311,11 @@ class _LegComposer:
         self.coordinates = coordinates
         self._composed: list[tuple[fmpq_mpoly, fmpq_mpoly]] = []  # (coefficient, image)
         #: a path given by expression trees: its legs are enclosed from the pose's balls
-        self.opaque = any(is_opaque(x.context()) for x in coordinates)
+        self.opaque = any(has_opaque_coordinates(x.context()) for x in coordinates)
+        #: the legs are enclosed from the pose's balls, never composed: on an opaque path,
+        #: and for a robot with opaque constants (parameters outside the exact field,
+        #: :mod:`singcheck.spec.real_constants`: their legs are not over Q)
+        self.balls_only = self.opaque or is_opaque(model.context)
         self._last: tuple = (None, 0, None)  # (t, precision, point)
 
     def point(self, t: arb) -> list:

@@ -387,7 +387,7 @@ def _exact_limits_unavailable(leg: LegAlongPath, limits) -> bool:
     an angle limit is not a multiple of π/12 (its cos and sin are not algebraic)."""
     from singcheck.elimination.projection import exact_angle_limit
 
-    if leg._composer.opaque:  # (read from the path: composing nothing)
+    if leg._composer.balls_only:  # (read from the path: composing nothing)
         return True
     if not leg.revolute:
         return not all(isinstance(v, Fraction) for v in limits)  # 2*sqrt(2), pi

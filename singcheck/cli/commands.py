@@ -13,7 +13,7 @@ import sys
 import click
 
 from singcheck.cli.exitcodes import ExitCode, exit_codes, fail
-from singcheck.errors import SpecError
+from singcheck.errors import SpecError, UnsupportedRobotError
 from singcheck.report.progress import Progress
 from singcheck.version import __version__
 
@@ -364,6 +364,11 @@ def _run(robot, trajectories, backend_name, timeout, no_cache, tolerance, fmt, o
             check_label(machine.model, selection["mode"])
         except SpecError as e:
             raise click.BadParameter(e.message, param_hint="--mode") from None
+    if certify_with == "exact":  # a robot with parameters outside the exact field:
+        # refused before any path (exit 2, the spec's parameters line, why)
+        from singcheck.elimination.projection import refuse_elimination
+
+        refuse_elimination(machine.model, "--engine exact cannot certify this robot")
     projection = machine.projection
     if projection.expanded:
         degree = projection.singularity_surface.total_degree()
@@ -566,8 +571,14 @@ def project(robot, trajectory, backend, as_latex, fmt, no_epsilon, segment) -> N
         from singcheck.elimination.projection import joint_space_singularities
         from singcheck.report.formulas import render
         from singcheck.spec.files import load_robot, load_trajectory
+        from singcheck.spec.real_constants import exact_engine_refusal
 
         spec = load_robot(robot)
+        if exact_engine_refusal(spec):  # nothing over Q to eliminate or write out
+            raise UnsupportedRobotError(
+                f"its formulas (ξ, ε, the workspace boundary) are not computed: "
+                f"{exact_engine_refusal(spec)}", path=spec.path,
+                line=spec.lines.get("parameters"), key="parameters")
         traj = load_trajectory(trajectory, spec) if trajectory else None
         if traj is not None and (traj.segments or segment):
             count = len(traj.pieces)

@@ -119,6 +119,9 @@ def _compute(space: str, robot: str, slices, surfaces: str, no_limits: bool, bac
 
     fixed = _slices(slices)
     model = build_model(load_robot(robot))
+    from singcheck.elimination.projection import refuse_elimination
+
+    refuse_elimination(model, f"the discriminant variety of the {space} cannot be computed")
     engine = elimination_engine(backend, timeout, not no_cache, progress.note)
     axes = model.pose if space == WORKSPACE else model.joints
     check_free_axes(model, space, fixed)  # before the work, not after the projection

@@ -50,6 +50,8 @@ from singcheck.model.robot import (
     leg_discriminant,
     revolute_discriminant,
 )
+from singcheck.spec.grammar import RealLimit
+from singcheck.spec.real_constants import exact_engine_refusal
 
 
 @dataclass(frozen=True)
@@ -198,14 +200,17 @@ def algebraic_limit(leg, value) -> bool:
 
 def exact_angle_limit(value) -> bool:
     """Whether an angle joint's limit has exact (algebraic) cos and sin here: qπ with 12q
-    an integer.  Other limits (0.5 rad) are compared by ball arithmetic alone."""
+    an integer.  Other limits (0.5 rad, ``cos(1/3)``: a RealLimit) are compared by ball
+    arithmetic alone."""
+    if isinstance(value, RealLimit):
+        return False
     return not value.rational and cos_pi(value.pi_coefficient) is not None
 
 
 def angle_limit_values(joint: str, value) -> tuple:
     """``(cos L, sin L)`` as exact surds for an angle joint's limit L = qπ, 12q an
     integer (the limits whose crossings are algebraic)."""
-    if value.rational or cos_pi(value.pi_coefficient) is None:
+    if isinstance(value, RealLimit) or value.rational or cos_pi(value.pi_coefficient) is None:
         raise UnsupportedRobotError(
             f"the limit {value} of angle joint {joint} must be a multiple of pi/12 (e.g. "
             "-pi/2, 2*pi/3) so that its sine and cosine are exact")
@@ -271,11 +276,14 @@ def degenerate_set(model: RobotModel) -> tuple[fmpq_mpoly, ...]:
     where W ≠ 0 the leg's joint is integral over the pose and ξ vanishes exactly on the
     singular modes; a real pose has W = 0 only if the leg does not depend on its angle."""
     pose_ctx = _pose_context(model)
+    over_q = not exact_engine_refusal(model.spec)
     out = []
     for leg in model.legs:
         if leg.kind == REVOLUTE:
             a, b, d = leg_coefficients(leg)
-            out.append(to_pose(model, revolute_discriminant(a, b, d) + d * d, pose_ctx))
+            w = revolute_discriminant(a, b, d) + d * d
+            # (a robot with opaque constants: W in its own ring, only enclosed by balls)
+            out.append(to_pose(model, w, pose_ctx) if over_q else w)
     return tuple(out)
 
 
@@ -383,6 +391,9 @@ def project_robot(model: RobotModel, backend: EliminationBackend,
     legs are dropped from ξ (each backend's closure may keep them or not): a real pose
     there has no real, separated branches of that leg (Δ = W - d² ≤ 0), so no feasible
     mode passes through it."""
+    refused = exact_engine_refusal(model.spec)
+    if refused:  # parameters outside the exact field: nothing over Q to eliminate
+        return not_projected(model, refused)
     pose_ctx = _pose_context(model)
     xi = None
     if model.joint_free_det_A:
@@ -426,6 +437,32 @@ def project_robot(model: RobotModel, backend: EliminationBackend,
         xi = _without_degenerate_factors(raw, degenerate_set(model))
     return RobotProjection(model, pose_ctx, xi, raw, workspace_boundary(model, pose_ctx),
                            joint_limit_surfaces(model, pose_ctx), name, method)
+
+
+#: the projection's ``method`` for a robot whose parameters leave the exact field
+NOT_PROJECTED = "not computed"
+
+
+def not_projected(model: RobotModel, reason: str) -> RobotProjection:
+    """The projection of a robot with opaque constants (parameters outside the exact
+    field, :mod:`singcheck.spec.real_constants`): ξ, the workspace boundary and the
+    joint-limit surfaces are not computed (they would not be polynomials over Q), and
+    ``not_expanded`` says why; the interval engine alone certifies its paths."""
+    pose_ctx = fmpq_mpoly_ctx.get(model.pose_variables, "lex")
+    return RobotProjection(model, pose_ctx, None, None, (), (), "none",
+                           f"{NOT_PROJECTED}: {reason}", reason)
+
+
+def refuse_elimination(model: RobotModel, what: str) -> None:
+    """An :class:`UnsupportedRobotError` (the spec's ``parameters`` line) when the robot
+    has parameters outside the exact field: ``what`` (an elimination, a region map, the
+    exact engine) cannot be computed for it, and the message says why."""
+    refused = exact_engine_refusal(model.spec)
+    if refused:
+        raise UnsupportedRobotError(f"{what}: {refused}",
+                                    path=model.spec.path,
+                                    line=model.spec.lines.get("parameters"),
+                                    key="parameters")
 
 
 def joint_space_singularities(model: RobotModel, backend: EliminationBackend) -> fmpq_mpoly:

@@ -232,6 +232,12 @@ def _legs(spec: RobotSpec) -> tuple[Leg, ...]:
         lead = coefficient_in(f, j, degree)
         if not lead.is_constant():
             value = constant_surd(lead)
+            if value is None and _only_opaque_constants(lead):
+                raise UnsupportedRobotError(
+                    f"the coefficient of {joint}^{degree} involves a parameter outside the "
+                    "exact field; write the constraint with a rational or square-root "
+                    f"coefficient of {joint}^{degree} (divide it out)", path=spec.path,
+                    line=line, key=key)
             if value is None:
                 raise UnsupportedRobotError(
                     f"the coefficient of {joint}^{degree} depends on the pose; singcheck needs "
@@ -242,6 +248,17 @@ def _legs(spec: RobotSpec) -> tuple[Leg, ...]:
             f = reduce_relations(f * surd_polynomial(value.inverse(), spec.context))
         found[joint] = Leg(joint, j, f, index, degree)
     return tuple(found[j] for j in joints)
+
+
+def _only_opaque_constants(p: fmpq_mpoly) -> bool:
+    """Whether ``p`` involves opaque constants (parameters outside the exact field,
+    :mod:`singcheck.spec.real_constants`) and no joint or pose variable."""
+    from singcheck.algebra.opaque import is_opaque_constant
+
+    names = p.context().names()
+    used = [names[i] for i, d in enumerate(p.degrees()) if d > 0]
+    return any(is_opaque_constant(n) for n in used) and \
+        all(is_opaque_constant(n) or n.startswith("sqrt(") for n in used)
 
 
 def _revolute_leg(spec: RobotSpec, joint: str, f: fmpq_mpoly, index: int, line: int,

@@ -115,7 +115,7 @@ def animation_figure(report: TrajectoryReport, d, title: str, samples: int = SAM
                                      marker={"color": _SINGULAR, "size": 10, "symbol": "x"}),
                           row=2, col=2)
         for row, curve in ((1, d.mu), (2, det)):
-            if curve is None:
+            if curve is None or not np.isfinite(curve).any():  # (no μ: interval engine)
                 continue
             lo, hi = float(np.nanmin(curve)), float(np.nanmax(curve))
             xs = [v for t in sing for v in (t, t, None)]

@@ -57,9 +57,13 @@ def numpy_polynomial(poly):
 def named_arrays(ctx, table: dict) -> list:
     """The values of ``ctx``'s variables by name, for :func:`numpy_polynomial`: from
     ``table``, an angle's ``cos(v)``/``sin(v)`` from ``table[v]`` when only the angle is
-    there, a ``sqrt(p)`` as √p, anything else 0 (drawing only)."""
+    there, a ``sqrt(p)`` as √p, a parameter outside the exact field as its value,
+    anything else 0 (drawing only)."""
     import math
 
+    from flint import arb
+
+    from singcheck.algebra.opaque import is_opaque_constant, opaque_ball
     from singcheck.algebra.radicals import radical_prime
 
     out = []
@@ -70,6 +74,8 @@ def named_arrays(ctx, table: dict) -> list:
             out.append((np.cos if name[0] == "c" else np.sin)(table[name[4:-1]]))
         elif radical_prime(name) is not None:
             out.append(math.sqrt(radical_prime(name)))
+        elif is_opaque_constant(name):  # a parameter outside the exact field: its value
+            out.append(float(opaque_ball(name, arb(0)).mid()))
         else:
             out.append(0.0)
     return out

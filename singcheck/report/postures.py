@@ -21,6 +21,7 @@ import numpy as np
 from flint import acb, arb
 
 from singcheck.algebra.intervals import evaluate
+from singcheck.algebra.opaque import is_opaque_constant, opaque_ball
 from singcheck.algebra.radicals import angle_names, radical_prime
 from singcheck.certify.classification import TrajectoryReport
 from singcheck.spec.files import RobotSpec
@@ -53,8 +54,8 @@ def _mid(value) -> float:
 def _values(spec: RobotSpec, joints: list, pose: list) -> list:
     """Balls of the spec's variables, in its context's order, from joint and pose values
     (balls or anything ``arb`` takes; an angle in radians, or a revolute branch's
-    (cos θ, sin θ) pair): an angle's ``cos(v)``, ``sin(v)`` and a parameter's ``sqrt(p)``
-    are enclosed by Arb."""
+    (cos θ, sin θ) pair): an angle's ``cos(v)``, ``sin(v)``, a parameter's ``sqrt(p)``
+    and a parameter outside the exact field (``K[[…]]``) are enclosed by Arb."""
     named = {}
     for n, v in zip((*spec.joints, *spec.pose), (*joints, *pose), strict=True):
         if n in spec.angles:
@@ -62,8 +63,8 @@ def _values(spec: RobotSpec, joints: list, pose: list) -> list:
             named.update(zip(angle_names(n), pair, strict=True))
         else:
             named[n] = v if isinstance(v, (arb, acb)) else arb(v)
-    return [named[n] if n in named else arb(radical_prime(n)).sqrt()
-            for n in spec.context.names()]
+    return [named[n] if n in named else opaque_ball(n, arb(0)) if is_opaque_constant(n)
+            else arb(radical_prime(n)).sqrt() for n in spec.context.names()]
 
 
 def draw_bodies(spec: RobotSpec, joints: list, pose: list) -> list[DrawnBody]:

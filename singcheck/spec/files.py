@@ -24,6 +24,7 @@ from singcheck.spec.grammar import (
     Constant,
     ExprError,
     RealLimit,
+    TooLarge,
     angles_in,
     compile_constant,
     compile_polynomial,
@@ -33,6 +34,13 @@ from singcheck.spec.grammar import (
 from singcheck.spec.paths import CsvFormat, csv_name, multi_piece, parse_csv
 from singcheck.spec.plainyaml import compose_all as compose_plain
 from singcheck.spec.plainyaml import kind
+from singcheck.spec.real_constants import (
+    RealConstant,
+    angle_offsets,
+    opaque_parameter,
+    outside_field,
+    real_constant,
+)
 from singcheck.spec.trajectory import (
     TrajectorySpec,
     exactly_less,
@@ -195,27 +203,61 @@ class _Doc:
         return value.rational
 
     def limit(self, node, key: str) -> Fraction | RealLimit:
-        """A prismatic joint's limit: a Fraction when rational, else any exact real
-        (``2*sqrt(2)``, ``pi``) as a :class:`RealLimit`."""
+        """A prismatic joint's limit: a Fraction when rational, else any finite real
+        (``2*sqrt(2)``, ``pi``, ``3*cos(1/3) + 1``) as a :class:`RealLimit`, compared by
+        ball arithmetic only."""
         text = self.text(node, key)
-        try:
-            value = compile_value(parse(text), {})
-        except (ExprError, ValueError, ZeroDivisionError) as e:
-            raise self.error(node, key, f"{e} in {_excerpt(text)}") from None
-        if not value.pi_coefficient and value.surd.is_rational():
+        value = self._constant(node, key, text, {})
+        if isinstance(value, Constant) and not value.pi_coefficient and \
+                value.surd.is_rational():
             return value.surd.rational_value()
         return RealLimit(value, text)
 
-    def value(self, node, key: str, parameters: dict) -> Fraction | Constant:
-        """A parameter's exact value: a Fraction when rational, else a Constant."""
+    def angle_limit(self, node, key: str):
+        """An angle joint's limit: ``a + b·π`` exactly (LinearInPi, as ever), else any
+        finite real (``cos(1/3)`` radians) as a :class:`RealLimit`, compared by ball
+        arithmetic only."""
+        try:
+            return self.expression(node, key, compile_constant)
+        except SpecError as e:
+            first = e
         text = self.text(node, key)
         try:
-            value = compile_value(parse(text), parameters)
-        except (ExprError, ValueError, ZeroDivisionError) as e:
-            raise self.error(node, key, f"{e} in {text!r}") from None
-        if not value.pi_coefficient and value.surd.is_rational():
+            return RealLimit(real_constant(parse(text), text, {}), text)
+        except ExprError as e:
+            if "not allowed here" in e.message or "unknown function" in e.message:
+                raise first from None  # (the exact grammar's own message)
+            raise self.error(node, key, f"{e} in {_excerpt(text)}") from None
+
+    def value(self, node, key: str, parameters: dict) -> Fraction | Constant | RealConstant:
+        """A parameter's value: a Fraction when rational, a Constant in the exact field
+        (surds, π), else a :class:`~singcheck.spec.real_constants.RealConstant` (any
+        finite real of the grammar, enclosed by balls)."""
+        text = self.text(node, key)
+        value = self._constant(node, key, text, parameters)
+        if isinstance(value, Constant) and not value.pi_coefficient and \
+                value.surd.is_rational():
             return value.surd.rational_value()
         return value
+
+    def _constant(self, node, key: str, text: str, parameters: dict):
+        """The exact Constant of a constant expression when the exact field holds it
+        (the same compiler as ever), else its :class:`RealConstant`, proven a finite
+        real; a located error when it is neither."""
+        try:
+            tree = parse(text)
+        except ExprError as e:
+            raise self.error(node, key, f"{e} in {_excerpt(text)}") from None
+        try:
+            return compile_value(tree, parameters)
+        except TooLarge as e:
+            raise self.error(node, key, f"{e} in {_excerpt(text)}") from None
+        except (ExprError, ValueError, ZeroDivisionError) as e:
+            first = e
+        try:
+            return real_constant(tree, text, parameters)
+        except ExprError as e:
+            raise self.error(node, key, f"{e} in {_excerpt(text)}") from first
 
     def expression(self, node, key: str, compile_, tree=None):
         """``compile_`` of the expression at ``node`` (``tree``: its parse, when the
@@ -395,22 +437,37 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     algebraic = [v for name in joints + pose
                  for v in (angle_names(name) if name in angles else (name,))]
     primes = sorted(radical_primes(parameters, trees))
-    wide = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in primes)), "lex")
+    # a parameter outside the exact field is an opaque constant: a variable of the ring
+    # after the square roots, enclosed by balls (:mod:`singcheck.spec.real_constants`)
+    outside = {p: opaque_parameter(p, v) for p, v in parameters.items() if outside_field(v)}
+    # sin/cos of an angle plus such a constant (cos(th1 + a), a: 0.1): cos a, sin a are
+    # opaque constants too, and the call is expanded exactly around them
+    offsets = angle_offsets(trees, angles, parameters) if angles else {}
+    offset_names = [n for _, c, s in offsets.values() for n in (c, s)]
+    wide = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in primes),
+                               *dict.fromkeys([*outside.values(), *offset_names])), "lex")
     gens = dict(zip(wide.names(), wide.gens(), strict=True))
     variables = {v: gens[v] for v in joints + pose if v not in angles}
     pairs = {v: tuple(gens[n] for n in angle_names(v)) for v in angles}
+    opaque = {p: gens[n] for p, n in outside.items()} or None
+    calls = {node: (k, gens[c], gens[s]) for node, (k, c, s) in offsets.items()} or None
     compiled, constraint_lines = [], []
     for i, item in enumerate(cnode.value):
         key = f"constraints[{i}]"
         poly = doc.expression(item, key, lambda n: compile_polynomial(n, wide, variables,
-                                                                      parameters, pairs))
+                                                                      parameters, pairs,
+                                                                      opaque, calls))
         if poly.is_zero():
             raise doc.error(item, key, "is identically zero")
         compiled.append(poly)
         constraint_lines.append(_line(item))
     used = tuple(p for i, p in radical_variables(wide)
                  if any(f.degrees()[i] > 0 for f in compiled))
-    ctx = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in used)), "lex")
+    constants = tuple(n for i, n in enumerate(wide.names())
+                      if (n in outside.values() or n in offset_names)
+                      and any(f.degrees()[i] > 0 for f in compiled))
+    ctx = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in used), *constants),
+                             "lex")
     constraints = [restrict(f, ctx) for f in compiled]
     if not len(constraints) == len(joints) == len(pose):
         raise doc.error(top["constraints"][0], "constraints",
@@ -429,8 +486,9 @@ def parse_robot(text: str, path: str) -> RobotSpec:
             if not kind(vnode) == "sequence" or len(vnode.value) != 2:
                 raise doc.error(vnode, key, "expected [min, max]")
             if jname in angles:
-                lo, hi = (doc.expression(v, key, compile_constant) for v in vnode.value)
-                if not exactly_less(lo, hi):
+                lo, hi = (doc.angle_limit(v, key) for v in vnode.value)
+                if not (exactly_less(lo, hi) if not isinstance(lo, RealLimit) and
+                        not isinstance(hi, RealLimit) else _below(lo, hi)):
                     raise doc.error(vnode, key, f"min {lo} must be smaller than max {hi}")
             else:
                 lo, hi = (doc.limit(v, key) for v in vnode.value)
@@ -440,7 +498,10 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     final = dict(zip(ctx.names(), ctx.gens(), strict=True))
     drawing = _drawing(doc, top["drawing"][1], ctx,
                        {v: final[v] for v in joints + pose if v not in angles}, parameters,
-                       {v: tuple(final[n] for n in angle_names(v)) for v in angles}) \
+                       {v: tuple(final[n] for n in angle_names(v)) for v in angles},
+                       {p: final[n] for p, n in outside.items() if n in final},
+                       {node: (k, final[c], final[s]) for node, (k, c, s) in offsets.items()
+                        if c in final and s in final}) \
         if "drawing" in top else ()
     length = _clearance_length(doc, top["clearance"][1]) if "clearance" in top else None
     return RobotSpec(path, name, description, joints, pose, parameters, ctx,
@@ -457,8 +518,8 @@ def _below(lo, hi) -> bool:
 
     from singcheck.algebra.intervals import working_precision
 
-    def ball(v):
-        return v.ball() if isinstance(v, RealLimit) else arb(fmpq(v.numerator, v.denominator))
+    def ball(v):  # (a RealLimit, an angle's LinearInPi, a Fraction)
+        return v.ball() if hasattr(v, "ball") else arb(fmpq(v.numerator, v.denominator))
 
     for bits in (64, 256, 1024):
         with working_precision(bits):
@@ -485,7 +546,7 @@ def _clearance_length(doc: _Doc, node) -> Fraction:
 
 
 def _drawing(doc: _Doc, node, ctx, variables, parameters,
-             angles=None) -> tuple[DrawingBody, ...]:
+             angles=None, opaque=None, offsets=None) -> tuple[DrawingBody, ...]:
     """The ``drawing`` key: ``body: [item, ...]`` where an item is a point ``[e, e(, e)]``
     or a chain of segments ``[[e, e(, e)], [e, e(, e)], ...]`` (two points: one segment),
     every ``e`` a polynomial in the joints, pose and parameters; one dimension, 2 or 3,
@@ -510,7 +571,7 @@ def _drawing(doc: _Doc, node, ctx, variables, parameters,
             raise doc.error(pnode, key, f"more than {MAX_DRAWING_POINTS} points")
         return tuple(doc.expression(
             v, f"{key}[{i}]", lambda n: compile_polynomial(n, ctx, variables, parameters,
-                                                          angles))
+                                                          angles, opaque, offsets))
             for i, v in enumerate(pnode.value))
 
     for bname, (knode, bnode) in doc.mapping(node, "drawing").items():

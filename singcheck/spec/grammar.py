@@ -66,6 +66,11 @@ class ExprError(ValueError):
         return self.message + (f" (column {self.column})" if self.column else "")
 
 
+class TooLarge(ExprError):
+    """A number past the grammar's size bounds (MAX_BITS): refused, never taken as a ball
+    (the bound is a budget, not a statement about the field)."""
+
+
 @dataclass(frozen=True)
 class Node:
     kind: str  # num | name | neg | add | sub | mul | div | pow | call
@@ -308,18 +313,30 @@ class Constant:
         return " + ".join(parts)
 
 
+class OutsideField:
+    """A constant outside the exact field (a
+    :class:`~singcheck.spec.real_constants.RealConstant`): the exact compilers refuse it,
+    unless a hook gives them a variable standing for it."""
+
+    text: str
+
+
 @dataclass(frozen=True)
 class RealLimit:
     """A prismatic joint's limit that is not rational (``2*sqrt(2)``, ``pi``): an exact
-    real ``surd + pi_coefficient·π``, compared by ball arithmetic only (its crossings are
-    never isolated exactly; :mod:`singcheck.certify.working_modes`)."""
+    real ``surd + pi_coefficient·π``, or any other finite real (``3*cos(1/3) + 1``, also
+    an angle joint's: a :class:`~singcheck.spec.real_constants.RealConstant`), compared
+    by ball arithmetic only (its crossings are never isolated exactly;
+    :mod:`singcheck.certify.working_modes`)."""
 
-    value: Constant
+    value: Constant  # or a RealConstant (:mod:`singcheck.spec.real_constants`)
     text: str
 
     def ball(self):
         from flint import arb, fmpq
 
+        if not isinstance(self.value, Constant):  # a RealConstant: its own enclosure
+            return self.value.ball()
         out = self.value.surd.ball()
         q = self.value.pi_coefficient
         if q:
@@ -327,6 +344,8 @@ class RealLimit:
         return out
 
     def __float__(self) -> float:
+        if not isinstance(self.value, Constant):
+            return float(self.value)
         return float(self.value.surd) + float(self.value.pi_coefficient) * 3.141592653589793
 
     def __str__(self) -> str:
@@ -368,7 +387,7 @@ class _Compiler:
     """Evaluate a tree over a ring, with hooks for names, calls, square roots and π."""
 
     def __init__(self, ring, names, call=None, what="expression", surd=None, pi=None,
-                 forbidden=None) -> None:
+                 forbidden=None, opaque=None) -> None:
         self.ring = ring
         self.names = names  # name -> ring element, Fraction, Surd or Constant
         self.call = call  # sin/cos hook
@@ -376,6 +395,9 @@ class _Compiler:
         self.surd = surd  # Surd -> ring element (None: square roots not allowed)
         self.pi = pi  # the ring element standing for π (None: π not allowed)
         self.forbidden = forbidden or {}  # name -> why it cannot be used bare
+        #: parameter name -> the ring's variable standing for its value, for a parameter
+        #: outside the exact field (an opaque constant: :mod:`~singcheck.spec.real_constants`)
+        self.opaque = opaque or {}
 
     def const(self, q: Fraction):
         return self.ring.from_dict({(0,) * self.ring.nvars(): fmpq(q.numerator, q.denominator)}) \
@@ -408,6 +430,15 @@ class _Compiler:
             declared = ", ".join(sorted(self.names)) or "none"
             raise ExprError(f"undeclared name {name!r} (declared: {declared})", node.column)
         value = self.names[name]
+        if isinstance(value, Constant) and value.pi_coefficient and self.pi is None and \
+                name in self.opaque:
+            return self.opaque[name]  # π cannot stay apart here: the value's ball is read
+        if isinstance(value, OutsideField):
+            if name in self.opaque:
+                return self.opaque[name]
+            raise ExprError(f"parameter {name!r} is not an exact algebraic number (it is "
+                            f"{value.text!r}): only the robot's constraints can use it "
+                            "outside sin/cos", node.column)
         if isinstance(value, Constant):
             if value.pi_coefficient:
                 if self.pi is None:
@@ -423,7 +454,9 @@ class _Compiler:
             arg = _simplify(self.run(node.args[0]))
             q = _constant_of(arg)
             if q is None:
-                raise ExprError("sqrt takes a rational constant (e.g. sqrt(3), sqrt(3/4))",
+                raise ExprError("sqrt takes a rational constant (e.g. sqrt(3), sqrt(3/4))" +
+                                ("; of a parameter outside the exact field, define it as a "
+                                 "parameter (m: sqrt(l))" if self.opaque else ""),
                                 node.column)
             if q < 0:
                 raise ExprError("sqrt of a negative number is not real", node.column)
@@ -493,7 +526,7 @@ def _check_power(base, e: int, node: Node) -> None:
     if isinstance(base, Fraction):
         bits = max(abs(base.numerator).bit_length(), base.denominator.bit_length())
         if bits * e > MAX_BITS:
-            raise ExprError(f"the number {_describe(base)}^{e} is too large", node.column)
+            raise TooLarge(f"the number {_describe(base)}^{e} is too large", node.column)
     elif base.total_degree() * e > MAX_DEGREE:
         raise ExprError(f"the expression's degree exceeds {MAX_DEGREE}", node.column)
     elif len(base) > 1 and e > 1:
@@ -509,7 +542,7 @@ def _check_power(base, e: int, node: Node) -> None:
 def _checked(value, node: Node):
     if isinstance(value, Fraction):
         if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) > MAX_BITS:
-            raise ExprError("a number in the expression is too large", node.column)
+            raise TooLarge("a number in the expression is too large", node.column)
     elif isinstance(value, Surd):
         for q in value.terms.values():
             _checked(q, node)
@@ -534,7 +567,7 @@ def angles_in(node: Node, names) -> set[str]:
 
 
 _ARGUMENT_FORM = ("the argument of sin/cos must be an integer combination of angles plus a "
-                  "multiple of pi/12 (e.g. cos(2*theta + pi/3))")
+                  "constant (e.g. cos(2*theta + pi/3), sin(theta + a))")
 
 
 def _linear_argument(node: Node, angles, parameters) -> tuple[dict[str, int], Fraction]:
@@ -566,23 +599,70 @@ def _linear_argument(node: Node, angles, parameters) -> tuple[dict[str, int], Fr
     return coefficients, q
 
 
+def angle_offset(node: Node, angles, parameters) -> tuple[dict[str, int], str] | None:
+    """``({angle: k}, c)`` when a sin/cos argument that :func:`_linear_argument` refuses
+    is Σ k·angle + c with integer k and a constant c (``th1 + a``, ``2*phi + 1/3``, with
+    ``a: 2*cos(1/10)`` or ``a: 0.1``): ``c`` written in the grammar (numbers, ``pi``,
+    parameters); None for any other argument.  cos c and sin c are then opaque constants
+    (:mod:`singcheck.spec.real_constants`)."""
+    names = sorted(angles)
+    symbolic = sorted(p for p, v in parameters.items() if not isinstance(v, Fraction))
+    ring = fmpq_mpoly_ctx.get((*names, "pi", *symbolic), "lex")
+    gens = dict(zip(ring.names(), ring.gens(), strict=True))
+    pi = gens.pop("pi")
+    rational = {p: v for p, v in parameters.items() if isinstance(v, Fraction)}
+    try:
+        compiler = _Compiler(ring, {**rational, **gens}, what="sin/cos argument", pi=pi)
+        value = compiler.lift(compiler.run(node), node)
+    except ExprError:
+        return None
+    count = len(names)
+    coefficients: dict[str, int] = {}
+    rest = {}
+    for exps, coeff in value.terms():
+        if any(exps[:count]):
+            if sum(exps[:count]) != 1 or any(exps[count:]) or coeff.q != 1:
+                return None  # not linear in the angles with integer multiples
+            coefficients[names[list(exps[:count]).index(1)]] = int(coeff.p)
+        else:
+            rest[exps[count:]] = coeff
+    if not rest or sum(abs(k) for k in coefficients.values()) > MAX_EXPONENT:
+        return None
+    constant = fmpq_mpoly_ctx.get(("pi", *symbolic), "lex").from_dict(rest)
+    return coefficients, str(constant)
+
+
 def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmpq_mpoly],
                        parameters: dict[str, object],
-                       angles: dict[str, tuple[fmpq_mpoly, fmpq_mpoly]] | None = None
-                       ) -> fmpq_mpoly:
+                       angles: dict[str, tuple[fmpq_mpoly, fmpq_mpoly]] | None = None,
+                       opaque: dict[str, fmpq_mpoly] | None = None,
+                       offsets: dict | None = None) -> fmpq_mpoly:
     """The exact polynomial of ``node`` in ``ctx`` (parameters substituted).
 
     ``angles[v] = (cos(v), sin(v))`` are the ring's variables of each angle v: ``sin`` and
     ``cos`` of integer combinations of angles plus multiples of π/12 are expanded exactly
     and reduced modulo cos² + sin² = 1; a bare angle is refused.  Square roots become
-    the ring's ``sqrt(p)`` variables (reduced modulo sqrt(p)² = p).
+    the ring's ``sqrt(p)`` variables (reduced modulo sqrt(p)² = p).  ``opaque[name]``
+    is the ring's variable standing for a parameter outside the exact field (its value
+    a :class:`~singcheck.spec.real_constants.RealConstant`, or ``a + b·π`` with b ≠ 0,
+    which cannot stay apart outside sin/cos); without it such a parameter is refused.
+    ``offsets[call]`` is ``({angle: k}, cos c, sin c)`` for a sin/cos call whose argument
+    is Σ k·angle + c with c outside the exact field (:func:`angle_offset`): cos c and
+    sin c are the ring's variables of those opaque constants, and
+    cos(Σ + c) = cos Σ·cos c − sin Σ·sin c exactly (sin likewise).
     """
     angles = angles or {}
+    offsets = offsets or {}
 
     def constant(value: Surd):
         return compiler.lift(_simplify(value))
 
     def call(n: Node):
+        if n in offsets:
+            coefficients, cos_c, sin_c = offsets[n]
+            c, s = expand_trig(coefficients, Fraction(0), angles, constant)
+            out = c * cos_c - s * sin_c if n.value == "cos" else s * cos_c + c * sin_c
+            return reduce_relations(out)
         coefficients, q = _linear_argument(n.args[0], angles, parameters)
         c, s = expand_trig(coefficients, q, angles, constant)
         return c if n.value == "cos" else s
@@ -590,7 +670,8 @@ def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmp
     forbidden = {v: f"{v!r} is an angle (it appears inside sin/cos): use it only through "
                     f"sin({v}) and cos({v})" for v in angles}
     compiler = _Compiler(ctx, {**parameters, **variables}, call, what="constraint",
-                         surd=lambda v: surd_polynomial(v, ctx), forbidden=forbidden)
+                         surd=lambda v: surd_polynomial(v, ctx), forbidden=forbidden,
+                         opaque=opaque)
     return reduce_relations(compiler.lift(compiler.run(node), node))
 
 
@@ -608,6 +689,9 @@ def compile_value(node: Node, parameters: dict[str, object]) -> Constant:
             raise ExprError(f"{node.value!r} is not allowed here: use numbers, pi, sqrt and "
                             "parameters defined above", node.column)
         v = parameters[node.value]
+        if isinstance(v, OutsideField):
+            raise ExprError(f"parameter {node.value!r} is not an exact algebraic number",
+                            node.column)
         return v if isinstance(v, Constant) else Constant(Surd.rational(v))
     if k == "call":
         arg = compile_value(node.args[0], parameters)
@@ -656,12 +740,17 @@ def compile_value(node: Node, parameters: dict[str, object]) -> Constant:
         base, e = args
         if e.pi_coefficient or not e.surd.is_rational():
             raise ExprError("exponents must be non-negative integers", node.column)
-        n = _exponent(node.args[1], e.surd.rational_value())
+        exponent = e.surd.rational_value()
+        inverse = exponent < 0 and exponent.denominator == 1  # x^(-n) = 1/x^n
+        n = _exponent(node.args[1], -exponent if inverse else exponent)
         if base.pi_coefficient:
             raise ExprError("powers of pi are not allowed: use a + b*pi", node.column)
         if base.surd.is_rational():
             _check_power(base.surd.rational_value(), n, node)
-        return Constant(_checked(base.surd ** n, node))
+        if inverse and not base.surd:
+            raise ExprError("a negative power of zero", node.column)
+        value = _checked(base.surd ** n, node)
+        return Constant(_checked(value.inverse(), node) if inverse else value)
     raise AssertionError(k)  # pragma: no cover
 
 

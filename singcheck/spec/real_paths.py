@@ -20,10 +20,14 @@ from fractions import Fraction
 from flint import arb, fmpq
 
 from singcheck.algebra.intervals import power
-from singcheck.spec.grammar import MAX_EXPONENT, Constant, ExprError, Node
+from singcheck.spec.grammar import MAX_EXPONENT, Constant, ExprError, Node, OutsideField
 
 
 def _ball(value) -> arb:
+    if isinstance(value, OutsideField):  # a parameter outside the exact field
+        from singcheck.spec.real_constants import constant_ball
+
+        return constant_ball(value)
     if isinstance(value, Constant):
         out = value.surd.ball()
         if value.pi_coefficient:

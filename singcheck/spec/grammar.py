@@ -755,7 +755,30 @@ def compile_value(node: Node, parameters: dict[str, object]) -> Constant:
 
 
 def _argument_terms(node: Node, parameter: str, parameters) -> dict | None:
-    """The argument of sin/cos as {(t-degree, π-degree): coefficient}, or None."""
+    """The argument of sin/cos as {(t-degree, π-degree): coefficient}, or None (a new
+    dict each call: callers pop from it).
+
+    A trajectory's compilation asks this of each sin/cos node three times (the π
+    rescaling, the pose angles, the polynomial), about a fifth of a heart's parse: the
+    answer is kept per node object, parameter name and parameters (the same dict object
+    holding the same items), the node and the dict held with it so that neither id is
+    reused while the entry lives."""
+    key = (id(node), parameter, id(parameters))
+    items = tuple(parameters.items())
+    hit = _ARGUMENT_TERMS.get(key)
+    if hit is not None and hit[0] is node and hit[1] is parameters and hit[2] == items:
+        return None if hit[3] is None else dict(hit[3])
+    terms = _argument_terms_of(node, parameter, parameters)
+    if len(_ARGUMENT_TERMS) >= 512:
+        _ARGUMENT_TERMS.clear()
+    _ARGUMENT_TERMS[key] = (node, parameters, items, terms)
+    return None if terms is None else dict(terms)
+
+
+_ARGUMENT_TERMS: dict = {}
+
+
+def _argument_terms_of(node: Node, parameter: str, parameters) -> dict | None:
     ring = fmpq_mpoly_ctx.get((parameter, "pi"), "lex")
     t, pi = ring.gens()
     try:

@@ -358,15 +358,13 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
     if len(model.det_A) > 5000:
         return {}
     fast = mode_program(path)
-    if fast is not None:
-        parts = _compiled_parts(model)
-        if parts is not None:
-            return _compiled_mean_value(fast, parts, path, modes, t, joints)
     rates = fast.rates(t) if fast is not None else path.pose_rates_at(t, angle_functions=False)
     if rates is None:
         return {}
+    parts = _compiled_parts(model)
+    if parts is not None:  # every partial derivative at once, then the rates
+        return _compiled_mean_value(parts, path, modes, t, joints, rates)
     n_joint, det_parts, legs = _derivative_parts(model)
-    program = ball_program(model, "mean value", _derivative_polys)
     variables = path.pose_variables_at(t)  # (before the midpoint's: the caller's, kept)
     m = arb(t.mid())
     _, _, at_mid = mode_values(path, modes, m)
@@ -384,13 +382,6 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
         point = flat + list(variables) + radicals
         speed = [_ZERO] * n_joint + rates
         sigmas = _branch_signs(mode)
-        if program is not None:  # every partial derivative at once, then the rates
-            slope = _assembler(model)(program(point), speed, sigmas, point)
-            if slope is not None:
-                value = mid + slope * (t - m)
-                if value.is_finite():
-                    out[mode.label] = (value, slope)
-            continue
         ball = _evaluator(_derivative_polys(model), point, {})  # too many terms: one by one
         for (kind, idx, dx, extra), sigma in zip(legs, sigmas, strict=True):
             push = arb(0)
@@ -446,17 +437,14 @@ def _compiled_parts(model):
     return parts
 
 
-def _compiled_mean_value(fast, parts, path, modes: list, t: arb, joints: dict) -> dict:
-    """:func:`mean_value` through the path's :class:`ModeProgram` and the model's
-    compiled programs (:func:`_compiled_parts`): the same balls and operations as its
-    loop, the lookups made once."""
-    rates = fast.rates(t)
-    if rates is None:
-        return {}
+def _compiled_mean_value(parts, path, modes: list, t: arb, joints: dict,
+                         rates: list) -> dict:
+    """:func:`mean_value` by the model's compiled programs (:func:`_compiled_parts`):
+    the same balls and operations as its loop, the lookups made once."""
     n_joint, program, assemble, radicals = parts
     variables = path.pose_variables_at(t)  # (before the midpoint's: the caller's, kept)
     m = arb(t.mid())
-    _, _, at_mid = fast(path, m, modes)
+    _, _, at_mid = mode_values(path, modes, m)
     head = [_ZERO] * n_joint
     out = {}
     for mode in modes:

@@ -17,25 +17,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 from fractions import Fraction
 
-from flint import arb, fmpq
+from flint import arb
 
 from singcheck.algebra.intervals import power
-from singcheck.spec.grammar import MAX_EXPONENT, Constant, ExprError, Node, OutsideField
+from singcheck.spec.grammar import MAX_EXPONENT, ExprError, Node
+from singcheck.spec.real_constants import constant_ball
 
-
-def _ball(value) -> arb:
-    if isinstance(value, OutsideField):  # a parameter outside the exact field
-        from singcheck.spec.real_constants import constant_ball
-
-        return constant_ball(value)
-    if isinstance(value, Constant):
-        out = value.surd.ball()
-        if value.pi_coefficient:
-            q = value.pi_coefficient
-            out += arb.pi() * arb(fmpq(q.numerator, q.denominator))
-        return out
-    q = Fraction(value)
-    return arb(fmpq(q.numerator, q.denominator))
+_ball = constant_ball  # the ball of a constant the tree names (a parameter's value)
 
 
 @dataclass(frozen=True)

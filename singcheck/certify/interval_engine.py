@@ -365,21 +365,11 @@ def mean_value(path, modes: list, t: arb, joints: dict) -> dict:
     if parts is not None:  # every partial derivative at once, then the rates
         return _compiled_mean_value(parts, path, modes, t, joints, rates)
     n_joint, det_parts, legs = _derivative_parts(model)
-    variables = path.pose_variables_at(t)  # (before the midpoint's: the caller's, kept)
-    m = arb(t.mid())
-    _, _, at_mid = mode_values(path, modes, m)
     radicals = [b for _, b in sorted(radical_balls(model.context).items())]
+    m, variables, points = _mode_points(path, modes, t, joints)
     out = {}
-    for mode in modes:
-        js, mid = joints[mode.label], at_mid[mode.label]
-        if not isinstance(mid, arb) or any(j is None for j in js):
-            continue
-        flat = []
-        for j in js:
-            flat += list(j) if isinstance(j, tuple) else [j]
-        if not all(isinstance(v, arb) for v in flat):
-            continue
-        point = flat + list(variables) + radicals
+    for mode, mid, flat in points:
+        point = flat + variables + radicals
         speed = [_ZERO] * n_joint + rates
         sigmas = _branch_signs(mode)
         ball = _evaluator(_derivative_polys(model), point, {})  # too many terms: one by one
@@ -437,16 +427,14 @@ def _compiled_parts(model):
     return parts
 
 
-def _compiled_mean_value(parts, path, modes: list, t: arb, joints: dict,
-                         rates: list) -> dict:
-    """:func:`mean_value` by the model's compiled programs (:func:`_compiled_parts`):
-    the same balls and operations as its loop, the lookups made once."""
-    n_joint, program, assemble, radicals = parts
+def _mode_points(path, modes: list, t: arb, joints: dict):
+    """(m, the pose variables' balls over ``t``, [(mode, det A at m, its joint balls over
+    ``t`` flattened)]) for the mean-value form: m the midpoint of ``t``, each mode whose
+    det A at m and joints over ``t`` are all real balls."""
     variables = path.pose_variables_at(t)  # (before the midpoint's: the caller's, kept)
     m = arb(t.mid())
     _, _, at_mid = mode_values(path, modes, m)
-    head = [_ZERO] * n_joint
-    out = {}
+    points = []
     for mode in modes:
         js, mid = joints[mode.label], at_mid[mode.label]
         if not isinstance(mid, arb) or any(j is None for j in js):
@@ -454,8 +442,20 @@ def _compiled_mean_value(parts, path, modes: list, t: arb, joints: dict,
         flat = []
         for j in js:
             flat += list(j) if isinstance(j, tuple) else [j]
-        if not all(isinstance(v, arb) for v in flat):
-            continue
+        if all(isinstance(v, arb) for v in flat):
+            points.append((mode, mid, flat))
+    return m, variables, points
+
+
+def _compiled_mean_value(parts, path, modes: list, t: arb, joints: dict,
+                         rates: list) -> dict:
+    """:func:`mean_value` by the model's compiled programs (:func:`_compiled_parts`):
+    the same balls and operations as its loop, the lookups made once."""
+    n_joint, program, assemble, radicals = parts
+    m, variables, points = _mode_points(path, modes, t, joints)
+    head = [_ZERO] * n_joint
+    out = {}
+    for mode, mid, flat in points:
         point = flat + variables + radicals
         slope = assemble(program(point), head + rates, _branch_signs(mode), point)
         if slope is not None:

@@ -86,6 +86,17 @@ def _cpu() -> float:
     return time.process_time() + children.ru_utime + children.ru_stime
 
 
+def _round_orders(count: int, repeat: int):
+    """Each round's order of the ``count`` contenders: a permutation drawn from a fixed
+    seed (the same orders on every run), or the listed order with BENCH_FIXED_ORDER."""
+    orders = random.Random(ROUND_ORDER_SEED)
+    for _ in range(repeat):
+        order = list(range(count))
+        if not FIXED_ORDER:
+            orders.shuffle(order)
+        yield order
+
+
 def interleaved(fns: list, repeat: int = REPEAT) -> list[list[tuple[float, float]]]:
     """(wall, CPU) seconds of several contenders run round-robin (one run of each per
     round), so that a noisy spell of the machine falls on all of them alike; one list
@@ -101,11 +112,7 @@ def interleaved(fns: list, repeat: int = REPEAT) -> list[list[tuple[float, float
     caches: on heart 1 that order made the scan's median 6-10 % lower and singcheck's
     a few % higher than in varied orders (docs/speed.md)."""
     out: list[list[tuple[float, float]]] = [[] for _ in fns]
-    orders = random.Random(ROUND_ORDER_SEED)
-    for _ in range(repeat):
-        order = list(range(len(fns)))
-        if not FIXED_ORDER:
-            orders.shuffle(order)
+    for order in _round_orders(len(fns), repeat):
         for i in order:
             cpu, start = _cpu(), time.perf_counter()
             fns[i]()
@@ -130,11 +137,7 @@ def in_blocks(fns: list, repeat: int = REPEAT, size: int = BLOCK
     (docs/speed.md)."""
     warm: list[list[tuple[float, float]]] = [[] for _ in fns]
     cold: list[list[tuple[float, float]]] = [[] for _ in fns]
-    orders = random.Random(ROUND_ORDER_SEED)
-    for _ in range(repeat):
-        order = list(range(len(fns)))
-        if not FIXED_ORDER:
-            orders.shuffle(order)
+    for order in _round_orders(len(fns), repeat):
         for i in order:
             runs = []
             for _ in range(size):

@@ -161,9 +161,10 @@ def exact(v) -> object:
 
 # --- the robots --------------------------------------------------------------------------
 
-def five_bar() -> Oracle:
-    """RR-RRR, A_i = (∓1, 0), l1 = l2 = 2.  det A ∝ det(P - B1, P - B2)."""
-    d, l1, l2 = 1, 2, 2
+def five_bar(l1=2, lo1=None) -> Oracle:
+    """RR-RRR, A_i = (∓1, 0), distal links l2 = 2, proximal links ``l1`` (2 for the
+    bundled robot), θ1 ≥ ``lo1`` (π/3).  det A ∝ det(P - B1, P - B2)."""
+    d, l2 = 1, 2
     bases = ((-d, 0), (d, 0))
 
     def abc(i):
@@ -180,7 +181,7 @@ def five_bar() -> Oracle:
              for i in range(2)]
         return 4 * (u[0][0] * u[1][1] - u[0][1] * u[1][0])
 
-    legs = (revolute_leg("th1", abc(0), PI / 3, PI),
+    legs = (revolute_leg("th1", abc(0), PI / 3 if lo1 is None else lo1, PI),
             revolute_leg("th2", abc(1), mp.mpf(0), 2 * PI / 3))
     return Oracle("five-bar", ("x", "y"), legs, det_A)
 

@@ -280,31 +280,17 @@ def test_the_exact_field_keeps_the_exact_path(tmp_path):
 
 # --- a revolute robot, a path naming the parameter, an undecided graze -----------------
 
-def _five_bar_oracle(l1, lo1=None):
-    """The 5-bar (RR-RRR) with proximal links l1, written here from its geometry: bases
-    (∓1, 0), distal links 2; each leg a·cos θ + b·sin θ + c = 0; det A ∝ det(P − B1,
-    P − B2) with Bᵢ the elbows."""
-    from tests import robot_oracles as oracles
-
-    bases, l2 = ((-1, 0), (1, 0)), 2
-
-    def abc(i):
-        ax, ay = bases[i]
-
-        def f(X):
-            px, py = X[0] - ax, X[1] - ay
-            return -2 * l1 * px, -2 * l1 * py, px * px + py * py + l1 * l1 - l2 * l2
-
-        return f
-
-    def det_A(q, X):
-        u = [[X[0] - bases[i][0] - l1 * mp.cos(q[i]), X[1] - bases[i][1] - l1 * mp.sin(q[i])]
-             for i in range(2)]
-        return u[0][0] * u[1][1] - u[0][1] * u[1][0]
-
-    legs = (oracles.revolute_leg("th1", abc(0), mp.pi / 3 if lo1 is None else lo1, mp.pi),
-            oracles.revolute_leg("th2", abc(1), mp.mpf(0), 2 * mp.pi / 3))
-    return oracles.Oracle("five-bar", ("x", "y"), legs, det_A)
+def _assert_matches(report, truth, name: str) -> None:
+    """singcheck's verdict, its one feasible mode and its singular times (each inside its
+    reported ball) are the oracle's ``truth``; a path named *cross* is singular."""
+    assert report.verdict == truth.verdict == ("singular" if "cross" in name
+                                               else "singularity-free")
+    feasible = [m for m in report.working_modes if m.feasible]
+    assert len(feasible) == len(truth.feasible) == 1
+    times = sorted(feasible[0].singular_times, key=lambda c: float(c.t.mid()))
+    assert len(times) == len(truth.singular_times)
+    for c, t in zip(times, truth.singular_times, strict=True):
+        assert float(c.t.lower()) - 1e-12 <= float(t) <= float(c.t.upper()) + 1e-12
 
 
 @pytest.mark.parametrize("name, pose", [
@@ -318,7 +304,7 @@ def test_a_revolute_robot_with_a_real_link_length(tmp_path, name, pose):
 
     mp.mp.dps = 50
     l1 = 2 * mp.cos(mp.mpf(1) / 20)
-    path = oracles.Path(name, lambda: _five_bar_oracle(l1), 0, 1, pose, None)
+    path = oracles.Path(name, lambda: oracles.five_bar(l1), 0, 1, pose, None)
     truth = oracles.solve(path)
     robot_file = tmp_path / "five-bar.yaml"
     robot_file.write_text((ROBOTS / "five-bar.yaml").read_text().replace(
@@ -327,14 +313,7 @@ def test_a_revolute_robot_with_a_real_link_length(tmp_path, name, pose):
     assert "l1" in str(robot.spec.context.names())  # an opaque constant of the ring
     report = check(robot, load_trajectory(str(TRAJECTORIES / f"{name}.yaml"), robot),
                    regions=False)
-    assert report.verdict == truth.verdict == ("singular" if "cross" in name
-                                               else "singularity-free")
-    feasible = [m for m in report.working_modes if m.feasible]
-    assert len(feasible) == len(truth.feasible) == 1
-    times = sorted(feasible[0].singular_times, key=lambda c: float(c.t.mid()))
-    assert len(times) == len(truth.singular_times)
-    for c, t in zip(times, truth.singular_times, strict=True):
-        assert float(c.t.lower()) - 1e-12 <= float(t) <= float(c.t.upper()) + 1e-12
+    _assert_matches(report, truth, name)
     if truth.singular_times:  # l1 = 2 crosses at (3 - √3)/2 ≈ 0.634: this one elsewhere
         assert abs(float(truth.singular_times[0]) - 0.6339746) > 1e-3
 
@@ -453,14 +432,8 @@ def test_an_angle_plus_a_real_offset_in_a_constraint(tmp_path, name, pose):
     assert "K[[cos(1/3)]]" in robot.spec.context.names()
     report = check(robot, load_trajectory(str(TRAJECTORIES / f"{name}.yaml"), robot),
                    regions=False)
-    assert report.verdict == truth.verdict == ("singular" if "cross" in name
-                                               else "singularity-free")
-    feasible = [m for m in report.working_modes if m.feasible]
-    assert len(feasible) == len(truth.feasible) == 1
-    times = sorted(feasible[0].singular_times, key=lambda c: float(c.t.mid()))
-    assert len(times) == len(truth.singular_times)
-    for c, t in zip(times, truth.singular_times, strict=True):
-        assert float(c.t.lower()) - 1e-12 <= float(t) <= float(c.t.upper()) + 1e-12
+    _assert_matches(report, truth, name)
+    for t in truth.singular_times:
         assert abs(float(t) - 0.119047) > 1e-2
 
 
@@ -475,7 +448,7 @@ def test_a_real_angle_limit(tmp_path, lower, feasible):
 
     mp.mp.dps = 50
     lo1 = 2 * mp.cos(1 if feasible else mp.mpf(1) / 5)
-    path = oracles.Path("five-bar-cross", lambda: _five_bar_oracle(mp.mpf(2), lo1), 0, 1,
+    path = oracles.Path("five-bar-cross", lambda: oracles.five_bar(mp.mpf(2), lo1), 0, 1,
                         lambda t: [mp.mpf(0), 3 - 2 * t], None)
     truth = oracles.solve(path)
     (tmp_path / "fb.yaml").write_text((ROBOTS / "five-bar.yaml").read_text().replace(

@@ -613,9 +613,11 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
     from itertools import islice
 
     from singcheck.algebra.pickling import register
+    from singcheck.elimination.cas.guard import ready_to_fork
     from singcheck.report.trajectory import error_json
 
     register()  # specs cross to the workers by pickle
+    ready_to_fork()  # each worker's die_with_parent, loaded once here
     _WORKER.update(robot=robot, options=options, parent=os.getpid(), line=line)
 
     def start():

@@ -14,13 +14,21 @@ isolation's norm over sin t.
 
 from __future__ import annotations
 
+import faulthandler
 import os
+import pickle
+import resource
+import select
 import signal
 import sys
+import tempfile
 import time
 
+# loaded here, before any fork: a child that imported them itself (ctypes, for
+# die_with_parent, above all) spent about 7 ms of a short call's 8 ms doing so
+from singcheck.algebra.pickling import register
 from singcheck.budget import TimeLimitExceeded, checkpoint, remaining
-from singcheck.elimination.cas.guard import die_with_parent
+from singcheck.elimination.cas.guard import die_with_parent, ready_to_fork
 from singcheck.elimination.cas.limits import (
     bound_text,
     inherited_limit,
@@ -42,8 +50,6 @@ def _address_space() -> int:
 
 def _child(fn, argument, write: int, err: int, parent: int, limit: int) -> None:
     """In the forked child: bound, compute, send ``(status, value)`` pickled, exit."""
-    import pickle
-
     try:
         die_with_parent(parent)
         signal.setitimer(signal.ITIMER_REAL, 0)  # the parent's alarm is the parent's
@@ -51,17 +57,11 @@ def _child(fn, argument, write: int, err: int, parent: int, limit: int) -> None:
         # fresh streams: a thread of the parent (a progress display) may have held the
         # old ones' locks at the fork, and it does not exist here to release them
         sys.stdout = sys.stderr = open(2, "w", closefd=False)
-        import faulthandler
-
         faulthandler.disable()  # an abort here is the parent's to report, in one line
-        import resource
-
         resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
         if limit:
             bound = under_inherited(_address_space() + limit)
             resource.setrlimit(resource.RLIMIT_AS, (bound, bound))
-        from singcheck.algebra.pickling import register
-
         register()
         try:
             message = pickle.dumps(("ok", fn(argument)))
@@ -85,10 +85,7 @@ def _child(fn, argument, write: int, err: int, parent: int, limit: int) -> None:
 def run_forked(fn, argument, timeout: float, what: str):
     """``fn(argument)`` computed in a forked child, within ``timeout`` seconds and the
     memory bound; its exceptions are re-raised here."""
-    import pickle  # noqa: F401 - loaded once here, not in the child
-    import select
-    import tempfile
-
+    ready_to_fork()
     limit = memory_limit()
     read, write = os.pipe()
     parent = os.getpid()
@@ -129,8 +126,6 @@ def run_forked(fn, argument, timeout: float, what: str):
 
 
 def _outcome(message: bytes, status: int, said: str, limit: int, what: str):
-    import pickle
-
     bound = bound_text(limit) + ("" if limit == inherited_limit() else
                                  " (SINGCHECK_MEMORY_LIMIT)")
     try:

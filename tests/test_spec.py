@@ -456,3 +456,52 @@ def test_a_plain_spec_is_read_without_pyyaml():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert out.stdout.strip() == "False"
+
+
+# --- the parse's caches (a batch's paths share their numbers and sin/cos terms) ---
+
+
+def test_a_shared_sin_cos_term_compiles_in_each_ring_on_its_own():
+    """cos(t + π/6) needs √3: compiled in a ring with √3 it is (√3/2)c - s/2, exactly;
+    the same term asked for in the plain trig ring afterwards must still be refused,
+    not served from the other ring's compilation."""
+    from flint import fmpq, fmpq_mpoly_ctx
+
+    from singcheck.algebra.trig import TRIG
+    from singcheck.spec.grammar import ExprError, compile_trajectory_coordinate, parse
+
+    ring = fmpq_mpoly_ctx.get(("t", "s", "c", "sqrt(3)"), "lex")
+    t, s, c, r3 = ring.gens()
+    p = compile_trajectory_coordinate(parse("cos(t + pi/6)"), "t", {}, ring)
+    assert p == r3 * c * fmpq(1, 2) - s * fmpq(1, 2)
+    q = compile_trajectory_coordinate(parse("2 + cos(t + pi/6)"), "t", {}, ring)
+    assert q == p + 2
+    with pytest.raises(ExprError):
+        compile_trajectory_coordinate(parse("cos(t + pi/6)"), "t", {}, TRIG)
+
+
+def test_an_argument_of_the_same_shape_is_read_with_the_parameters_of_its_robot():
+    """k*pi*t with k = 1/2, then with k = 1/3 (another parameters dict, then the same dict
+    changed): each reading gives its own multiple of π·t, whatever was read before."""
+    from fractions import Fraction
+
+    from singcheck.spec.grammar import Constant, compile_value, parse, pi_multiples
+
+    tree = parse("sin(k*pi*t)")
+    half = {"k": compile_value(parse("1/2"), {})}
+    third = {"k": compile_value(parse("1/3"), {})}
+    assert isinstance(half["k"], Constant)
+    assert pi_multiples(tree, "t", half) == [Fraction(1, 2)]
+    assert pi_multiples(parse("1 + sin(k*pi*t)"), "t", third) == [Fraction(1, 3)]
+    half["k"] = third["k"]  # the same dict, changed in place
+    assert pi_multiples(tree, "t", half) == [Fraction(1, 3)]
+
+
+def test_a_literal_read_again_is_the_same_exact_number():
+    from fractions import Fraction
+
+    from singcheck.spec.grammar import compile_constant, parse
+
+    for _ in range(2):
+        assert compile_constant(parse("0.1 + 0.1")).rational == Fraction(1, 5)
+        assert compile_constant(parse("1e-3")).rational == Fraction(1, 1000)

@@ -266,15 +266,24 @@ def _exact_number(text: str, column: int) -> Fraction:
     if max(numerator, denominator) * _LOG2_10 > MAX_LITERAL_BITS + 4 and digits:
         raise ExprError(f"the number {_short(text)} is too large (at most "
                         f"{MAX_LITERAL_BITS} bits)", column)
-    try:
-        value = Fraction(text)  # exact decimal: Fraction("0.1") == 1/10
-    except (ValueError, ZeroDivisionError):
-        raise ExprError(f"bad number {text!r}", column) from None
+    value = _LITERALS.get(text)
+    if value is None:
+        try:
+            value = Fraction(text)  # exact decimal: Fraction("0.1") == 1/10
+        except (ValueError, ZeroDivisionError):
+            raise ExprError(f"bad number {text!r}", column) from None
+        if len(_LITERALS) >= 4096:
+            _LITERALS.clear()
+        _LITERALS[text] = value
     if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) > \
             MAX_LITERAL_BITS:
         raise ExprError(f"the number {_short(text)} is too large (at most "
                         f"{MAX_LITERAL_BITS} bits)", column)
     return value
+
+
+#: literals read (text -> Fraction, immutable): a batch's paths repeat their numbers
+_LITERALS: dict[str, Fraction] = {}
 
 
 def _short(text: str) -> str:
@@ -759,20 +768,26 @@ def _argument_terms(node: Node, parameter: str, parameters) -> dict | None:
     dict each call: callers pop from it).
 
     A trajectory's compilation asks this of each sin/cos node three times (the π
-    rescaling, the pose angles, the polynomial), about a fifth of a heart's parse: the
-    answer is kept per node object, parameter name and parameters (the same dict object
-    holding the same items), the node and the dict held with it so that neither id is
-    reused while the entry lives."""
-    key = (id(node), parameter, id(parameters))
+    rescaling, the pose angles, the polynomial), and a batch's paths share their
+    arguments (``2*t``): about a fifth of a heart's parse.  The answer is kept per
+    argument's shape (the tree without its columns), parameter name and parameters (the
+    same dict object holding the same items; the dict held with it so that its id is not
+    reused while the entry lives)."""
+    key = (_shape(node), parameter, id(parameters))
     items = tuple(parameters.items())
     hit = _ARGUMENT_TERMS.get(key)
-    if hit is not None and hit[0] is node and hit[1] is parameters and hit[2] == items:
-        return None if hit[3] is None else dict(hit[3])
+    if hit is not None and hit[0] is parameters and hit[1] == items:
+        return None if hit[2] is None else dict(hit[2])
     terms = _argument_terms_of(node, parameter, parameters)
     if len(_ARGUMENT_TERMS) >= 512:
         _ARGUMENT_TERMS.clear()
-    _ARGUMENT_TERMS[key] = (node, parameters, items, terms)
+    _ARGUMENT_TERMS[key] = (parameters, items, terms)
     return None if terms is None else dict(terms)
+
+
+def _shape(node: Node) -> tuple:
+    """The tree as nested tuples of kinds and values, without the columns."""
+    return (node.kind, node.value, *(_shape(a) for a in node.args))
 
 
 _ARGUMENT_TERMS: dict = {}
@@ -883,9 +898,16 @@ def compile_trajectory_coordinate(node: Node, parameter: str, parameters,
         if abs(k) > MAX_DEGREE:
             raise ExprError(f"the multiple {k} of {parameter} is larger than {MAX_DEGREE}",
                             n.column)
-        ck, sk = (_into(cos_multiple(k), ring), _into(sin_multiple(k), ring))
-        cq, sq = constant(cos_pi(q)), constant(sin_pi(q))
-        return ck * cq - sk * sq if n.value == "cos" else sk * cq + ck * sq
+        key = (ring, n.value, k, q)
+        hit = _SIN_COS.get(key)
+        if hit is None:
+            ck, sk = (_into(cos_multiple(k), ring), _into(sin_multiple(k), ring))
+            cq, sq = constant(cos_pi(q)), constant(sin_pi(q))
+            hit = ck * cq - sk * sq if n.value == "cos" else sk * cq + ck * sq
+            if len(_SIN_COS) >= 1024:
+                _SIN_COS.clear()
+            _SIN_COS[key] = hit
+        return hit
 
     forbidden = {} if pi_scale is None else {parameter: (
         f"{parameter} outside sin/cos cannot be mixed with sin/cos of k*pi*{parameter} (it "
@@ -893,6 +915,14 @@ def compile_trajectory_coordinate(node: Node, parameter: str, parameters,
     compiler = _Compiler(ring, {**parameters, parameter: t}, call, what="trajectory",
                          surd=lambda v: surd_polynomial(v, ring), forbidden=forbidden)
     return _reduce_path(compiler.lift(compiler.run(node), node))
+
+
+#: cos(k·t + qπ) and sin(k·t + qπ) per (ring, function, k, q), as compiled by
+#: :func:`compile_trajectory_coordinate`: a batch's hearts ask for the same few multiples
+#: again and again (Chebyshev polynomials, moved into the ring, times the exact cos qπ,
+#: sin qπ: about a tenth of a heart's parse).  FLINT polynomials are values here: nothing
+#: in singcheck changes one in place, so one object serves every coordinate.
+_SIN_COS: dict = {}
 
 
 def compile_angle_coordinate(node: Node, parameter: str, parameters,

@@ -298,10 +298,25 @@ def _describe(q: Fraction) -> str:
 
 
 def parse(text: str) -> Node:
-    """The tree of an expression (raises :class:`ExprError`)."""
+    """The tree of an expression (raises :class:`ExprError`).  A short text read before
+    gets the same tree (trees are frozen): a batch's paths repeat their ranges and
+    constant coordinates (``-pi``, ``pi``, ``1``)."""
     if len(text) > MAX_LENGTH:
         raise ExprError(f"expression longer than {MAX_LENGTH} characters")
-    return _Parser(text).parse()
+    if len(text) > _SHORT:
+        return _Parser(text).parse()
+    tree = _PARSED.get(text)
+    if tree is None:
+        tree = _Parser(text).parse()
+        if len(_PARSED) >= 1024:
+            _PARSED.clear()
+        _PARSED[text] = tree
+    return tree
+
+
+#: texts up to this length are kept with their trees (:func:`parse`)
+_SHORT = 32
+_PARSED: dict[str, Node] = {}
 
 
 # ---------------------------------------------------------------------------------

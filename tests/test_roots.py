@@ -70,6 +70,21 @@ def test_roots_at_and_just_outside_the_range_ends():
     assert_roots(isolate_real_roots(p, rng(eps, Fraction(4, 3) - eps)), [1])
 
 
+def test_roots_outside_the_range_are_left_out_whatever_their_distance():
+    """Roots far outside, an irrational one just inside or just outside an end (√2 against
+    ends 1.4142135623 and 1.4142135624), and rational ones on the ends: each placed
+    exactly (the isolating interval decides the far ones without refining them)."""
+    p = (T + 7) * (T - fmpq(1, 3)) * (T**2 - 2) * (T - 9) * (T - 1) * (T**2 + T + 5)
+    r2 = mpmath.sqrt(2)
+    assert_roots(isolate_real_roots(p, rng(0, Fraction(14142135624, 10**10))),
+                 [mpmath.mpf(1) / 3, 1, r2])
+    assert_roots(isolate_real_roots(p, rng(0, Fraction(14142135623, 10**10))),
+                 [mpmath.mpf(1) / 3, 1])
+    assert_roots(isolate_real_roots(p, rng(1, 9)), [1, r2, 9])
+    assert_roots(isolate_real_roots(p, rng(-7, -1)), [-7, -r2])
+    assert isolate_real_roots(p, rng(2, 8)).roots == ()
+
+
 def test_sine_on_minus_pi_to_pi_has_three_roots():
     iso = isolate_real_roots(S, rng(0, 0, -1, 1))
     assert iso.method == "tangent half-angle"

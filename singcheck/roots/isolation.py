@@ -71,6 +71,14 @@ def as_univariate_t(p: fmpq_mpoly) -> fmpq_poly:
     return fmpq_poly(coeffs)
 
 
+def _outside(rr, start: fmpq, end: fmpq) -> bool:
+    """Proven, exactly: the root of the isolating interval ``rr`` lies outside [start,
+    end] (it is ``lo`` when ``lo == hi``, else strictly between them)."""
+    if rr.lo == rr.hi:
+        return rr.lo < start or rr.lo > end
+    return rr.hi <= start or rr.lo >= end
+
+
 def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> RootIsolation:
     roots, undecided = [], []
     ends = [fmpq(e.rational.numerator, e.rational.denominator)
@@ -82,6 +90,8 @@ def _exact_univariate(p: fmpq_mpoly, interval: TimeRange, tolerance: float) -> R
         checkpoint()
         for q in ends:
             rr.pin(q)
+        if len(ends) == 2 and _outside(rr, *ends):
+            continue
 
         def make(tol: float, rr=rr) -> arb:
             rr.bisect_to(exact_tolerance(tol))

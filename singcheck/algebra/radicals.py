@@ -338,35 +338,48 @@ def angle_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
 def reduce_relations(p: fmpq_mpoly) -> fmpq_mpoly:
     """The representative of ``p`` modulo ``cos(v)² + sin(v)² = 1`` (each angle of its
     ring) and ``sqrt(q)² = q`` (each radical): degree ≤ 1 in every ``sin(v)`` and
-    every ``sqrt(q)``.  A polynomial without those variables is returned unchanged."""
+    every ``sqrt(q)``.  A polynomial without those variables is returned unchanged.
+
+    FLINT's division with remainder, in C: in a lexicographic order that puts every
+    ``sin(v)`` and ``sqrt(q)`` first (:func:`_relations_order`), the relations' leading
+    monomials sin(v)², sqrt(q)² are pairwise coprime, so the relations are a Gröbner
+    basis and the remainder is the unique polynomial congruent to ``p`` with no monomial
+    divisible by any of them: exactly the representative above.  (It was a Python loop
+    over p's terms: 2.2 s of a 6-RUS hexapod's 3.2 s model.)"""
     ctx = p.context()
     angles = angle_variables(ctx)
     radicals = radical_variables(ctx)
     degrees = p.degrees()
     if all(degrees[s] < 2 for _, s in angles) and all(degrees[i] < 2 for i, _ in radicals):
         return p
-    groups: dict[tuple[int, ...], dict[tuple[int, ...], fmpq]] = {}
-    for exps, coeff in p.terms():
-        e = list(exps)
-        halves = []
-        for _, s in angles:
-            halves.append(e[s] // 2)
-            e[s] %= 2
-        for i, q in radicals:
-            coeff = coeff * fmpq(q) ** (e[i] // 2)
-            e[i] %= 2
-        bucket = groups.setdefault(tuple(halves), {})
-        bucket[tuple(e)] = bucket.get(tuple(e), fmpq(0)) + coeff
-    gens = ctx.gens()
-    one = ctx.from_dict({(0,) * ctx.nvars(): 1})
-    out = ctx.from_dict({})
-    for halves, terms in groups.items():
-        factor = one
-        for (c, _), h in zip(angles, halves, strict=True):
-            if h:
-                factor *= (1 - gens[c] ** 2) ** h
-        out += ctx.from_dict({k: v for k, v in terms.items() if v != 0}) * factor
-    return out
+    order, relations = _relations_order(ctx, angles, radicals)
+    q = p.project_to_context(order)
+    for relation in relations:
+        q = divmod(q, relation)[1]
+    return q.project_to_context(ctx)
+
+
+def _relations_order(ctx: fmpq_mpoly_ctx, angles, radicals):
+    """(the ring of ``ctx`` reordered lexicographically with every sine and square root
+    first, the relations sin(v)² + cos(v)² - 1 and sqrt(q)² - q in it), once per ring."""
+    hit = _RELATIONS.get(id(ctx))
+    if hit is not None and hit[0] is ctx:
+        return hit[1], hit[2]
+    names = ctx.names()
+    first = [s for _, s in angles] + [i for i, _ in radicals]
+    order = fmpq_mpoly_ctx.get(tuple(names[i] for i in first) +
+                               tuple(n for i, n in enumerate(names) if i not in first),
+                               "lex")
+    g = dict(zip(order.names(), order.gens(), strict=True))
+    relations = [g[names[s]] ** 2 + g[names[c]] ** 2 - 1 for c, s in angles] + \
+                [g[names[i]] ** 2 - q for i, q in radicals]
+    if len(_RELATIONS) > 256:
+        _RELATIONS.clear()
+    _RELATIONS[id(ctx)] = (ctx, order, relations)  # (ctx held: its id is not reused)
+    return order, relations
+
+
+_RELATIONS: dict = {}
 
 
 def modulo_circles(p: fmpq_mpoly) -> fmpq_mpoly:

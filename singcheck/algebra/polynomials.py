@@ -31,6 +31,17 @@ def exact_terms(p: fmpq_mpoly) -> list:
     return memo_per_object(_TERMS, p, lambda p: list(p.terms()), keep=512)
 
 
+def with_unit_coefficients(p: fmpq_mpoly) -> fmpq_mpoly:
+    """``p`` with every coefficient replaced by 1, once per polynomial object: composed
+    with monomials it cannot cancel, so the image's degrees and term counts bound those
+    of ``p``'s own image (two a-priori size estimates read it from the same det A)."""
+    return memo_per_object(_UNIT, p, lambda q: q.context().from_dict(
+        dict.fromkeys(q.monoms(), 1)), keep=64)
+
+
+_UNIT: dict = {}
+
+
 def restrict(p: fmpq_mpoly, ctx: fmpq_mpoly_ctx) -> fmpq_mpoly:
     """``p`` (free of the dropped variables) re-expressed in the smaller context ``ctx``.
 

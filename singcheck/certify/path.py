@@ -41,6 +41,7 @@ from singcheck.algebra.polynomials import (
     constant_value,
     memo_per_object,
     restrict,
+    with_unit_coefficients,
 )
 from singcheck.algebra.radicals import (
     angle_function,
@@ -83,6 +84,7 @@ from singcheck.model.robot import (
     REVOLUTE,
     Leg,
     RobotModel,
+    det_a_factors,
     leg_coefficients,
     leg_discriminant,
 )
@@ -1002,9 +1004,6 @@ def eliminate_along_path(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...],
 MAX_PATHWISE_TERMS = 2_000_000
 
 
-_DET_A_FACTORS: dict = {}
-
-
 def pathwise_size_bound(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
                         ) -> tuple[int, int, int]:
     """(degree in t, degree in sin/cos, terms) that the path-wise μ cannot exceed, and a
@@ -1055,8 +1054,7 @@ def pathwise_size_bound(model: RobotModel, coordinates: tuple[fmpq_mpoly, ...]
     # (the legs along the path are composed too: their size counts)
     largest = max((size(bounds(f)) for _, f in norm_legs(model)), default=0)
     total_t = total_sc = 0
-    for factor in memo_per_object(_DET_A_FACTORS, model,
-                                  lambda m: [g for g, _ in m.det_A.factor()[1]]):
+    for factor, _ in det_a_factors(model):
         acc = bounds(factor)
         largest = max(largest, size(acc))
         for v, f, d in legs:
@@ -1092,7 +1090,7 @@ def _pair_degrees(p: fmpq_mpoly, names, pairs: list) -> list[int]:
         ring = fmpq_mpoly_ctx.get(tuple(f"z{k}" for k in range(len(pairs))), "lex")
         one = ring.from_dict({(0,) * len(pairs): 1})
         image = {names.index(v): ring.gens()[k] for k, pair in enumerate(pairs) for v in pair}
-        ones = p.context().from_dict({e: 1 for e in p.monoms()})
+        ones = with_unit_coefficients(p)
         composed = ones.compose(*[image.get(i, one) for i in range(len(names))], ctx=ring)
         return [max(0, int(d)) for d in composed.degrees()]
 

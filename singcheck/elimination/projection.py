@@ -46,6 +46,7 @@ from singcheck.errors import BackendError, UnsupportedRobotError
 from singcheck.model.robot import (
     REVOLUTE,
     RobotModel,
+    det_a_factors,
     leg_coefficients,
     leg_discriminant,
     revolute_discriminant,
@@ -359,7 +360,7 @@ def expansion_bound(model: RobotModel) -> tuple[int, int]:
     names = model.context.names()
     n = len(model.pose_variables)
     worst = (0, 1)
-    for g, _ in model.det_A.factor()[1]:
+    for g, _ in det_a_factors(model):
         degree = g.total_degree()
         for leg in (*model.legs, *model.radical_legs):
             if any(g.degrees()[names.index(v)] > 0 for v in leg.variables):

@@ -174,7 +174,7 @@ def test_reduce_relations_is_the_normal_form_modulo_circles_and_square_roots():
             point = [x, mpmath.cos(a), mpmath.sqrt(3), mpmath.sin(a), mpmath.cos(b),
                      mpmath.sin(b), mpmath.sqrt(2)]
 
-            def value(q):
+            def value(q, point=point):
                 total = mpmath.mpf(0)
                 for exps, c in q.terms():
                     term = mpmath.mpf(int(c.p)) / int(c.q)

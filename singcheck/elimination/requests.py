@@ -215,7 +215,8 @@ def norm_chain(g: fmpq_mpoly, legs: list[tuple[object, fmpq_mpoly]],
     from singcheck.elimination.cas.forked import until_deadline
 
     def stoppable(fn, p: fmpq_mpoly, what: str):  # one FLINT call a deadline can stop
-        return until_deadline(fn, p, f"the norm chain's {what}", may_be_slow(p))
+        return until_deadline(fn, p, f"the norm chain's {what}",
+                              may_be_slow(p, squarefree=what == "squarefree part"))
 
     names = g.context().names()
     _, factors = stoppable(lambda p: p.factor(), g, "factorization")

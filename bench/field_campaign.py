@@ -74,6 +74,7 @@ FIVE, RPR, PRR = "robots/five-bar.yaml", "robots/3-rpr.yaml", "robots/3-prr.yaml
 LDELTA, RDELTA = "robots/linear-delta.yaml", "robots/rotary-delta.yaml"
 GS = "robots/gough-stewart.yaml"
 RRR = "tests/data/robots/3-rrr.yaml"
+LIMITS_5BAR = "joint_limits: {th1: [pi/3, pi], th2: [0, 2*pi/3]}\n"
 
 #: (name, robot file or variant, trajectory text (YAML, or CSV when the name ends in .csv),
 #:  what it is meant to show)
@@ -258,6 +259,59 @@ INPUTS: list[tuple] = [
                {"t": 1, "x": 0.1, "y": 0, "z": 2, "psi": 1.8, "theta": 0.05, "phi": 0},
                {"t": 2, "x": 0.1, "y": 0.1, "z": 2.1, "psi": 1.8, "theta": 0.05, "phi": 0.05}),
      "six coordinates through decimal waypoints, turning past psi ~ 1.55"),
+    # --- fourth round: close double crossings, one-mode selections, mode switches -------
+    ("biglide-double-close", BIGLIDE, path("[0, 1]", x="t", y="(t - 1/2)^2 - 1/100000000"),
+     "two crossings 2e-4 apart (polynomial: exact engine)"),
+    ("biglide-double-close-cos", BIGLIDE, path("[0, 2]", x="t/2", y="1 - cos(t - 1) - 1/100000000"),
+     "two crossings about 2.8e-4 apart in a shifted cosine (interval engine)"),
+    ("biglide-mode-switch", variant(BIGLIDE, ("{p: [-4, 4]", "{p: [-1, 1]")),
+     path("[0, 1]", x="2*t - 1", y="6/5"),
+     "p+ leaves [-1, 1] at x = -0.6 before p- enters it at 0.6: no mode lasts"),
+    ("3-rrr-one-mode", variant(RRR, ("constraints:",
+                                     "joint_limits: {th1: [-2.5, -0.5], th2: [0.2, 1.2], "
+                                     "th3: [0.5, 1.5]}\nconstraints:")),
+     path("[0, 1]", x="sin(t)/5", y="cos(2*t)/10 - 1/10", phi="0.05"),
+     "decimal limits keep the mode ++- of the home pose; a decimal constant angle"),
+    ("rotary-delta-degrees", variant(RDELTA, ("{th1: [-pi/2, 3*pi/4], th2: [-pi/2, 3*pi/4], "
+                                              "th3: [-pi/2, 3*pi/4]}",
+                                              "{th1: [-80 deg, 130 deg], th2: [-80 deg, 130 deg],"
+                                              " th3: [-80 deg, 130 deg]}")),
+     "trajectories/rotary-delta-cross.yaml",
+     "limits in degrees, not multiples of 15, on the bundled crossing"),
+    ("3-prr-decimal-limits", variant(PRR, ("{r1: [2, 6], r2: [2, 6], r3: [-2, 1]}",
+                                           "{r1: [2.5, 5.5], r2: [2.5, 5.5], r3: [-1.5, 0.5]}")),
+     path("[0, 1]", x="3/2 + sin(t)/2", y="2 - cos(t)/2", phi="0.1*t + 0.3"),
+     "decimal limits; the bundled arc turning by 0.1*t + 0.3 (irrational cosines)"),
+    # --- fifth round: serial touches, pi-rescaled circles, Euler-angle lock ------------
+    ("biglide-serial-touch", BIGLIDE, path("[0, pi]", x="0", y="3/2*sin(t)"),
+     "y reaches 3/2 at t = pi/2: leg q's two branches meet (serial singularity)"),
+    ("biglide-serial-touch-shifted", BIGLIDE, path("[0, 2]", x="0", y="3/2*cos(t - 1)"),
+     "the same serial touch at t = 1 in a shifted cosine (interval engine)"),
+    ("biglide-2pi-circle", BIGLIDE, path("[0, 1]", x="cos(2*pi*t)/2", y="sin(2*pi*t)/2"),
+     "a circle in 2*pi*t (rescaled exactly): singular at 0, 1/2 and 1"),
+    ("biglide-third-pi", BIGLIDE, path("[0, 4]", x="1/2", y="sin(pi*t/3)/2"),
+     "sin(pi*t/3): singular at 0 and 3"),
+    ("gough-stewart-pitch-lock", GS, path("[1.4, 1.7]", x="0", y="0", z="2", psi="0",
+                                          theta="t", phi="0"),
+     "pitch theta through pi/2, where Z-Y-X Euler angles lock (cos theta in det A)"),
+    # --- sixth round: square roots in robots and tangent lines ------------------------
+    ("ortho-sqrt-leg", variant(ORTHO, ("{l: 2}", "{l: sqrt(5)}")), "trajectories/heart1.yaml",
+     "leg length sqrt(5) on heart 1: the exact engine through norms over Q(sqrt 5)"),
+    ("skew-real-rail", variant(SKEW, ("constraints:", "parameters: {l1: 2, l2: 3/2, "
+                                      "c: cos(1), s: sin(1)}\nconstraints:"),
+                               ("parameters: {l1: 2, l2: 3/2}\n", ""),
+                               ("(x - 3/5*rho2)^2 + (y - 4/5*rho2)^2",
+                                "rho2^2 - 2*rho2*(c*x + s*y) + x^2 + y^2")),
+     path("[-pi, pi]", x="-1 + cos(t)", y="-1 + sin(t)/2"),
+     "the rail at angle 1 rad (cos 1, sin 1: real parameters), its leg expanded so that "
+     "rho2^2 has coefficient 1 (written as (x - c*rho2)^2 + (y - s*rho2)^2 it is refused, "
+     "exit 2: c^2 + s^2 is not seen to be 1): interval engine"),
+    ("five-bar-circle-top", variant(FIVE, (LIMITS_5BAR, "")),
+     path("[-1, 1]", x="t/4", y="sqrt(3) + 2"),
+     "no limits; the line touches the circle of radius 2 about (0, sqrt 3) at its top"),
+    ("five-bar-circle-tangent", variant(FIVE, (LIMITS_5BAR, "")),
+     path("[-1/4, 1/4]", x="sqrt(3) - t/2", y="sqrt(3) + 1 + sqrt(3)*t/2"),
+     "no limits; tangent to that circle at 30 degrees, sqrt 3 in the path"),
 ]
 
 SAMPLES = {"ortho-constant": 8, "3-rpr-constant-tilt": 8,
@@ -276,6 +330,8 @@ def materialise(item, work: Path):
         robot_file.write_text(text)
     else:
         robot_file = ROOT / robot
+    if "\n" not in traj:  # a bundled trajectory file
+        return robot_file, ROOT / traj
     traj_file = work / (name if name.endswith(".csv") else f"{name}.yaml")
     traj_file.write_text(traj)
     return robot_file, traj_file

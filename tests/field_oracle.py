@@ -429,7 +429,11 @@ def judge(robot: OracleRobot, pieces: list[Piece], samples: int = 600) -> Oracle
             for j in range(len(ds)):
                 lo_ok = j == 0 or abs(ds[j]) <= abs(ds[j - 1])
                 hi_ok = j == len(ds) - 1 or abs(ds[j]) <= abs(ds[j + 1])
-                if not (lo_ok and hi_ok) or abs(ds[j]) < mp.mpf(10) ** -40:
+                strict = ((j > 0 and abs(ds[j]) < abs(ds[j - 1]))
+                          or (j < len(ds) - 1 and abs(ds[j]) < abs(ds[j + 1])))
+                # a dip of |det A| (not a plateau, and well below its largest value)
+                if (not (lo_ok and hi_ok and strict) or abs(ds[j]) < tiny
+                        or abs(ds[j]) > scale / 10):
                     continue
                 a, b = ts[max(j - 1, 0)], ts[min(j + 1, len(ts) - 1)]
                 if any(a <= c <= b for c in r.crossings):

@@ -174,37 +174,62 @@ def test_a_tangency_of_a_shifted_cosine_is_singular_or_an_unknown_window(tmp_pat
     assert_agrees(singcheck(robot_file, traj_file), truth, touch_may_be_unknown=True)
 
 
-def test_a_singular_mode_keeps_its_windows_at_the_other_end(tmp_path):
-    """x = t, y = sin(2πt)/2 on [0, 1]: the biglide (det A = 4·y·(q − p), q ≠ p on every
-    pose it reaches) is singular at t = 0, 1/2 and 1 in all four modes.  The pose at
-    t = 0 is rational, so det A = 0 is proven there exactly, and the interval engine then
-    stops searching those modes; at t = 1 the pose is rational too but its enclosure is
-    not exact (sin 2π as a ball), so it is not proven.  singcheck once dropped the window
-    at t = 1 silently (singular times 0 and 1/2 only, nothing undecided); now each
-    singular time is listed or lies in a window the report names as undecided."""
-    robot_file, traj_file = files(tmp_path, BIGLIDE, path("[0, 1]", x="t", y="sin(2*pi*t)/2"))
+def _biglide_sine_oracle(x):
+    """The zeros of det A = 4·y·(q − p) on y = sin(2πt)/2, t ∈ [0, 1]: those of y (q − p
+    stays away from 0 in every mode, checked at 50 digits), found by mpmath."""
     mp.mp.dps = 50
     y = lambda t: mp.sin(2 * mp.pi * t) / 2  # noqa: E731
     roots = sorted({mp.findroot(y, mp.mpf(g)) for g in ("0", "0.49", "0.99")})
     assert [float(r) for r in roots] == [0.0, 0.5, 1.0]
-    for t in (mp.mpf("0.1"), mp.mpf("0.7")):  # q − p stays away from 0: det A ∝ y
-        x, yy = t, y(t)
-        for sp_ in (1, -1):
-            for sq in (1, -1):
-                p = x + sp_ * mp.sqrt(4 - yy**2)
-                q = x + sq * mp.sqrt(mp.mpf(9) / 4 - yy**2)
+    for k in range(101):
+        t = mp.mpf(k) / 100
+        for s1 in (1, -1):
+            for s2 in (1, -1):
+                p = x(t) + s1 * mp.sqrt(4 - y(t) ** 2)
+                q = x(t) + s2 * mp.sqrt(mp.mpf(9) / 4 - y(t) ** 2)
                 assert abs(q - p) > mp.mpf("0.4")
+    return [float(r) for r in roots]
+
+
+def test_a_singular_mode_keeps_its_windows_at_the_other_end(tmp_path):
+    """x = √2·t, y = sin(2πt)/2 on [0, 1]: the biglide is singular at t = 0, 1/2 and 1 in
+    all four modes.  The pose at t = 0 is rational, so det A = 0 is proven there exactly,
+    and the interval engine then stops searching those modes; at t = 1 the pose (√2, 0)
+    is not rational, so that zero is not proven.  singcheck once dropped the window at
+    t = 1 silently (singular times 0 and 1/2 only, nothing undecided); now each singular
+    time is listed or lies in a window the report names as undecided, with the reason."""
+    roots = _biglide_sine_oracle(lambda t: mp.sqrt(2) * t)
+    robot_file, traj_file = files(tmp_path, BIGLIDE,
+                                  path("[0, 1]", x="sqrt(2)*t", y="sin(2*pi*t)/2"))
     result = singcheck(robot_file, traj_file)
     assert result["verdict"] == "singular"
     times = singular_times(result)
     windows = [u["t_interval"] for u in result["undecided"]]
     for r in roots:
-        assert close_to_any(float(r), times) or any(a - TOL <= r <= b + TOL
-                                                     for a, b in windows), (r, times, windows)
+        assert close_to_any(r, times) or any(a - TOL <= r <= b + TOL
+                                             for a, b in windows), (r, times, windows)
     for t in times:
-        assert close_to_any(t, [float(r) for r in roots])
-    assert all("did not search this window further" in u["reason"]
-               for u in result["undecided"])
+        assert close_to_any(t, roots)
+    assert windows and all("did not search this window further" in u["reason"]
+                           for u in result["undecided"])
+
+
+def test_a_rational_pose_at_a_multiple_of_pi_is_decided_exactly(tmp_path):
+    """x = t, y = sin(2πt)/2 on [0, 1]: at t = 1 the pose is (1, 0), rational, but its
+    ball is not exact (sin 2π over a ball of π); the expression tree evaluated in
+    Q + Qπ with the rational sines of rational multiples of π gives it exactly, so
+    det A = 0 is proven at both ends (before: t = 1 was missing, then undecided)."""
+    roots = _biglide_sine_oracle(lambda t: t)
+    robot_file, traj_file = files(tmp_path, BIGLIDE, path("[0, 1]", x="t", y="sin(2*pi*t)/2"))
+    result = singcheck(robot_file, traj_file)
+    assert result["verdict"] == "singular"
+    assert result["undecided"] == []
+    for mode in result["working_modes"]:
+        assert len(mode["singular_times"]) == 3
+        for t, r in zip(mode["singular_times"], roots, strict=True):
+            assert abs(t - r) <= TOL
+    ends = [c for c in result["candidates"] if c["t"] == 1.0]
+    assert ends and all(m["proof"].startswith("det A = 0 exactly") for m in ends[0]["modes"])
 
 
 @pytest.mark.slow

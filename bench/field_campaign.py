@@ -228,7 +228,9 @@ INPUTS: list[tuple] = [
      "a real proximal length: free line, interval engine with revolute legs"),
     # --- third round: pi-rescaled times, ends at +-pi, units, long and late ranges ------
     ("biglide-2pi-rescaled", BIGLIDE, path("[0, 1]", x="t", y="sin(2*pi*t)/2"),
-     "sin(2*pi*t): singular at both range ends and at 1/2"),
+     "sin(2*pi*t) beside a bare t: singular at both range ends and at 1/2"),
+    ("biglide-2pi-sqrt2", BIGLIDE, path("[0, 1]", x="sqrt(2)*t", y="sin(2*pi*t)/2"),
+     "the same, ending at the irrational pose (sqrt 2, 0)"),
     ("biglide-ends-at-plus-minus-pi", BIGLIDE, path("[-pi, pi]", x="cos(t)/2", y="sin(t)/2"),
      "a circle about a rail point: singular at -pi, 0 and pi"),
     ("biglide-rail-then-leave", BIGLIDE,

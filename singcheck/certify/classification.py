@@ -568,11 +568,11 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
     window."""
     feasible = [m for m in modes if m.status == FEASIBLE]
     at_end = _end_zeros(path, feasible)
+    # a mode where det A = 0 exactly at a range end is singular: its other zeros do
+    # not change the verdict, and it is not refined (a hexapod's mode lying on its
+    # singularity all along would spend the whole budget)
+    known = {label for zero in at_end.values() for label, z in zero.items() if z}
     if searches is None:
-        # a mode where det A = 0 exactly at a range end is singular: its other zeros do
-        # not change the verdict, and it is not refined (a hexapod's mode lying on its
-        # singularity all along would spend the whole budget)
-        known = {label for zero in at_end.values() for label, z in zero.items() if z}
         searches = search_det_a(path, feasible, refine={m.label for m in feasible
                                                          if m.label not in known}
                                 ) if feasible else {}
@@ -585,7 +585,13 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
     candidates.sort(key=lambda c: float(c.t.mid()))
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
+    # a singular mode's windows away from its singular end stay in the report: the
+    # verdict does not rest on them, but they may hold more singular times of that mode
     undecided = [(arb(w.lo).union(arb(w.hi)),
+                  f"mode {m.label} is proven singular at a range end, so the interval "
+                  f"engine did not search this window further (|det A| ≤ {w.bound:.3g}): "
+                  f"it may hold more singular times of that mode, and {path.exact_refused}"
+                  if m.label in known else
                   f"the interval engine could not prove det A ≠ 0 along mode {m.label} "
                   f"there (|det A| ≤ {w.bound:.3g}), and {path.exact_refused}")
                  for m in feasible for w in searches[m.label].windows
@@ -644,8 +650,9 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
             continue
         singular = [m for m in feasible if zero.get(m.label)]
         mine = [(m, w) for m, w in touching if zero.get(m.label)]
-        # the mode is singular: its windows elsewhere (not refined) decide nothing more
-        settled |= {(m.label, w) for m in singular for w in searches[m.label].windows}
+        # the zero at this end settles the windows there; the mode's windows elsewhere
+        # (not refined) decide nothing more, but are reported as undecided
+        settled |= {(m.label, w) for m, w in mine}
         # the enclosure: the end, and the windows there (the certificate's checker skips
         # them as the singular stretch, and re-proves det A = 0 at the end exactly)
         for _, w in mine:

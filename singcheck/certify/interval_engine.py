@@ -243,6 +243,7 @@ def _summarise(label: str, found: dict) -> ModeSearch:
     out = ModeSearch(label)
     run: list = []
     before: int | None = None
+    monotone: Window | None = None  # the last window, when a proven simple crossing
 
     def close(after: int | None) -> None:
         if run:
@@ -254,9 +255,23 @@ def _summarise(label: str, found: dict) -> ModeSearch:
         s, bound = entry[0], entry[1]
         if len(entry) == 3:  # a proven simple crossing
             close(None)
-            out.windows.append(Window(lo, hi, bound, *entry[2]))
-            before = entry[2][1]
+            left, right = entry[2]
+            last = monotone
+            if (last is not None and out.windows and out.windows[-1] is last
+                    and lo <= last.hi and last.right != left):
+                # two simple crossings on pieces that overlap (their balls' rounded
+                # ends): this one's sign changes between its start and the last one's
+                # end, both inside the last piece, where det A has one zero only: the
+                # same zero, counted once (y = sin(2πt)/2 of the biglide, t = 1/2)
+                end, after = (hi, right) if hi >= last.hi else (last.hi, last.right)
+                out.windows[-1] = Window(last.lo, end, max(bound, last.bound), last.left,
+                                         after)
+            else:
+                out.windows.append(Window(lo, hi, bound, left, right))
+            monotone = out.windows[-1]
+            before = right
             continue
+        monotone = None
         if s is None:
             run.append((lo, hi, bound))
             continue

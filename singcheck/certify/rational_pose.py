@@ -18,6 +18,9 @@ factoring).  Robots with square roots among their numbers are not handled (None)
 
 from __future__ import annotations
 
+from fractions import Fraction
+from math import isqrt
+
 from flint import fmpq, fmpq_mat, fmpz
 
 from singcheck.algebra.trig import TRIG, LinearInPi
@@ -66,14 +69,111 @@ def rational_pose(path, end: LinearInPi) -> list[fmpq] | None:
 
 def _exact_ball(x, end: LinearInPi) -> fmpq | None:
     """x at the end, when its enclosure there is an exact ball (radius 0: every operation
-    was exact, as sin 0 = 0 is): that ball *is* the value, a dyadic rational."""
+    was exact, as sin 0 = 0 is): that ball *is* the value, a dyadic rational; else its
+    exact value when every variable of its ring has one (:func:`_exact_value`)."""
     from singcheck.algebra.radicals import evaluate_path
 
     ball = evaluate_path(x, end.ball())
     if not ball.is_finite() or not ball.is_exact():
-        return None
+        return _exact_value(x, end)
     man, exp = ball.mid().man_exp()
     return fmpq(man * fmpz(2) ** int(exp)) if exp >= 0 else fmpq(man, fmpz(2) ** int(-exp))
+
+
+#: sin(bπ) for the b in [0, 2) where it is rational (Niven: 0, ±1/2, ±1)
+_RATIONAL_SINES = {Fraction(0): 0, Fraction(1, 6): Fraction(1, 2), Fraction(1, 2): 1,
+                   Fraction(5, 6): Fraction(1, 2), Fraction(1): 0,
+                   Fraction(7, 6): Fraction(-1, 2), Fraction(3, 2): -1,
+                   Fraction(11, 6): Fraction(-1, 2)}
+
+
+def _sine(a: Fraction, b: Fraction) -> Fraction | None:
+    """sin(a + bπ) when it is rational and known so exactly (a = 0), else None."""
+    if a:
+        return None
+    value = _RATIONAL_SINES.get(b % 2)
+    return None if value is None else Fraction(value)
+
+
+def _tree_value(node, t: tuple[Fraction, Fraction], parameter: str, constants: dict):
+    """An expression tree's exact value a + bπ as (a, b), or None where it is not known
+    exactly this way (a product of two π parts, a sine that is irrational, …)."""
+    k = node.kind
+    if k == "num":
+        return (node.value, Fraction(0)) if isinstance(node.value, Fraction) else None
+    if k == "name":
+        if node.value == parameter:
+            return t
+        if node.value == "pi":
+            return Fraction(0), Fraction(1)
+        value = constants.get(node.value)
+        return (value, Fraction(0)) if isinstance(value, Fraction) else None
+    args = [_tree_value(a, t, parameter, constants) for a in node.args]
+    if any(a is None for a in args):
+        return None
+    if k == "neg":
+        return -args[0][0], -args[0][1]
+    if k in ("add", "sub"):
+        sign = 1 if k == "add" else -1
+        return args[0][0] + sign * args[1][0], args[0][1] + sign * args[1][1]
+    if k == "mul":
+        (a, b), (c, d) = args
+        if b and d:
+            return None
+        return a * c, a * d + b * c
+    if k == "div":
+        (a, b), (c, d) = args
+        if d or not c:
+            return None
+        return a / c, b / c
+    if k == "pow":
+        (a, b), (e, f) = args
+        if b or f or e.denominator != 1 or e < 0:
+            return None
+        return a ** int(e), Fraction(0)
+    if k == "call":
+        (a, b), = args
+        if node.value == "sin":
+            value = _sine(a, b)
+        elif node.value == "cos":
+            value = _sine(a, b + Fraction(1, 2))
+        elif b or a < 0:
+            value = None
+        else:  # sqrt of a rational square
+            num, den = isqrt(a.numerator), isqrt(a.denominator)
+            value = Fraction(num, den) if Fraction(num * num, den * den) == a else None
+        return None if value is None else (value, Fraction(0))
+    return None
+
+
+def _exact_value(x, end: LinearInPi) -> fmpq | None:
+    """x at the end exactly, when t (or its sine and cosine) and every opaque
+    coordinate of its ring have exact rational values there: a coordinate's expression
+    tree evaluated in Q + Qπ, with the rational sines of rational multiples of π
+    (y = sin(2πt)/2 at t = 1 is 0, though its ball there is not exact)."""
+    from singcheck.algebra.opaque import opaque_of
+
+    t = (end.rational, end.pi_coefficient)
+    s, c = _sine(*t), _sine(t[0], t[1] + Fraction(1, 2))
+    values: list = [None if t[1] else t[0], s, c]
+    for name in x.context().names()[3:]:
+        hit = opaque_of(name)
+        if hit is None or hit[1] != "X":
+            values.append(None)
+            continue
+        f = hit[0]
+        value = _tree_value(f.tree, t, f.parameter, dict(f.constants))
+        values.append(value[0] if value is not None and not value[1] else None)
+    total = Fraction(0)
+    for exps, coeff in x.terms():
+        term = Fraction(int(coeff.p), int(coeff.q))
+        for v, e in zip(values, exps, strict=True):
+            if e:
+                if v is None:
+                    return None
+                term *= v ** int(e)
+        total += term
+    return fmpq(total.numerator, total.denominator)
 
 
 def _legs_at(model, point: dict) -> list | None:

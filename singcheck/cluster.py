@@ -115,6 +115,32 @@ def _pause_diagnostics(dask_worker) -> None:
             saved[name] = pc.callback_time
             pc.callback_time = ms
     server._singcheck_saved = saved
+    _fewer_collections(+1)
+
+
+def _fewer_collections(step: int) -> None:
+    """While any server of this process (worker or nanny: a LocalCluster's nannies
+    share the client's process) is in a batch, the cyclic garbage collector's first
+    threshold is raised as the command line raises it for itself and its ``--jobs``
+    workers (``cli.commands._fewer_collections``: a process holds tens of thousands of
+    long-lived objects, scanned again at every full collection; 2% of a path); the
+    last one to leave restores it.  ``step``: +1 entering, -1 leaving."""
+    import gc
+
+    held = _GC["held"] + step
+    _GC["held"] = max(held, 0)
+    if step > 0 and held == 1:
+        _GC["before"] = gc.get_threshold()
+        gc.set_threshold(max(_GC["before"][0], GC_THRESHOLD), *_GC["before"][1:])
+    elif step < 0 and held == 0 and _GC["before"] is not None:
+        gc.set_threshold(*_GC["before"])
+        _GC["before"] = None
+
+
+#: the garbage collector's first threshold during a batch (the command line's own)
+GC_THRESHOLD = 50_000
+#: this process's servers in a batch, and the thresholds to restore after the last
+_GC: dict = {"held": 0, "before": None}
 
 
 def _resume_diagnostics(dask_worker) -> None:
@@ -127,6 +153,7 @@ def _resume_diagnostics(dask_worker) -> None:
         return
     from time import time
 
+    _fewer_collections(-1)
     saved = getattr(server, "_singcheck_saved", {})
     if "tick" in saved and hasattr(server, "_last_tick"):
         # the pause is not the event loop being unresponsive: measure from now on

@@ -444,12 +444,15 @@ def test_the_dask_run_gives_the_local_verdicts(local_cluster, tmp_path, orthogli
 
 
 def _diagnostics(dask_worker) -> dict:
-    """On a worker or nanny: which periodic diagnostics run, and the memory monitor's
-    period (ms)."""
+    """On a worker or nanny: which periodic diagnostics run, the memory monitor's
+    period (ms), and the garbage collector's first threshold."""
+    import gc
+
     from singcheck.cluster import DIAGNOSTICS
 
     callbacks = dask_worker.periodic_callbacks
     out = {n: callbacks[n].is_running() for n in DIAGNOSTICS if n in callbacks}
+    out["gc"] = gc.get_threshold()[0]
     if "memory_monitor" in callbacks:
         out["memory_monitor"] = callbacks["memory_monitor"].callback_time
     return out
@@ -458,11 +461,12 @@ def _diagnostics(dask_worker) -> dict:
 def test_a_dask_batch_pauses_the_workers_diagnostics_and_restores_them(
         local_cluster, tmp_path, orthoglide_robot):
     """While a batch runs, every worker's and nanny's profiler, tick and system monitor
-    are paused and the memory monitor polls every second (not 100 ms); once the batch
-    has ended, or is stopped early, they are as they were."""
+    are paused, the memory monitor polls every second (not 100 ms) and the garbage
+    collector's first threshold is the command line's own; once the batch has ended, or
+    is stopped early, they are as they were."""
     from distributed import Client
 
-    from singcheck.cluster import check_on_cluster
+    from singcheck.cluster import GC_THRESHOLD, check_on_cluster
     from singcheck.spec.files import load_trajectories
 
     specs = list(load_trajectories(_generated(tmp_path, 12), orthoglide_robot.spec))
@@ -474,14 +478,16 @@ def test_a_dask_batch_pauses_the_workers_diagnostics_and_restores_them(
         assert len(before) == 4 and all(d["profile"] for d in before[:2])
         assert all(d["tick"] and d["monitor"] and d["memory_monitor"] == 100
                    for d in before)
+        assert all(d["gc"] < GC_THRESHOLD for d in before)
         for stop_early in (False, True):
             results = check_on_cluster(local_cluster.scheduler_address, orthoglide_robot,
                                        specs, regions=False)
             first = next(results)
             assert first["verdict"] in ("singular", "singularity-free", "infeasible")
             during = every(False) + every(True)
-            assert all(not any(v for k, v in d.items() if k != "memory_monitor")
-                       and d["memory_monitor"] == 1000 for d in during), during
+            assert all(not any(v for k, v in d.items() if k not in ("memory_monitor", "gc"))
+                       and d["memory_monitor"] == 1000 and d["gc"] == GC_THRESHOLD
+                       for d in during), during
             if stop_early:
                 results.close()  # (the CLI's Ctrl-C, or a consumer that stops)
             else:

@@ -409,14 +409,7 @@ def test_the_norm_steps_on_large_polynomials_run_where_the_deadline_stops_them(
     from singcheck.elimination.cas import forked
     from singcheck.elimination.requests import norm_chain
 
-    calls = []
-    real = forked.until_deadline
-
-    def spy(fn, argument, what, costly):
-        calls.append((what, costly))
-        return real(fn, argument, what, costly)
-
-    monkeypatch.setattr(forked, "until_deadline", spy)
+    calls = _spied_forks(monkeypatch)
     ring = fmpq_mpoly_ctx.get(("r", "t", "s", "c"), "lex")
     r, t, s, c = ring.gens()
     if where == "norm_chain":
@@ -486,16 +479,8 @@ def test_may_be_slow_flags_the_measured_slow_shapes(nvars, terms, degree, bits, 
 def test_the_rotary_delta_circle_runs_its_squarefree_parts_in_this_process(monkeypatch):
     """The free circle's norm chain forks no call (its two squarefree parts took 7 and 5
     ms here, a fork and its pickled result 20 and 13 ms); its verdict is unchanged."""
-    from singcheck.elimination.cas import forked
 
-    calls = []
-    real = forked.until_deadline
-
-    def spy(fn, argument, what, costly):
-        calls.append((what, costly))
-        return real(fn, argument, what, costly)
-
-    monkeypatch.setattr(forked, "until_deadline", spy)
+    calls = _spied_forks(monkeypatch)
     robot = api.load_robot(ROTARY, backend="flint", cache=False)
     spec = api.load_trajectory(TRAJECTORIES / "rotary-delta-free.yaml", robot)
     report = api.check(robot, spec, time_limit=300, regions=False)
@@ -524,3 +509,18 @@ def test_a_costly_rotary_delta_path_stops_within_a_second_of_its_limit(rotary, t
     elapsed = time.monotonic() - start
     assert report.verdict == "unknown" and "time limit" in report.reason
     assert elapsed < limit + 1, elapsed
+
+
+def _spied_forks(monkeypatch) -> list[tuple[str, bool]]:
+    """Every stoppable FLINT call from now on, as (what, costly), recorded as it runs."""
+    from singcheck.elimination.cas import forked
+
+    calls: list[tuple[str, bool]] = []
+    real = forked.until_deadline
+
+    def spy(fn, argument, what, costly):
+        calls.append((what, costly))
+        return real(fn, argument, what, costly)
+
+    monkeypatch.setattr(forked, "until_deadline", spy)
+    return calls

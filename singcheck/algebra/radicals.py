@@ -35,6 +35,7 @@ from flint import arb, ctx, fmpq, fmpq_mpoly, fmpq_mpoly_ctx, fmpz
 
 from singcheck.algebra.intervals import power
 from singcheck.algebra.opaque import has_opaque_coordinates, is_opaque, opaque_ball, opaque_of
+from singcheck.algebra.polynomials import memo_per_object
 from singcheck.algebra.trig import TRIG, evaluate_trig, evaluate_trig_at
 
 MAX_RADICAND_BITS = 64
@@ -306,20 +307,15 @@ def constant_surd(p: fmpq_mpoly) -> Surd | None:
 def radical_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
     """[(index, p)] for every ``sqrt(p)`` variable of ``ctx`` (read once per context:
     asked at every candidate)."""
-    hit = _RADICAL_VARIABLES.get(id(ctx))
-    if hit is None or hit[0] is not ctx:  # the entry holds ctx: its id is not reused
-        out = []
-        for i, name in enumerate(ctx.names()):
-            p = radical_prime(name)
-            if p is not None:
-                out.append((i, p))
-        if len(_RADICAL_VARIABLES) > 256:
-            _RADICAL_VARIABLES.clear()
-        hit = _RADICAL_VARIABLES[id(ctx)] = (ctx, tuple(out))
-    return list(hit[1])
+    def read(ctx: fmpq_mpoly_ctx) -> tuple:
+        return tuple((i, p) for i, p in ((i, radical_prime(n))
+                                          for i, n in enumerate(ctx.names()))
+                     if p is not None)
+
+    return list(memo_per_object(_RADICAL_VARIABLES, ctx, read))
 
 
-_RADICAL_VARIABLES: dict[int, tuple[fmpq_mpoly_ctx, tuple]] = {}
+_RADICAL_VARIABLES: dict = {}
 
 
 def angle_variables(ctx: fmpq_mpoly_ctx) -> list[tuple[int, int]]:
@@ -362,21 +358,18 @@ def reduce_relations(p: fmpq_mpoly) -> fmpq_mpoly:
 def _relations_order(ctx: fmpq_mpoly_ctx, angles, radicals):
     """(the ring of ``ctx`` reordered lexicographically with every sine and square root
     first, the relations sin(v)² + cos(v)² - 1 and sqrt(q)² - q in it), once per ring."""
-    hit = _RELATIONS.get(id(ctx))
-    if hit is not None and hit[0] is ctx:
-        return hit[1], hit[2]
-    names = ctx.names()
-    first = [s for _, s in angles] + [i for i, _ in radicals]
-    order = fmpq_mpoly_ctx.get(tuple(names[i] for i in first) +
-                               tuple(n for i, n in enumerate(names) if i not in first),
-                               "lex")
-    g = dict(zip(order.names(), order.gens(), strict=True))
-    relations = [g[names[s]] ** 2 + g[names[c]] ** 2 - 1 for c, s in angles] + \
-                [g[names[i]] ** 2 - q for i, q in radicals]
-    if len(_RELATIONS) > 256:
-        _RELATIONS.clear()
-    _RELATIONS[id(ctx)] = (ctx, order, relations)  # (ctx held: its id is not reused)
-    return order, relations
+    def build(ctx: fmpq_mpoly_ctx) -> tuple:
+        names = ctx.names()
+        first = [s for _, s in angles] + [i for i, _ in radicals]
+        order = fmpq_mpoly_ctx.get(tuple(names[i] for i in first) +
+                                   tuple(n for i, n in enumerate(names) if i not in first),
+                                   "lex")
+        g = dict(zip(order.names(), order.gens(), strict=True))
+        relations = [g[names[s]] ** 2 + g[names[c]] ** 2 - 1 for c, s in angles] + \
+                    [g[names[i]] ** 2 - q for i, q in radicals]
+        return order, relations
+
+    return memo_per_object(_RELATIONS, ctx, build)
 
 
 _RELATIONS: dict = {}

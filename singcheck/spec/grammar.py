@@ -272,13 +272,21 @@ def _exact_number(text: str, column: int) -> Fraction:
             value = Fraction(text)  # exact decimal: Fraction("0.1") == 1/10
         except (ValueError, ZeroDivisionError):
             raise ExprError(f"bad number {text!r}", column) from None
-        if len(_LITERALS) >= 4096:
-            _LITERALS.clear()
-        _LITERALS[text] = value
+        _kept(_LITERALS, text, value, 4096)
     if max(abs(value.numerator).bit_length(), value.denominator.bit_length()) > \
             MAX_LITERAL_BITS:
         raise ExprError(f"the number {_short(text)} is too large (at most "
                         f"{MAX_LITERAL_BITS} bits)", column)
+    return value
+
+
+def _kept(cache: dict, key, value, keep: int):
+    """``value``, stored under ``key`` in one of the parse's caches, which is emptied when
+    it holds ``keep`` entries (a batch's paths share a few; a hostile stream cannot grow
+    it)."""
+    if len(cache) >= keep:
+        cache.clear()
+    cache[key] = value
     return value
 
 
@@ -307,10 +315,7 @@ def parse(text: str) -> Node:
         return _Parser(text).parse()
     tree = _PARSED.get(text)
     if tree is None:
-        tree = _Parser(text).parse()
-        if len(_PARSED) >= 1024:
-            _PARSED.clear()
-        _PARSED[text] = tree
+        tree = _kept(_PARSED, text, _Parser(text).parse(), 1024)
     return tree
 
 
@@ -794,9 +799,7 @@ def _argument_terms(node: Node, parameter: str, parameters) -> dict | None:
     if hit is not None and hit[0] is parameters and hit[1] == items:
         return None if hit[2] is None else dict(hit[2])
     terms = _argument_terms_of(node, parameter, parameters)
-    if len(_ARGUMENT_TERMS) >= 512:
-        _ARGUMENT_TERMS.clear()
-    _ARGUMENT_TERMS[key] = (parameters, items, terms)
+    _kept(_ARGUMENT_TERMS, key, (parameters, items, terms), 512)
     return None if terms is None else dict(terms)
 
 
@@ -918,10 +921,8 @@ def compile_trajectory_coordinate(node: Node, parameter: str, parameters,
         if hit is None:
             ck, sk = (_into(cos_multiple(k), ring), _into(sin_multiple(k), ring))
             cq, sq = constant(cos_pi(q)), constant(sin_pi(q))
-            hit = ck * cq - sk * sq if n.value == "cos" else sk * cq + ck * sq
-            if len(_SIN_COS) >= 1024:
-                _SIN_COS.clear()
-            _SIN_COS[key] = hit
+            hit = _kept(_SIN_COS, key, ck * cq - sk * sq if n.value == "cos" else
+                        sk * cq + ck * sq, 1024)
         return hit
 
     forbidden = {} if pi_scale is None else {parameter: (

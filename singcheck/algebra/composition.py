@@ -80,7 +80,7 @@ def _cost(a: int, b: int, bits: int, widest: int) -> int:
     return (a + 1) * (2 * b + 1) * (1 + bits // 64) * widest
 
 
-_ONES: dict = {}
+_TOP_BITS: dict = {}  # the largest coefficient bits of each composed polynomial
 _ABW = fmpq_mpoly_ctx.get(("a", "b", "w"), "lex")
 
 
@@ -97,7 +97,7 @@ def composition_work(p: fmpq_mpoly, args: list[fmpq_mpoly]) -> tuple[int, int, i
     answer's correctness rests on it."""
     if p.is_zero():
         return 0, 0, 0
-    ones, top_bits = with_unit_coefficients(p), memo_per_object(_ONES, p, _height_bits)
+    ones, top_bits = with_unit_coefficients(p), memo_per_object(_TOP_BITS, p, _height_bits)
     degrees = p.degrees()
     used = [a for a, d in zip(args, degrees, strict=True) if d > 0]
     widest = max([len(a) for a in used] or [1])

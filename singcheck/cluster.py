@@ -120,26 +120,24 @@ def _pause_diagnostics(dask_worker) -> None:
 
 def _fewer_collections(step: int) -> None:
     """While any server of this process (worker or nanny: a LocalCluster's nannies
-    share the client's process) is in a batch, the cyclic garbage collector's first
-    threshold is raised as the command line raises it for itself and its ``--jobs``
-    workers (``cli.commands._fewer_collections``: a process holds tens of thousands of
-    long-lived objects, scanned again at every full collection; 2% of a path); the
-    last one to leave restores it.  ``step``: +1 entering, -1 leaving."""
+    share the client's process) is in a batch, the cyclic garbage collector is tuned as
+    the command line tunes itself and its ``--jobs`` workers
+    (:func:`singcheck.collector.fewer_collections`); the last one to leave restores it.
+    ``step``: +1 entering, -1 leaving."""
     import gc
+
+    from singcheck.collector import fewer_collections
 
     held = _GC["held"] + step
     _GC["held"] = max(held, 0)
     if step > 0 and held == 1:
-        _GC["before"] = gc.get_threshold()
-        gc.set_threshold(max(_GC["before"][0], GC_THRESHOLD), *_GC["before"][1:])
+        _GC["before"] = fewer_collections()
     elif step < 0 and held == 0 and _GC["before"] is not None:
         gc.set_threshold(*_GC["before"])
         _GC["before"] = None
 
 
-#: the garbage collector's first threshold during a batch (the command line's own)
-GC_THRESHOLD = 50_000
-#: this process's servers in a batch, and the thresholds to restore after the last
+#: this process's servers in a batch, and the collector's thresholds to restore after
 _GC: dict = {"held": 0, "before": None}
 
 

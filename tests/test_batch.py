@@ -468,7 +468,8 @@ def test_a_dask_batch_pauses_the_workers_diagnostics_and_restores_them(
 
     from distributed import Client
 
-    from singcheck.cluster import GC_THRESHOLD, check_on_cluster
+    from singcheck.cluster import check_on_cluster
+    from singcheck.collector import FIRST_THRESHOLD as GC_THRESHOLD
     from singcheck.spec.files import load_trajectories
 
     specs = list(load_trajectories(_generated(tmp_path, 12), orthoglide_robot.spec))

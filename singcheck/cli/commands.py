@@ -13,6 +13,7 @@ import sys
 import click
 
 from singcheck.cli.exitcodes import ExitCode, exit_codes, fail
+from singcheck.collector import fewer_collections
 from singcheck.errors import SpecError, UnsupportedRobotError
 from singcheck.report.progress import Progress
 from singcheck.version import __version__
@@ -918,17 +919,6 @@ def _interrupt_on_signals() -> None:
         signal.signal(sig, interrupt)
 
 
-def _fewer_collections() -> None:
-    """Start-up imports create tens of thousands of long-lived objects (modules, classes,
-    functions), and the cyclic garbage collector would scan them again and again: a few
-    milliseconds of a warm run.  A larger first-generation threshold lets it run less
-    often; it still runs (memory stays bounded in long batches)."""
-    import gc
-
-    threshold, *older = gc.get_threshold()
-    gc.set_threshold(max(threshold, 50_000), *older)
-
-
 def _exit_quickly(code) -> None:
     """End the process now with ``code``, skipping the interpreter's teardown (freeing
     every module and object: several milliseconds of a warm run), when that teardown
@@ -953,7 +943,7 @@ def _exit_quickly(code) -> None:
 
 def main() -> None:
     """Console-script entry point: never lets a traceback reach the user."""
-    _fewer_collections()
+    fewer_collections()  # (the forked --jobs workers inherit it)
     _interrupt_on_signals()
     try:
         cli.main(standalone_mode=False)

@@ -101,15 +101,25 @@ _BALLS: dict[tuple[int, int], tuple[RealConstant, arb]] = {}
 
 def _enclose(node: Node, constants: dict) -> arb:
     """The ball of a checked tree (:func:`real_constant` proved it finite)."""
+    return tree_ball(node, lambda name: arb.pi() if name == "pi" else
+                     constant_ball(constants[name]), _integer)
+
+
+def tree_ball(node: Node, name_ball, exponent) -> arb:
+    """The ball of a checked tree of the grammar at the current precision: numbers
+    exactly, each name by ``name_ball(name)``, each exponent's integer by
+    ``exponent(node)`` (which refuses what it does not take), + - * / ^ and sin, cos,
+    sqrt by Arb (the square root of a ball not proven > 0 is NaN: nothing proven).  A
+    constant's tree here, a real path coordinate's in :mod:`singcheck.spec.real_paths`."""
     k = node.kind
     if k == "num":
         return arb(fmpq(node.value.numerator, node.value.denominator))
     if k == "name":
-        return arb.pi() if node.value == "pi" else constant_ball(constants[node.value])
+        return name_ball(node.value)
     if k == "pow":
-        base, e = _enclose(node.args[0], constants), _integer(node.args[1])
-        return _power(base, e)
-    args = [_enclose(a, constants) for a in node.args]
+        base = tree_ball(node.args[0], name_ball, exponent)
+        return _power(base, exponent(node.args[1]))
+    args = [tree_ball(a, name_ball, exponent) for a in node.args]
     if k == "neg":
         return -args[0]
     if k == "add":
@@ -120,6 +130,8 @@ def _enclose(node: Node, constants: dict) -> arb:
         return args[0] * args[1]
     if k == "div":
         return args[0] / args[1]
+    if k != "call":
+        raise AssertionError(k)  # pragma: no cover
     if node.value == "sin":
         return args[0].sin()
     if node.value == "cos":

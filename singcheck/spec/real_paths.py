@@ -21,7 +21,7 @@ from flint import arb
 
 from singcheck.algebra.intervals import power
 from singcheck.spec.grammar import MAX_EXPONENT, ExprError, Node
-from singcheck.spec.real_constants import constant_ball
+from singcheck.spec.real_constants import constant_ball, tree_ball
 
 _ball = constant_ball  # the ball of a constant the tree names (a parameter's value)
 
@@ -87,40 +87,14 @@ def _dual(node: Node, t: arb, parameter: str, constants: dict) -> tuple[arb, arb
 
 
 def _enclose(node: Node, t: arb, parameter: str, constants: dict) -> arb:
-    k = node.kind
-    if k == "num":
-        return _ball(node.value)
-    if k == "name":
-        if node.value == parameter:
+    """The coordinate's ball over the ball ``t`` of the parameter
+    (:func:`~singcheck.spec.real_constants.tree_ball`)."""
+    def name_ball(name: str) -> arb:
+        if name == parameter:
             return t
-        if node.value == "pi":
-            return arb.pi()
-        return _ball(constants[node.value])
-    args = [_enclose(a, t, parameter, constants) for a in node.args] if k != "pow" else None
-    if k == "neg":
-        return -args[0]
-    if k == "add":
-        return args[0] + args[1]
-    if k == "sub":
-        return args[0] - args[1]
-    if k == "mul":
-        return args[0] * args[1]
-    if k == "div":
-        return args[0] / args[1]
-    if k == "pow":
-        base = _enclose(node.args[0], t, parameter, constants)
-        e = _integer(node.args[1])
-        return arb(1) if e == 0 else power(base, e)
-    if k == "call":
-        x = args[0]
-        if node.value == "sin":
-            return x.sin()
-        if node.value == "cos":
-            return x.cos()
-        if x > 0:
-            return x.sqrt()
-        return arb("nan")  # √ of a ball reaching 0 or below: nothing proven
-    raise AssertionError(k)  # pragma: no cover
+        return arb.pi() if name == "pi" else _ball(constants[name])
+
+    return tree_ball(node, name_ball, _integer)
 
 
 def _integer(node: Node) -> int:

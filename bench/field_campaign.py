@@ -75,6 +75,9 @@ LDELTA, RDELTA = "robots/linear-delta.yaml", "robots/rotary-delta.yaml"
 GS = "robots/gough-stewart.yaml"
 RRR = "tests/data/robots/3-rrr.yaml"
 LIMITS_5BAR = "joint_limits: {th1: [pi/3, pi], th2: [0, 2*pi/3]}\n"
+#: the biglide with legs of 2 mm and 1.5 mm, in metres
+MICRO_BIGLIDE = variant(BIGLIDE, ("- 4\n", "- 0.002^2\n"), ("- 9/4", "- 0.0015^2"),
+                        ("[-4, 4], q: [-4, 4]", "[-0.004, 0.004], q: [-0.004, 0.004]"))
 
 #: (name, robot file or variant, trajectory text (YAML, or CSV when the name ends in .csv),
 #:  what it is meant to show)
@@ -241,13 +244,10 @@ INPUTS: list[tuple] = [
                                    "{rho1: [0, 4000], rho2: [0, 4000], rho3: [0, 4000]}")),
      path("[-pi, pi]", x="1000 + 500*cos(t)", y="500 + 500*sin(t)", z="1000"),
      "the Orthoglide in millimetres (l = 2000) on a circle of radius 500"),
-    ("biglide-micro", variant(BIGLIDE, ("- 4\n", "- 0.002^2\n"), ("- 9/4", "- 0.0015^2"),
-                              ("[-4, 4], q: [-4, 4]", "[-0.004, 0.004], q: [-0.004, 0.004]")),
+    ("biglide-micro", MICRO_BIGLIDE,
      path("[0, 1]", x="1/2000", y="(t - 1/3)/1000"),
      "legs of 2 mm and 1.5 mm in metres: a crossing at t = 1/3"),
-    ("biglide-micro-narrow", variant(BIGLIDE, ("- 4\n", "- 0.002^2\n"), ("- 9/4", "- 0.0015^2"),
-                                     ("[-4, 4], q: [-4, 4]",
-                                      "[-0.004, 0.004], q: [-0.004, 0.004]")),
+    ("biglide-micro-narrow", MICRO_BIGLIDE,
      path("[0, 1]", x="1/2000", y="((t - 1/2)^2 + 1/1000000)/1000"),
      "the same robot within 1e-9 of its singularity: free"),
     ("biglide-long-range", BIGLIDE, path("[0, 1000]", x="1/2", y="cos(t/500)"),

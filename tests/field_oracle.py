@@ -27,6 +27,8 @@ import mpmath as mp
 import sympy as sp
 from sympy.parsing.sympy_parser import parse_expr, standard_transformations
 
+from tests.robot_oracles import _bisect  # (it imports nothing of singcheck's either)
+
 mp.mp.dps = 50
 GOLD = (mp.sqrt(5) - 1) / 2
 ZERO = mp.mpf(10) ** -30  # |det A| below this at a refined minimum: a touch
@@ -247,19 +249,6 @@ def path_pieces(traj: dict, robot_spec: dict, csv_rows=None, interpolation="cubi
 
 # --- one-dimensional search ----------------------------------------------------------
 
-def bisect(f, a, b, fa, iterations=110):
-    for _ in range(iterations):
-        m = (a + b) / 2
-        fm = f(m)
-        if fm == 0:
-            return m
-        if (fm > 0) == (fa > 0):
-            a, fa = m, fm
-        else:
-            b = m
-    return (a + b) / 2
-
-
 def golden_min(f, a, b, iterations=130):
     """The minimum of f on [a, b] (f unimodal there), by golden-section search."""
     c, d = b - GOLD * (b - a), a + GOLD * (b - a)
@@ -425,7 +414,7 @@ def judge(robot: OracleRobot, pieces: list[Piece], samples: int = 600) -> Oracle
                 if (da > 0) != (db > 0):
                     if any(ta < t < tb for t in r.crossings):
                         continue  # an exact zero at a sample between them
-                    r.crossings.append(bisect(f, ta, tb, da))
+                    r.crossings.append(_bisect(f, ta, tb, da, steps=110))
             for j in range(len(ds)):
                 lo_ok = j == 0 or abs(ds[j]) <= abs(ds[j - 1])
                 hi_ok = j == len(ds) - 1 or abs(ds[j]) <= abs(ds[j + 1])

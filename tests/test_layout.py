@@ -13,6 +13,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "singcheck"
 STAGES = ["verify", "algebra", "spec", "model", "elimination", "roots", "certify", "spaces",
           "report", "api", "cli"]
 FOUNDATION = {"errors", "budget", "atomic", "version",  # importable by every stage
+              "collector",  # the garbage collector's tuning (imports only gc)
               "schemas"}  # data files (the JSON Schemas) and a reader
 ONLY_IN = {"click": {"cli"}, "rich": {"report"}, "matplotlib": {"report"}}
 

@@ -194,7 +194,7 @@ def _biglide_sine_oracle(x):
 def test_a_singular_mode_keeps_its_windows_at_the_other_end(tmp_path):
     """x = √2·t, y = sin(2πt)/2 on [0, 1]: the biglide is singular at t = 0, 1/2 and 1 in
     all four modes.  The pose at t = 0 is rational, so det A = 0 is proven there exactly,
-    and the interval engine then stops searching those modes; at t = 1 the pose (√2, 0)
+    and the interval engine then searches those modes on a small budget; at t = 1 the pose (√2, 0)
     is not rational, so that zero is not proven.  singcheck once dropped the window at
     t = 1 silently (singular times 0 and 1/2 only, nothing undecided); now each singular
     time is listed or lies in a window the report names as undecided, with the reason."""
@@ -210,7 +210,7 @@ def test_a_singular_mode_keeps_its_windows_at_the_other_end(tmp_path):
                                              for a, b in windows), (r, times, windows)
     for t in times:
         assert close_to_any(t, roots)
-    assert windows and all("did not search this window further" in u["reason"]
+    assert windows and all("on a first pass's budget only" in u["reason"]
                            for u in result["undecided"])
 
 
@@ -230,6 +230,39 @@ def test_a_rational_pose_at_a_multiple_of_pi_is_decided_exactly(tmp_path):
             assert abs(t - r) <= TOL
     ends = [c for c in result["candidates"] if c["t"] == 1.0]
     assert ends and all(m["proof"].startswith("det A = 0 exactly") for m in ends[0]["modes"])
+
+
+def test_a_mode_singular_at_an_end_has_its_other_singular_times_listed(tmp_path):
+    """x = t/2, y = sin(2πt)/2 + t²/100 on [0, 2.3] (only the interval engine takes π·t):
+    det A = 0 exactly at t = 0 along all four modes.  Those modes were not searched
+    further, so their one window was the whole range, settled by the zero at t = 0: the
+    report gave t = 0 only, its enclosure [0, 2.3].  Now every zero of y is a singular
+    time of every mode, one candidate each, nothing undecided.  Oracle: det A = 4·y·(q − p)
+    (q − p ≠ 0: checked at 50 digits), so the singular times are the zeros of y,
+    bracketed by sign changes on a 2,300-point grid and refined by mpmath."""
+    mp.mp.dps = 50
+    y = lambda t: mp.sin(2 * mp.pi * t) / 2 + t**2 / 100  # noqa: E731
+    grid = [mp.mpf(k) / 1000 for k in range(1, 2301)]
+    roots = [0.0] + [float(mp.findroot(y, (a, b), solver="anderson"))
+                     for a, b in zip(grid, grid[1:], strict=False) if y(a) * y(b) < 0]
+    assert len(roots) == 5
+    for t in grid[::10]:
+        for s1 in (1, -1):
+            for s2 in (1, -1):
+                p = t / 2 + s1 * mp.sqrt(4 - y(t) ** 2)
+                q = t / 2 + s2 * mp.sqrt(mp.mpf(9) / 4 - y(t) ** 2)
+                assert abs(q - p) > mp.mpf("0.4")
+    robot_file, traj_file = files(tmp_path, BIGLIDE, path(
+        "[0, 2.3]", x="t/2", y="sin(2*pi*t)/2 + t^2/100"))
+    result = singcheck(robot_file, traj_file)
+    assert result["verdict"] == "singular" and result["undecided"] == []
+    assert len(result["candidates"]) == len(roots)
+    for c, r in zip(result["candidates"], roots, strict=True):
+        a, b = c["t_interval"]
+        assert a - 1e-12 <= r <= b + 1e-12 and b - a < 1e-6
+        assert {m["mode"] for m in c["modes"]} == {"++", "+-", "-+", "--"}
+    for mode in result["working_modes"]:
+        assert len(mode["singular_times"]) == len(roots)
 
 
 @pytest.mark.slow

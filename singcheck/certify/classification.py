@@ -569,17 +569,17 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
     feasible = [m for m in modes if m.status == FEASIBLE]
     at_end = _end_zeros(path, feasible)
     # a mode where det A = 0 exactly at a range end is singular: its other zeros do
-    # not change the verdict, and it is not refined (a hexapod's mode lying on its
-    # singularity all along would spend the whole budget)
+    # not change the verdict, and it is searched on a first pass's budget only (a
+    # hexapod's mode lying on its singularity all along would spend the whole budget)
     known = {label for zero in at_end.values() for label, z in zero.items() if z}
     if searches is None:
-        searches = search_det_a(path, feasible, refine={m.label for m in feasible
-                                                         if m.label not in known}
-                                ) if feasible else {}
-    candidates = []
-    for mode in feasible:
-        for w in searches[mode.label].crossings:
-            candidates.append(_window_candidate(path, mode, w, tolerance))
+        rest = [m for m in feasible if m.label not in known]
+        searches = search_det_a(path, rest) if rest else {}
+        searches.update(_search_singular_modes(path, [m for m in feasible
+                                                      if m.label in known]))
+    candidates = _merged_crossings(path, [
+        _window_candidate(path, mode, w, tolerance)
+        for mode in feasible for w in searches[mode.label].crossings], [m.label for m in modes])
     at_ends, settled = _zeros_at_range_ends(path, feasible, searches, at_end)
     candidates += at_ends
     candidates.sort(key=lambda c: float(c.t.mid()))
@@ -589,7 +589,8 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
     # verdict does not rest on them, but they may hold more singular times of that mode
     undecided = [(arb(w.lo).union(arb(w.hi)),
                   f"mode {m.label} is proven singular at a range end, so the interval "
-                  f"engine did not search this window further (|det A| ≤ {w.bound:.3g}): "
+                  f"engine searched it on a first pass's budget only and left this window "
+                  f"(|det A| ≤ {w.bound:.3g}): "
                   f"it may hold more singular times of that mode, and {path.exact_refused}"
                   if m.label in known else
                   f"the interval engine could not prove det A ≠ 0 along mode {m.label} "
@@ -605,6 +606,28 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
 
 
 BY_RATIONAL_POSE = "det A = 0 exactly (a rational pose: multilinear in the legs' √Δ)"
+
+
+def _search_singular_modes(path: PathModel, singular: list[WorkingMode]) -> dict:
+    """The interval engine's search along modes already proven singular at a range end,
+    within a first pass's budget and seconds (:func:`first_pass_budget`,
+    :data:`FIRST_PASS_SECONDS`): their other singular times, and the window at that end
+    narrowed, for the report and the certificate (biglide, y = sin(2πt)/2 + t²/100 on
+    [0, 2.3]: unrefined, its one window was the whole range, settled by the zero at
+    t = 0, and three crossings went unreported).  Past the seconds: the first cover
+    alone."""
+    from singcheck.budget import TimeLimitExceeded, deadline, remaining
+
+    if not singular:
+        return {}
+    left = remaining()
+    try:
+        with deadline(FIRST_PASS_SECONDS):
+            return search_det_a(path, singular, budget=first_pass_budget(path, singular))
+    except TimeLimitExceeded:
+        if left is not None and left <= FIRST_PASS_SECONDS:
+            raise  # the trajectory's own time limit
+    return search_det_a(path, singular, refine=set())
 
 
 def _end_zeros(path: PathModel, feasible: list[WorkingMode]) -> dict:
@@ -670,21 +693,48 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
     return candidates, settled
 
 
+def _merged_crossings(path: PathModel, candidates: list[Candidate], order: list[str]
+                      ) -> list[Candidate]:
+    """The crossings proven mode by mode, those whose enclosures overlap made one
+    candidate (each of its modes is singular somewhere in the union of the enclosures):
+    one row per singular time, not one per mode."""
+    out: list[Candidate] = []
+    for c in sorted(candidates, key=lambda c: float(c.t.lower())):
+        last = out[-1] if out else None
+        if last is None or not last.t.overlaps(c.t):
+            out.append(c)
+            continue
+        t = last.t.union(c.t)
+        pose, _, _ = _mode_values(path, [], t)
+        modes = sorted(last.modes + c.modes, key=lambda m: order.index(m.mode))
+        out[-1] = Candidate(RealRoot(t, None), pose, {m.mode: {**last.joints, **c.joints}[m.mode]
+                                                      for m in modes}, modes, "real")
+    return out
+
+
+#: where a crossing's window is split (the middle, else the golden sections)
+_SPLITS = (0.5, 0.3819660112501051, 0.6180339887498949)
+
+
 def _window_candidate(path: PathModel, mode: WorkingMode, w,
                       tolerance: float = 1e-9) -> Candidate:
     """A crossing the interval engine proved along ``mode`` in the window ``w``, the
     window narrowed by bisection to ``tolerance``: det A is continuous along the feasible
     mode and has proven opposite signs at the two ends of the window, so it keeps a zero
-    between the ends of whichever half has opposite proven signs at its ends (a point
-    where the sign is not proven stops the narrowing there)."""
+    between the ends of whichever part has opposite proven signs at its ends.  Where the
+    sign at the midpoint is not proven (the zero may be there: y = sin(2πt) at t = 1/2)
+    a point at the golden sections is tried; where neither is, the narrowing stops."""
     lo, hi = inside_range(path, arb(w.lo).union(arb(w.hi)))
     while float(hi.upper() - lo.lower()) > tolerance:
         checkpoint()
-        mid = arb(((lo + hi) / 2).mid())
-        _, _, at = _mode_values(path, [mode], mid)
-        v = at[mode.label]
-        s = sign(v) if isinstance(v, arb) else None
-        if s is None or not (lo < mid < hi):
+        for split in _SPLITS:
+            mid = arb((lo + (hi - lo) * split).mid())
+            _, _, at = _mode_values(path, [mode], mid)
+            v = at[mode.label]
+            s = sign(v) if isinstance(v, arb) else None
+            if s is not None and lo < mid < hi:
+                break
+        else:
             break
         if s == w.left:
             lo = mid

@@ -101,11 +101,11 @@ def test_the_checker_imports_nothing_of_singcheck_but_itself(certs, tmp_path):
 
 def test_the_checker_is_short():
     """Short enough to review in an afternoon (the aim was 800 lines; with revolute legs,
-    pose angles, segments, waypoints and exact roots it holds 1,255, docstrings
-    included): this bound keeps it from growing unnoticed."""
+    pose angles, segments, waypoints, exact roots and exact multiples of π it holds
+    1,336, docstrings included): this bound keeps it from growing unnoticed."""
     lines = sum(len(p.read_text().splitlines())
                 for p in (ROOT / "singcheck" / "verify").glob("*.py"))
-    assert lines <= 1300, lines
+    assert lines <= 1350, lines
 
 
 def _plain(value):
@@ -639,3 +639,63 @@ def test_one_certificate_per_document_of_a_batch(tmp_path):
         assert f"name: {name}\n" in cert["claim"]["trajectory_spec"]
         assert cert["claim"]["trajectory_spec"].count("name:") == 1
         assert main([str(tmp_path / "certs" / f"{name}.cert.json")]) == 0
+
+
+def test_a_path_starting_and_ending_on_the_singularity_is_proven(tmp_path):
+    """biglide, x = t, y = sin(2πt)/2 on [0, 1] (the interval engine alone: π·t): det A =
+    4·y·(q − p) vanishes at t = 0, 1/2 and 1 in every mode.  The pieces touching an end
+    cannot get a sign; the checker accepts them inside a claimed singular time reaching
+    past that end whose exact root it proves itself (sin(2π·0) and sin(2π·1) evaluated in
+    Q + Qπ).  Before, the certificate said `incomplete` and verify refused it."""
+    mpmath.mp.dps = 50
+    for t in (0, mpmath.mpf(1) / 2, 1):  # the oracle: y = 0 there, q − p = ±2 ± 3/2 ≠ 0
+        assert abs(mpmath.sin(2 * mpmath.pi * t)) < mpmath.mpf(10) ** -45
+    robot = tmp_path / "biglide.yaml"
+    robot.write_text((ROBOTS / "biglide.yaml").read_text())
+    traj = tmp_path / "p.yaml"
+    traj.write_text("name: p\nparameter: t\nrange: [0, 1]\npose:\n  x: t\n"
+                    "  y: sin(2*pi*t)/2\n")
+    out = singcheck("run", str(robot), str(traj), "--no-regions", "-q", "--format", "json",
+                    "--certificate", str(tmp_path))
+    assert out.returncode == 1, out.stderr
+    cert = json.loads((tmp_path / "p.cert.json").read_text())
+    assert "incomplete" not in cert and failures(cert) == []
+    for mode, roots in cert["proof"]["exact_roots"].items():
+        assert roots == ["0", "1/2", "1"], mode
+        first, *_, last = cert["claim"]["singular_times"][mode]
+        assert Fraction(first[0]) <= 0 <= Fraction(first[1])
+        assert Fraction(last[0]) <= 1 <= Fraction(last[1])
+        assert cert["proof"]["signs"][mode][0] == cert["proof"]["signs"][mode][-1] == "0"
+    c = copy.deepcopy(cert)  # the end's exact root taken away: the end run is unproven
+    c["proof"]["exact_roots"]["++"] = ["1/2", "1"]
+    assert any("working mode ++ singular in t ∈ [-" in f for f in failures(c))
+    c = copy.deepcopy(cert)  # an exact root outside the range does not count
+    c["claim"]["trajectory_spec"] = c["claim"]["trajectory_spec"].replace("[0, 1]",
+                                                                         "[1/1000, 1]")
+    assert failures(c)
+    c = copy.deepcopy(cert)  # the first span no longer reaches the start
+    c["claim"]["singular_times"]["--"][0][0] = "1/1000000000000"
+    assert any("working mode --: det A not proven ≠ 0 on pieces 1 to" in f for f in failures(c))
+
+
+@pytest.mark.parametrize("k", range(-13, 14))
+def test_exact_sines_of_multiples_of_pi_agree_with_mpmath(k):
+    """The checker's exact values of sin and cos at kπ/6 (a path's pose at a rational
+    time, such as sin(2πt) at t = 1/12), against mpmath at 50 digits: rational where
+    they are, refused (NotDecided) where not (√3/2)."""
+    from singcheck.verify.checker import EXACT, value
+    from singcheck.verify.numbers import NotDecided
+    from singcheck.verify.reader import parse_expr
+
+    mpmath.mp.dps = 50
+    for fn, exact in (("sin", mpmath.sin), ("cos", mpmath.cos)):
+        truth = exact(k * mpmath.pi / 6)
+        rational = [q for q in (-1, Fraction(-1, 2), 0, Fraction(1, 2), 1)
+                    if abs(truth - mpmath.mpf(q.numerator if isinstance(q, Fraction) else q)
+                           / (q.denominator if isinstance(q, Fraction) else 1)) < 1e-40]
+        for text in (f"{fn}({k}*pi*t/6)", f"{fn}(pi*t*{k}/6 + 1 - 1)"):
+            try:
+                got = value(parse_expr(text), {"t": Fraction(1)}, EXACT)
+            except NotDecided:
+                got = None
+            assert got == (rational[0] if rational else None), (text, truth)

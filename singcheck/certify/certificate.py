@@ -91,8 +91,11 @@ class _Prover:
         self.undecided = 0
 
     def _inside(self, m: str, lo, hi) -> bool:
-        return lo is not None and hi is not None and any(
-            a <= lo and hi <= b for a, b in self.spans[m])
+        """Whether the piece [lo, hi] lies in a claimed singular time of ``m`` (a piece at
+        a range end, in one reaching past that end: the checker's rule)."""
+        return any((a <= lo if lo is not None else Iv.q(a).hi <= self.path.start.lo) and
+                   (hi <= b if hi is not None else self.path.end.hi <= Iv.q(b).lo)
+                   for a, b in self.spans[m])
 
     def piece(self, lo: Fraction | None, hi: Fraction | None, depth: int) -> None:
         """Prove the piece [lo, hi] (None: the range's end) or halve it."""
@@ -143,14 +146,17 @@ def _exact_roots(robot: Robot, path: PathSpec, spans: dict) -> dict[str, list[st
     """Per mode, the simplest rational of each singular time where det A = 0 exactly
     (a root the checker proves without a sign change: a tangency at t = 0, say)."""
     out: dict[str, list[str]] = {}
+    ends = [Fraction(e.lo, ONE) for e in (path.start, path.end) if e.lo == e.hi]
     for m, found in spans.items():
         for a, b in found:
-            t = simplest_between(a, b)
-            try:
-                if singular_at(robot, path, t, m):
-                    out.setdefault(m, []).append(_text(t))
-            except NotDecided:
-                pass
+            for t in [simplest_between(a, b)] + [e for e in ends if a <= e <= b]:
+                try:
+                    if path.start.hi <= Iv.q(t).lo and Iv.q(t).hi <= path.end.lo and \
+                            singular_at(robot, path, t, m):
+                        out.setdefault(m, []).append(_text(t))
+                        break
+                except NotDecided:
+                    pass
     return out
 
 

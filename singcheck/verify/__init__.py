@@ -125,7 +125,9 @@ def check(cert: dict) -> tuple[list[str], str]:
             fails.append(f"working mode {m}: not proven infeasible (no valid witness)")
     exact = _get(proof, "exact_roots", dict) if "exact_roots" in proof else {}
     fails += _singular_times(claim, feasible, signs, cuts, n, lambda m, a, b: any(
-        a <= _q(t) <= b and _singular_at(robot, path, _q(t), m) for t in exact.get(m, [])))
+        a <= _q(t) <= b and path.start.hi <= Iv.q(_q(t)).lo and
+        Iv.q(_q(t)).hi <= path.end.lo and _singular_at(robot, path, _q(t), m)
+        for t in exact.get(m, [])), (path.start, path.end))
     derived = "infeasible" if not feasible else "singular" if any(
         claim.get("singular_times", {}).get(m) for m in feasible) else "singularity-free"
     if verdict != derived:
@@ -143,9 +145,12 @@ def _singular_at(robot, path, t: Fraction, mode: str) -> bool:
 
 
 def _singular_times(claim: dict, feasible: list[str], signs: dict, cuts: list, n: int,
-                    root_in) -> list[str]:
+                    root_in, ends: tuple[Iv, Iv]) -> list[str]:
     """The runs of '0' pieces inside the claimed singular times, each of which holds a
-    sign change or an exact root (``root_in(mode, a, b)``)."""
+    sign change or an exact root (``root_in(mode, a, b)``, a root inside the range).  A
+    run at a range end lies in a span that reaches past that end (``ends``); no sign
+    change can be seen there, so its span needs an exact root (a path starting on the
+    singularity)."""
     fails = []
     times = claim.get("singular_times", {})
     if not isinstance(times, dict) or set(times) - set(feasible):
@@ -166,12 +171,13 @@ def _singular_times(claim: dict, feasible: list[str], signs: dict, cuts: list, n
             while j + 1 < n and s[j + 1] == "0":
                 j += 1
             lo, hi = (cuts[i - 1] if i > 0 else None), (cuts[j] if j < n - 1 else None)
-            k = next((k for k, (a, b) in enumerate(spans) if lo is not None and
-                      hi is not None and a <= lo and hi <= b), None)
+            k = next((k for k, (a, b) in enumerate(spans) if (
+                a <= lo if lo is not None else Iv.q(a).hi <= ends[0].lo) and (
+                hi <= b if hi is not None else ends[1].hi <= Iv.q(b).lo)), None)
             if k is None:
                 fails.append(f"working mode {m}: det A not proven ≠ 0 on pieces {i + 1} to "
                              f"{j + 1}, outside every claimed singular time")
-            elif s[i - 1] != s[j + 1] and s[j + 1] != "0":
+            elif 0 < i and j < n - 1 and s[i - 1] != s[j + 1] and s[j + 1] != "0":
                 crossing[k] = True
             i = j + 1
         for (a, b), ok in zip(spans, crossing, strict=False):

@@ -323,18 +323,59 @@ def _exact_root(x: Fraction) -> Fraction:
     return Fraction(r[0], r[1])
 
 
-def _exact_trig(x: Fraction, at_zero: int) -> Fraction:
-    if x != 0:
-        raise NotDecided("sin or cos of a non-zero rational")
-    return Fraction(at_zero)
+class _Pi(tuple):
+    """(q, p): q + p·π exactly, p ≠ 0 (a sin or cos argument: 2πt at t = 1/4)."""
+
+    def __add__(self, o):
+        q, p = _qp(o)
+        return _pi(self[0] + q, self[1] + p)
+
+    def __neg__(self):
+        return _Pi((-self[0], -self[1]))
+
+    def __mul__(self, o):
+        return _pi(self[0] * _rational(o), self[1] * _rational(o))
+
+    __radd__, __rmul__ = __add__, __mul__
+    __sub__ = lambda self, o: self + -o  # noqa: E731
+    __rsub__ = lambda self, o: -self + o  # noqa: E731
+    __truediv__ = lambda self, o: self * (1 / _rational(o))  # noqa: E731
+    __pow__ = lambda self, n: self if n == 1 else _rational(self)  # noqa: E731
+    __rtruediv__ = lambda self, o: _rational(self)  # noqa: E731
 
 
-def _no_pi():
-    raise NotDecided("π at an exact time")
+def _qp(x) -> tuple[Fraction, Fraction]:
+    return x if isinstance(x, _Pi) else (Fraction(x), Fraction(0))
+
+
+def _pi(q: Fraction, p: Fraction):
+    return _Pi((q, p)) if p else q
+
+
+#: sin(kπ/6) for k mod 12, where it is rational
+_SIXTHS = {0: 0, 1: Fraction(1, 2), 3: 1, 5: Fraction(1, 2), 6: 0, 7: Fraction(-1, 2),
+           9: -1, 11: Fraction(-1, 2)}
+
+
+def _exact_trig(x, quarter: int) -> Fraction:
+    """sin(x + quarter·π/2) exactly, where it is rational: x = 0, or x a rational multiple
+    of π with a rational sine (k·π/6)."""
+    q, p = _qp(x)
+    k = (p + Fraction(quarter, 2)) * 6
+    if q or k.denominator != 1 or int(k) % 12 not in _SIXTHS:
+        raise NotDecided("sin or cos at an exact time with no rational value")
+    return Fraction(_SIXTHS[int(k) % 12])
+
+
+def _rational(x) -> Fraction:
+    if isinstance(x, _Pi):
+        raise NotDecided("π where a rational is needed, at an exact time")
+    return x
 
 
 INTERVAL = {"num": Iv.q, "pi": lambda: PI, "sin": sin, "cos": cos, "sqrt": Iv.sqrt}
-EXACT = {"num": Fraction, "pi": _no_pi, "sqrt": _exact_root,
+EXACT = {"num": Fraction, "pi": lambda: _Pi((Fraction(0), Fraction(1))),
+         "sqrt": lambda x: _exact_root(_rational(x)),
          "sin": lambda x: _exact_trig(x, 0), "cos": lambda x: _exact_trig(x, 1)}
 
 
@@ -472,7 +513,7 @@ def _mq_poly(p: dict, values: list, ds: list) -> dict:
 def singular_at(robot: Robot, path: Path, t: Fraction, mode: str) -> bool:
     """Proven: at the rational time t the mode's branches are real and distinct and
     det A = 0 exactly (the branches in Q(√D₀, …), D the legs' discriminants there)."""
-    pose = [value(tree, {**path.known, path.param: t}, EXACT)
+    pose = [_rational(value(tree, {**path.known, path.param: t}, EXACT))
             for tree in path.trees_on(Iv.q(t))]
     if any(pose[j] for j in robot.angles):
         raise NotDecided("sin or cos of a non-zero pose angle")

@@ -60,7 +60,7 @@ from singcheck.certify.engines import (
     corroborated_verdict,
 )
 from singcheck.certify.exact import vanishes_at_root
-from singcheck.certify.interval_engine import inside_range, search_det_a
+from singcheck.certify.interval_engine import HINT_WIDTH, inside_range, search_det_a
 from singcheck.certify.interval_engine import mode_values as _mode_values
 from singcheck.certify.path import PathModel, joint_float
 from singcheck.certify.working_modes import (
@@ -614,19 +614,20 @@ def _search_singular_modes(path: PathModel, singular: list[WorkingMode]) -> dict
     :data:`FIRST_PASS_SECONDS`): their other singular times, and the window at that end
     narrowed, for the report and the certificate (biglide, y = sin(2πt)/2 + t²/100 on
     [0, 2.3]: unrefined, its one window was the whole range, settled by the zero at
-    t = 0, and three crossings went unreported).  Past the seconds: the first cover
-    alone."""
+    t = 0, and four crossings went unreported).  Past the seconds, or half the
+    trajectory's time left if that is less (the verdict, singular, is known already):
+    the first cover alone."""
     from singcheck.budget import TimeLimitExceeded, deadline, remaining
 
     if not singular:
         return {}
     left = remaining()
     try:
-        with deadline(FIRST_PASS_SECONDS):
+        with deadline(FIRST_PASS_SECONDS if left is None else min(FIRST_PASS_SECONDS,
+                                                                   left / 2)):
             return search_det_a(path, singular, budget=first_pass_budget(path, singular))
     except TimeLimitExceeded:
-        if left is not None and left <= FIRST_PASS_SECONDS:
-            raise  # the trajectory's own time limit
+        pass
     return search_det_a(path, singular, refine=set())
 
 
@@ -664,6 +665,8 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
     from singcheck.roots.enclosures import AT_POINT, ExactTime
 
     candidates, settled = [], set()
+    rng = path.trajectory.range
+    narrow = (float(rng.end) - float(rng.start)) * HINT_WIDTH
     for end, zero in at_end.items():
         ball = end.ball()
         touching = [(m, w) for m in feasible for w in searches[m.label].windows
@@ -672,9 +675,11 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
         if not touching:
             continue
         singular = [m for m in feasible if zero.get(m.label)]
-        mine = [(m, w) for m, w in touching if zero.get(m.label)]
-        # the zero at this end settles the windows there; the mode's windows elsewhere
-        # (not refined) decide nothing more, but are reported as undecided
+        # the zero at this end settles the windows there that the search narrowed about
+        # it; a wider one (the search's budget spent: a hexapod's mode that may lie on
+        # its singularity) and the mode's windows elsewhere may hold more singular times:
+        # they decide nothing more, but are reported as undecided
+        mine = [(m, w) for m, w in touching if zero.get(m.label) and w.hi - w.lo <= narrow]
         settled |= {(m.label, w) for m, w in mine}
         # the enclosure: the end, and the windows there (the certificate's checker skips
         # them as the singular stretch, and re-proves det A = 0 at the end exactly)

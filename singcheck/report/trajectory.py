@@ -90,6 +90,8 @@ def segments_json(report: TrajectoryReport) -> list[dict[str, Any]]:
 
 #: a path of more pieces than this has its pieces summarised, not listed, in the table
 MAX_LISTED_SEGMENTS = 6
+#: undecided stretches the table lists in full without -v (the rest: a count)
+MAX_UNDECIDED_SHOWN = 5
 
 
 def segments_line(segments: list[dict[str, Any]]) -> str:
@@ -378,10 +380,15 @@ def render_tables(console, robot: dict[str, Any], trajectories: list[dict[str, A
                 console.print(f"  candidate {i}: {t['parameter']} ∈ [{lo:.17g}, {hi:.17g}]")
                 for m in c["modes"]:
                     console.print(f"    {m['mode']}: {m['status']} ({m['proof']})")
-        for u in t["undecided"]:
+        shown = t["undecided"] if verbose or len(t["undecided"]) <= MAX_UNDECIDED_SHOWN \
+            else t["undecided"][:MAX_UNDECIDED_SHOWN - 1]
+        for u in shown:
             lo, hi = u["t_interval"]
             console.print(f"  undecided for {t['parameter']} in [{lo:.9g}, {hi:.9g}]: "
                           f"{u['reason']}")
+        if len(shown) < len(t["undecided"]):
+            console.print(f"  … and {len(t['undecided']) - len(shown)} more undecided "
+                          "stretch(es): all of them with -v or --format json")
         if t.get("mode"):
             console.print(mode_line(t["mode"]))
         if t.get("clearance") is not None:

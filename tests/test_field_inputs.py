@@ -26,6 +26,7 @@ ROOT = Path(__file__).resolve().parent.parent
 TOL = 1e-6
 BIGLIDE, FIVE, ORTHO = "robots/biglide.yaml", "robots/five-bar.yaml", "robots/orthoglide.yaml"
 RPR, RDELTA, GS = "robots/3-rpr.yaml", "robots/rotary-delta.yaml", "robots/gough-stewart.yaml"
+SKEW = "robots/skew-biglide.yaml"
 
 
 def path(rng: str, **pose: str) -> str:
@@ -138,6 +139,12 @@ CASES = {
     "3-rpr-constant-singular": (RPR, path("[0, 1]", x="1", y="0", phi="0"), ()),
     "rotary-delta-real-offset": (RDELTA, path("[0, 1]", x="7/4 + 3*t/10", y="0", z="-1"),
                                  (("{e: 1/2,", "{e: cos(1/2)/2,"),)),
+    # the rail at 1 rad written as users do: rho2^2 has the coefficient c^2 + s^2, which
+    # balls prove ≠ 0 but nothing proves = 1 (it was refused, exit 2: "divide it out")
+    "skew-rail-at-one-radian": (SKEW, path("[-pi, pi]", x="-1 + cos(t)", y="-1 + sin(t)/2"),
+                                (("{l1: 2, l2: 3/2}", "{l1: 2, l2: 3/2, c: cos(1), s: sin(1)}"),
+                                 ("(x - 3/5*rho2)^2 + (y - 4/5*rho2)^2",
+                                  "(x - c*rho2)^2 + (y - s*rho2)^2"))),
 }
 
 

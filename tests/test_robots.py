@@ -16,6 +16,7 @@ import pytest
 from singcheck import api
 from tests import robot_oracles as oracles
 from tests.conftest import ROBOTS, TRAJECTORIES
+from tests.test_cli import singcheck
 
 PATHS = {p.name: p for p in oracles.PATHS}
 
@@ -124,6 +125,21 @@ def test_a_constant_irrational_leading_coefficient_is_a_leg(tmp_path):
     report = api.check(robot, api.load_trajectory(tmp_path / "path.yaml", robot),
                        regions=False)
     _agrees(report, path.oracle(), truth)
+
+
+def test_a_real_leading_coefficient_not_proven_nonzero_is_refused_in_one_line(tmp_path):
+    """c·p² − k·p² + … with c = k = cos 1: the coefficient of p² is 0, which balls cannot
+    prove ≠ 0 (nor = 0): refused, exit 2, naming the file, line and joint, no traceback
+    (c² + s² with s = sin 1 is accepted: tests/test_field_inputs.py)."""
+    (tmp_path / "robot.yaml").write_text(SQRT3_LEAD.replace(
+        "{s3: sqrt(3)}", "{c: cos(1), k: cos(1)}").replace("s3*p^2", "c*p^2 - k*p^2"))
+    (tmp_path / "path.yaml").write_text(
+        "name: line\nparameter: t\nrange: [0, 1]\npose: {x: t, y: 1 - 2*t}\n")
+    out = singcheck("run", str(tmp_path / "robot.yaml"), str(tmp_path / "path.yaml"))
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    last = out.stderr.splitlines()[-1]
+    assert last.startswith(f"singcheck: error: {tmp_path / 'robot.yaml'}:6:")
+    assert "coefficient of p^2" in last and "cannot be proven ≠ 0" in last
 
 
 def test_designed_crossings_are_where_the_geometry_says():

@@ -21,7 +21,9 @@ constraint involves exactly one actuated joint (a leg), and that leg is
 
 * **prismatic**: of degree 1 or 2 in its joint ρ with a non-zero constant leading
   coefficient (an irrational one, √3 from a parameter, is divided out: the model's
-  constraint then has leading coefficient 1); its branches are ``ρ = (-b ± √D)/(2a)``,
+  constraint then has leading coefficient 1; one in parameters outside the exact field,
+  c² + s² with c = cos 1, is kept when its ball excludes 0: only the interval engine
+  takes such a robot); its branches are ``ρ = (-b ± √D)/(2a)``,
   D = b² - 4ac; or
 * **revolute**: an angle joint θ entering as ``a(X)·cos θ + b(X)·sin θ + d(X)`` (degree
   ≤ 2 in the half-angle tangent); its branches are
@@ -233,11 +235,18 @@ def _legs(spec: RobotSpec) -> tuple[Leg, ...]:
         if not lead.is_constant():
             value = constant_surd(lead)
             if value is None and _only_opaque_constants(lead):
-                raise UnsupportedRobotError(
-                    f"the coefficient of {joint}^{degree} involves a parameter outside the "
-                    "exact field; write the constraint with a rational or square-root "
-                    f"coefficient of {joint}^{degree} (divide it out)", path=spec.path,
-                    line=line, key=key)
+                if not _proven_nonzero(lead):
+                    raise UnsupportedRobotError(
+                        f"the coefficient of {joint}^{degree} involves a parameter outside "
+                        "the exact field and cannot be proven ≠ 0 by ball arithmetic; "
+                        f"write the constraint with a rational or square-root coefficient "
+                        f"of {joint}^{degree} (divide it out)", path=spec.path, line=line,
+                        key=key)
+                # a constant the balls prove ≠ 0 (c² + s² with c = cos 1, s = sin 1): the
+                # leg keeps it; only the interval engine takes such a robot, and it reads
+                # a leg's leading coefficient as a ball
+                found[joint] = Leg(joint, j, f, index, degree)
+                continue
             if value is None:
                 raise UnsupportedRobotError(
                     f"the coefficient of {joint}^{degree} depends on the pose; singcheck needs "
@@ -248,6 +257,24 @@ def _legs(spec: RobotSpec) -> tuple[Leg, ...]:
             f = reduce_relations(f * surd_polynomial(value.inverse(), spec.context))
         found[joint] = Leg(joint, j, f, index, degree)
     return tuple(found[j] for j in joints)
+
+
+def _proven_nonzero(p: fmpq_mpoly) -> bool:
+    """Whether the ball of ``p``, a polynomial in opaque constants and square roots of
+    rationals (:func:`~singcheck.algebra.radicals.radical_balls`), excludes 0."""
+    from flint import arb
+
+    from singcheck.algebra.radicals import radical_balls
+
+    balls = radical_balls(p.context())
+    total = arb(0)
+    for exps, q in p.terms():
+        term = arb(q)
+        for i, e in enumerate(exps):
+            if e:
+                term *= balls[i] ** e
+        total += term
+    return not total.contains(0)
 
 
 def _only_opaque_constants(p: fmpq_mpoly) -> bool:

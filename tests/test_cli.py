@@ -263,3 +263,27 @@ def test_a_batch_in_parallel_gives_the_same_answers_as_one_process(tmp_path):
     assert "certified" in parallel.stderr or "12/12" in parallel.stderr
     verdicts = {t["verdict"] for t in json.loads(serial.stdout)["trajectories"]}
     assert verdicts <= {"singular", "singularity-free", "infeasible"}
+
+
+@pytest.mark.parametrize(("count", "verbose", "listed"), [(5, False, 5), (7, False, 4),
+                                                          (7, True, 7)])
+def test_the_table_lists_a_few_undecided_stretches_and_counts_the_rest(
+        heart1_json, count, verbose, listed):
+    """A hexapod from its home pose leaves 63 undecided stretches: the table lists the
+    first MAX_UNDECIDED_SHOWN − 1 and counts the rest (all of them with -v)."""
+    import io
+
+    from rich.console import Console
+
+    from singcheck.report.trajectory import render_tables
+
+    report = json.loads(heart1_json.stdout)
+    doc = report["trajectories"][0]
+    doc["undecided"] = [{"t_interval": [k / 10, k / 10 + 0.01], "reason": f"reason {k}"}
+                        for k in range(count)]
+    out = io.StringIO()
+    render_tables(Console(file=out, width=200), report["robot"], [doc], verbose)
+    text = out.getvalue()
+    assert [k for k in range(count) if f"reason {k}\n" in text] == list(range(listed))
+    more = f"… and {count - listed} more undecided stretch(es)"
+    assert (more in text) == (listed < count)

@@ -459,3 +459,103 @@ def test_a_real_angle_limit(tmp_path, lower, feasible):
                    regions=False)
     assert report.verdict == truth.verdict == ("singular" if feasible else "infeasible")
     assert len([m for m in report.working_modes if m.feasible]) == len(truth.feasible)
+
+
+@pytest.mark.parametrize(("parameters", "length_squared", "L"), [
+    # sqrt of a real parameter inside a constraint (it was refused: "define it as a
+    # parameter (m: sqrt(l))"): l = 2·cos(1/10) written through a = l²
+    ("{a: 4*cos(1/10)^2}", "sqrt(a)^2", lambda: 2 * mp.cos(mp.mpf(1) / 10)),
+    # square roots of constants outside the rationals: √(8 + 4√3)·√(8 − 4√3) = √16 = 4
+    ("{}", "sqrt(8 + 4*sqrt(3))*sqrt(8 - 4*sqrt(3))", lambda: mp.mpf(2)),
+])
+def test_a_square_root_of_a_real_constant_in_a_constraint(tmp_path, parameters,
+                                                          length_squared, L):
+    """Each sqrt of a constant the exact field does not hold is an opaque constant of its
+    own (proven a finite real on balls), so only the interval engine runs; heart 1's
+    singular times are the oracle's for that leg length."""
+    mp.mp.dps = 50
+    text = ORTHO.replace("parameters: {l: 2}", f"parameters: {parameters}").replace(
+        "l^2", length_squared)
+    assert text.count(length_squared) == 3
+    (tmp_path / "robot.yaml").write_text(text)
+    pose = _heart("heart1")
+    roots, _ = _roots(lambda t: _det(L(), pose(t), (1, 1, 1)), -mp.pi, mp.pi)
+    assert len(roots) == 2 and _feasible_modes(L(), pose, [LIMITS] * 3) == ["+++"]
+    out = singcheck("run", str(tmp_path / "robot.yaml"), str(TRAJECTORIES / "heart1.yaml"),
+                    "--format", "json", "-q")
+    assert out.returncode == 1, out.stderr
+    doc = json.loads(out.stdout)
+    assert doc["elimination_method"].startswith("not computed: the constant")
+    (traj,) = doc["trajectories"]
+    assert [m["label"] for m in traj["working_modes"] if m["feasible"]] == ["+++"]
+    spans = [c["t_interval"] for c in traj["candidates"]]
+    assert len(spans) == 2
+    for (lo, hi), root in zip(spans, roots, strict=True):
+        assert lo - 1e-12 <= float(root) <= hi + 1e-12 and hi - lo < 1e-5
+
+
+@pytest.mark.parametrize(("constraint", "message"), [
+    ("sqrt(l - 3)", "constraints[0]: sqrt(l - 3): sqrt of a negative number is not real"),
+    ("sqrt(x)", "constraints[0]: sqrt takes a constant (e.g. sqrt(3), sqrt(3/4), sqrt(l) of "
+                "a parameter l), not a joint or pose variable"),
+])
+def test_a_square_root_that_is_not_a_real_constant_is_refused(tmp_path, constraint, message):
+    text = ORTHO.replace("parameters: {l: 2}", "parameters: {l: 2*cos(1/10)}").replace(
+        "+ z^2 - l^2\n  - x^2", f"+ z^2 - {constraint}\n  - x^2", 1)
+    (tmp_path / "robot.yaml").write_text(text)
+    out = singcheck("run", str(tmp_path / "robot.yaml"), str(TRAJECTORIES / "heart1.yaml"))
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert out.stderr.strip().splitlines()[-1].startswith(
+        f"singcheck: error: {tmp_path / 'robot.yaml'}:9: {message}")
+
+
+def test_unparse_writes_what_the_grammar_reads():
+    """The text of a constant (an opaque constant's name, sqrt(...)) read back is the same
+    real: 3,000 random expressions with -, ^, /, sqrt, cos, pi, evaluated at 40 digits
+    from both trees by an evaluator written here."""
+    import random
+    from fractions import Fraction
+
+    from singcheck.spec.grammar import parse, unparse
+
+    mp.mp.dps = 40
+    env = {"a": mp.mpf("1.3"), "b": mp.mpf("0.7"), "pi": mp.pi}
+
+    def value(n):
+        if n.kind == "num":
+            return mp.mpf(Fraction(n.value).numerator) / Fraction(n.value).denominator
+        if n.kind == "name":
+            return env[n.value]
+        if n.kind == "neg":
+            return -value(n.args[0])
+        if n.kind == "call":
+            return getattr(mp, n.value)(value(n.args[0]))
+        a, b = (value(x) for x in n.args)
+        return {"add": lambda: a + b, "sub": lambda: a - b, "mul": lambda: a * b,
+                "div": lambda: a / b, "pow": lambda: a ** b}[n.kind]()
+
+    rng = random.Random(7)
+
+    def text(depth):
+        if depth == 0 or rng.random() < 0.2:
+            return rng.choice(["a", "b", "2", "1/3", "0.5", "pi", "-a", "-2"])
+        op = rng.choice(["+", "-", "*", "/", "^", "neg", "sqrt", "cos"])
+        if op == "neg":
+            return f"-({text(depth - 1)})"
+        if op in ("sqrt", "cos"):
+            return f"{op}({text(depth - 1)})"
+        if op == "^":
+            return f"({text(depth - 1)})^{rng.choice(['2', '3', '-1'])}"
+        return f"({text(depth - 1)}) {op} ({text(depth - 1)})"
+
+    checked = 0
+    for _ in range(3000):
+        tree = parse(text(5))
+        try:
+            want = value(tree)
+        except (ZeroDivisionError, ValueError):
+            continue
+        got = value(parse(unparse(tree)))
+        assert abs(got - want) <= mp.mpf(10) ** -30 * (1 + abs(want)), unparse(tree)
+        checked += 1
+    assert checked > 2500

@@ -101,7 +101,7 @@ BAD_ROBOTS = [
     # (sin(x + 1), cos(x + pi/5): an angle plus a real offset, accepted since issue 27)
     (ROBOT.replace("(x - p)^2", "sin(x/2 + 1)"), 6, "constraints[0]", "integer combination"),
     (ROBOT.replace("(x - p)^2", "cos(p) + p"), 6, "constraints[0]", "is an angle"),
-    (ROBOT.replace("(x - p)^2", "sqrt(x)"), 6, "constraints[0]", "sqrt takes a rational"),
+    (ROBOT.replace("(x - p)^2", "sqrt(x)"), 6, "constraints[0]", "sqrt takes a constant"),
     (ROBOT.replace("(x - p)^2", "sqrt(-2)"), 6, "constraints[0]", "not real"),
     (ROBOT.replace("{l: 2}", "{l: sqrt(-1)}"), 4, "parameters.l", "not real"),
     # (pi*sqrt(2) and pi are finite reals: accepted, as opaque constants, since issue 27)

@@ -40,6 +40,7 @@ from singcheck.spec.real_constants import (
     opaque_parameter,
     outside_field,
     real_constant,
+    root_constants,
 )
 from singcheck.spec.trajectory import (
     TrajectorySpec,
@@ -444,12 +445,17 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     # opaque constants too, and the call is expanded exactly around them
     offsets = angle_offsets(trees, angles, parameters) if angles else {}
     offset_names = [n for _, c, s in offsets.values() for n in (c, s)]
+    # sqrt of such a constant (sqrt(l), l: 2*cos(1/10)): an opaque constant of its own
+    roots = root_constants(trees, parameters)
+    offset_names += [n for n in roots.values() if isinstance(n, str)]
     wide = fmpq_mpoly_ctx.get((*algebraic, *(radical_name(p) for p in primes),
                                *dict.fromkeys([*outside.values(), *offset_names])), "lex")
     gens = dict(zip(wide.names(), wide.gens(), strict=True))
     variables = {v: gens[v] for v in joints + pose if v not in angles}
     pairs = {v: tuple(gens[n] for n in angle_names(v)) for v in angles}
-    opaque = {p: gens[n] for p, n in outside.items()} or None
+    opaque = {**{p: gens[n] for p, n in outside.items()},
+              **{node: gens[n] if isinstance(n, str) else n for node, n in roots.items()}
+              } or None
     calls = {node: (k, gens[c], gens[s]) for node, (k, c, s) in offsets.items()} or None
     compiled, constraint_lines = [], []
     for i, item in enumerate(cnode.value):

@@ -479,14 +479,18 @@ class _Compiler:
         return value
 
     def _call(self, node: Node):
+        if node.value == "sqrt" and node in self.opaque:  # of a real parameter: its own
+            hit = self.opaque[node]  # opaque constant (real_constants.root_constants)
+            if isinstance(hit, ExprError):
+                raise hit
+            return hit
         if node.value == "sqrt":
             arg = _simplify(self.run(node.args[0]))
             q = _constant_of(arg)
             if q is None:
-                raise ExprError("sqrt takes a rational constant (e.g. sqrt(3), sqrt(3/4))" +
-                                ("; of a parameter outside the exact field, define it as a "
-                                 "parameter (m: sqrt(l))" if self.opaque else ""),
-                                node.column)
+                raise ExprError("sqrt takes a constant (e.g. sqrt(3), sqrt(3/4)" +
+                                (", sqrt(l) of a parameter l" if self.opaque else "") +
+                                "), not a joint or pose variable", node.column)
             if q < 0:
                 raise ExprError("sqrt of a negative number is not real", node.column)
             try:
@@ -659,6 +663,73 @@ def angle_offset(node: Node, angles, parameters) -> tuple[dict[str, int], str] |
         return None
     constant = fmpq_mpoly_ctx.get(("pi", *symbolic), "lex").from_dict(rest)
     return coefficients, str(constant)
+
+
+def constant_text(node: Node, parameters) -> str | None:
+    """The constant ``node`` written anew in the grammar, when it names nothing but
+    parameters and ``pi`` and is not a rational (the argument of ``sqrt(l)`` in a
+    constraint, ``l: 2*cos(1/10)``, or of ``sqrt(1 + sqrt(2))``); None otherwise (the
+    exact compiler takes ``sqrt(3)``; ``sqrt(x)`` of a pose variable is refused)."""
+    if not _names_in(node) <= {*parameters, "pi"}:
+        return None
+    try:
+        value = compile_value(node, parameters)
+        if not value.pi_coefficient and value.surd.is_rational():
+            return None
+    except ExprError:
+        pass
+    return unparse(node)
+
+
+def _names_in(node: Node) -> set[str]:
+    own = {node.value} if node.kind == "name" else set()
+    return own.union(*(_names_in(a) for a in node.args))
+
+
+_SYMBOLS = {"add": "+", "sub": "-", "mul": "*", "div": "/", "pow": "^"}
+_PRECEDENCE = {"add": 1, "sub": 1, "mul": 2, "div": 2, "neg": 3, "pow": 4}
+
+
+def unparse(node: Node) -> str:
+    """The text of a tree in the grammar, with the parentheses its precedence needs.
+
+    >>> unparse(parse("-2*l^2/3 + sqrt(l - 1/2)"))
+    '-2*l^2/3 + sqrt(l - 1/2)'
+    >>> unparse(parse("(a - b)^2 / (c*d) - -e / -3"))
+    '(a - b)^2/(c*d) - -e/-3'
+    """
+    return _unparse(node)[0]
+
+
+def _unparse(node: Node) -> tuple[str, int]:
+    """(text, precedence): 5 for an atom."""
+    k = node.kind
+    if k == "num":
+        q = Fraction(node.value)
+        return (str(q.numerator), 5) if q.denominator == 1 else (str(q), 2)
+    if k in ("name", "call"):
+        return (str(node.value), 5) if k == "name" else \
+            (f"{node.value}({_unparse(node.args[0])[0]})", 5)
+    if k == "neg":
+        if node.args[0].kind == "neg":
+            return _unparse(node.args[0].args[0])
+        inner, p = _unparse(node.args[0])
+        return (f"-{inner}", min(p, 3)) if p >= 2 else (f"-({inner})", 3)
+    (a, pa), (b, pb) = (_unparse(x) for x in node.args)
+    own = _PRECEDENCE[k]
+    if k in ("add", "sub"):
+        right = node.args[1]
+        while right.kind == "neg":  # a + -b: a - b (and a - -b: a + b)
+            right = right.args[0]
+            k = "sub" if k == "add" else "add"
+        b, pb = _unparse(right)
+        b = f"({b})" if pb <= 1 and k == "sub" else b
+        return f"{a} {_SYMBOLS[k]} {b}", own
+    if k == "pow":
+        return f"{a if pa == 5 else f'({a})'}^{b if pb == 5 else f'({b})'}", own
+    a = a if pa >= own else f"({a})"
+    b = b if pb > own or (k == "mul" and pb == own) else f"({b})"
+    return f"{a}{_SYMBOLS[k]}{b}", own
 
 
 def compile_polynomial(node: Node, ctx: fmpq_mpoly_ctx, variables: dict[str, fmpq_mpoly],

@@ -334,6 +334,36 @@ def angle_offsets(trees: list[Node], angles, parameters: dict) -> dict:
     return out
 
 
+def root_constants(trees: list[Node], parameters: dict) -> dict:
+    """{sqrt call: opaque constant's name} for each ``sqrt`` of the constraint trees whose
+    argument is a constant outside the exact field (``sqrt(l)`` with ``l: 2*cos(1/10)``):
+    its value is an opaque constant of the robot's ring, proven a finite real like a
+    parameter (:func:`real_constant`: the argument proven > 0 on balls), or the
+    :class:`ExprError` saying why it is not (the compiler raises it).  A call the exact
+    compiler takes is not listed."""
+    from singcheck.spec.grammar import constant_text, parse
+
+    out: dict = {}
+
+    def walk(node: Node) -> None:
+        if node.kind == "call" and node.value == "sqrt" and node not in out:
+            text = constant_text(node.args[0], parameters)
+            if text is not None:
+                label = f"sqrt({text})"
+                try:
+                    out[node] = opaque_parameter(label, real_constant(parse(label), label,
+                                                                      parameters))
+                except ExprError as e:  # (the compiler raises it, with the line)
+                    out[node] = ExprError(f"{label}: {e.message}", node.column)
+                return
+        for a in node.args:
+            walk(a)
+
+    for tree in trees:
+        walk(tree)
+    return out
+
+
 def opaque_parameters(spec) -> dict[str, str]:
     """{parameter: its value's text} for each opaque constant of a robot spec's ring (""
     for none): what the report names when it says why the exact engine does not run."""

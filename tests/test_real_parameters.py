@@ -215,9 +215,11 @@ def test_a_transcendental_joint_limit_decides_a_mode(tmp_path, l_text, lower, fe
 
 BAD = [
     ("sqrt(1 - 2*cos(1/10))", "parameters.l", "sqrt of a negative number is not real"),
-    ("1/(cos(1) - cos(1))", "parameters.l", "not proven non-zero"),
+    ("1/(cos(1)^2 + sin(1)^2 - 1)", "parameters.l", "not proven non-zero"),
+    ("1/(cos(1) - cos(1))", "parameters.l", "division by zero"),  # a − a: exactly 0
     ("1/(3 - 3)", "parameters.l", "division by zero"),
-    ("(sin(1/2) - sin(1/2))^(-1)", "parameters.l", "not proven non-zero"),
+    ("(sin(1/2) - sin(1/2))^(-1)", "parameters.l", "a negative power of zero"),
+    ("(cos(1)*sin(1) - sin(1)*cos(1))^(-1)", "parameters.l", "not proven non-zero"),
     ("cos(1)^(1/2)", "parameters.l", "exponents must be integers"),
     ("exp(1)", "parameters.l", "unknown function 'exp'"),
 ]
@@ -233,6 +235,25 @@ def test_values_that_are_not_finite_reals_are_refused_with_file_and_line(tmp_pat
     out = singcheck("run", robot, str(TRAJECTORIES / "heart1.yaml"), "-q")
     assert out.returncode == 2 and f"{robot}:7: {key}:" in out.stderr
     assert phrase in out.stderr and "Traceback" not in out.stderr
+
+
+@pytest.mark.parametrize("text", ["2 + sqrt(cos(1) - cos(1))", "2 + sqrt(1 - 1)",
+                                  "sqrt(4 + sin(1/3) - sin(1/3))"])
+def test_a_difference_of_the_same_constant_is_exactly_zero(tmp_path, text):
+    """a − a is 0 wherever a is defined, though its ball is not [0, 0]; the square root
+    of an exact 0 is 0 (both were refused: "not proven positive").  l = 2 then, and
+    heart 1's singular times are the oracle's for l = 2."""
+    mp.mp.dps = 50
+    pose = _heart("heart1")
+    roots, _ = _roots(lambda t: _det(mp.mpf(2), pose(t), (1, 1, 1)), -mp.pi, mp.pi)
+    robot = load_robot(_robot(tmp_path, text), backend="flint", cache=False)
+    report = check(robot, load_trajectory(str(TRAJECTORIES / "heart1.yaml"), robot),
+                   regions=False).certificate
+    singular = sorted((c for c in report.candidates if c.status == "real"),
+                      key=lambda c: float(c.t.mid()))
+    assert report.verdict == "singular" and len(singular) == len(roots) == 2
+    for c, root in zip(singular, roots, strict=True):
+        assert float(c.t.lower()) - 1e-12 <= float(root) <= float(c.t.upper()) + 1e-12
 
 
 def test_a_limit_that_is_not_real_is_refused(tmp_path):

@@ -122,6 +122,8 @@ def tree_ball(node: Node, name_ball, exponent) -> arb:
     args = [tree_ball(a, name_ball, exponent) for a in node.args]
     if k == "neg":
         return -args[0]
+    if cancels(node):
+        return arb(0)
     if k == "add":
         return args[0] + args[1]
     if k == "sub":
@@ -136,7 +138,24 @@ def tree_ball(node: Node, name_ball, exponent) -> arb:
         return args[0].sin()
     if node.value == "cos":
         return args[0].cos()
+    if args[0] == 0:  # exactly (a ball of radius 0 at 0: sqrt(cos(1) - cos(1)))
+        return arb(0)
     return args[0].sqrt() if args[0] > 0 else arb("nan")
+
+
+def cancels(node: Node) -> bool:
+    """Whether ``node`` is a − a (``a - a`` or ``a + -a``, the two sides the same tree
+    but for their columns): exactly 0 wherever a is defined, though its ball is not
+    [0, 0] (``cos(1) - cos(1)``)."""
+    from singcheck.spec.grammar import unparse
+
+    if node.kind == "sub":
+        a, b = node.args
+    elif node.kind == "add" and node.args[1].kind == "neg":
+        a, b = node.args[0], node.args[1].args[0]
+    else:
+        return False
+    return unparse(a) == unparse(b)
 
 
 def _power(base: arb, e: int) -> arb:
@@ -176,6 +195,8 @@ def _check(node: Node, constants: dict) -> arb:
                             node.column)
         x = _check(node.args[0], constants)
         if node.value == "sqrt":
+            if x == 0:  # exactly: sqrt(cos(1) - cos(1)), sqrt(1 - 1)
+                return arb(0)
             if x < 0:
                 raise ExprError("sqrt of a negative number is not real", node.column)
             if not x > 0:
@@ -188,6 +209,8 @@ def _check(node: Node, constants: dict) -> arb:
             raise _zero("a negative power of", base, node)
         return _power(base, e)
     args = [_check(a, constants) for a in node.args]
+    if cancels(node):
+        return arb(0)
     if k == "div" and not (args[1] > 0 or args[1] < 0):
         raise _zero("division by", args[1], node)
     if k == "neg":

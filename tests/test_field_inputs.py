@@ -198,45 +198,24 @@ def _biglide_sine_oracle(x):
     return [float(r) for r in roots]
 
 
-def test_a_singular_mode_keeps_its_windows_at_the_other_end(tmp_path):
+def test_a_factor_of_det_a_in_the_pose_decides_an_irrational_end(tmp_path):
     """x = √2·t, y = sin(2πt)/2 on [0, 1]: the biglide is singular at t = 0, 1/2 and 1 in
-    all four modes.  The pose at t = 0 is rational, so det A = 0 is proven there exactly,
-    and the interval engine then searches those modes on a small budget; at t = 1 the pose (√2, 0)
-    is not rational, so that zero is not proven.  singcheck once dropped the window at
-    t = 1 silently (singular times 0 and 1/2 only, nothing undecided); now each singular
-    time is listed or lies in a window the report names as undecided, with the reason."""
+    all four modes.  At t = 1 the pose (√2, 0) is not rational, so the rational-pose
+    determinant cannot decide it, and singcheck once dropped that end silently, then
+    left it an undecided window; det A = 4·y·(q − p) has the factor y, in the pose
+    alone, which is exactly 0 there: every mode is singular at t = 1, proven so."""
     roots = _biglide_sine_oracle(lambda t: mp.sqrt(2) * t)
     robot_file, traj_file = files(tmp_path, BIGLIDE,
                                   path("[0, 1]", x="sqrt(2)*t", y="sin(2*pi*t)/2"))
     result = singcheck(robot_file, traj_file)
-    assert result["verdict"] == "singular"
-    times = singular_times(result)
-    windows = [u["t_interval"] for u in result["undecided"]]
-    for r in roots:
-        assert close_to_any(r, times) or any(a - TOL <= r <= b + TOL
-                                             for a, b in windows), (r, times, windows)
-    for t in times:
-        assert close_to_any(t, roots)
-    assert windows and all("on a first pass's budget only" in u["reason"]
-                           for u in result["undecided"])
-
-
-def test_a_rational_pose_at_a_multiple_of_pi_is_decided_exactly(tmp_path):
-    """x = t, y = sin(2πt)/2 on [0, 1]: at t = 1 the pose is (1, 0), rational, but its
-    ball is not exact (sin 2π over a ball of π); the expression tree evaluated in
-    Q + Qπ with the rational sines of rational multiples of π gives it exactly, so
-    det A = 0 is proven at both ends (before: t = 1 was missing, then undecided)."""
-    roots = _biglide_sine_oracle(lambda t: t)
-    robot_file, traj_file = files(tmp_path, BIGLIDE, path("[0, 1]", x="t", y="sin(2*pi*t)/2"))
-    result = singcheck(robot_file, traj_file)
-    assert result["verdict"] == "singular"
-    assert result["undecided"] == []
+    assert result["verdict"] == "singular" and result["undecided"] == []
     for mode in result["working_modes"]:
         assert len(mode["singular_times"]) == 3
         for t, r in zip(mode["singular_times"], roots, strict=True):
             assert abs(t - r) <= TOL
-    ends = [c for c in result["candidates"] if c["t"] == 1.0]
-    assert ends and all(m["proof"].startswith("det A = 0 exactly") for m in ends[0]["modes"])
+    (end,) = [c for c in result["candidates"] if c["t"] == 1.0]
+    assert {m["proof"] for m in end["modes"]} == {
+        "det A = 0 exactly (a factor of det A in the pose alone is 0 there)"}
 
 
 def test_a_mode_singular_at_an_end_has_its_other_singular_times_listed(tmp_path):

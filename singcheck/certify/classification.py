@@ -571,7 +571,7 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
     # a mode where det A = 0 exactly at a range end is singular: its other zeros do
     # not change the verdict, and it is searched on a first pass's budget only (a
     # hexapod's mode lying on its singularity all along would spend the whole budget)
-    known = {label for zero in at_end.values() for label, z in zero.items() if z}
+    known = {label for zero, _ in at_end.values() for label, z in zero.items() if z}
     if searches is None:
         rest = [m for m in feasible if m.label not in known]
         searches = search_det_a(path, rest) if rest else {}
@@ -606,6 +606,7 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
 
 
 BY_RATIONAL_POSE = "det A = 0 exactly (a rational pose: multilinear in the legs' √Δ)"
+BY_POSE_FACTOR = "det A = 0 exactly (a factor of det A in the pose alone is 0 there)"
 
 
 def _search_singular_modes(path: PathModel, singular: list[WorkingMode]) -> dict:
@@ -632,15 +633,22 @@ def _search_singular_modes(path: PathModel, singular: list[WorkingMode]) -> dict
 
 
 def _end_zeros(path: PathModel, feasible: list[WorkingMode]) -> dict:
-    """{range end: {mode: det A = 0 there exactly}} for the ends where the pose is
-    rational and :mod:`.rational_pose` decides (a few hundred rational determinants per
-    mode; an end where balls prove det A ≠ 0 along every mode is not looked at: a long
-    spline's ends, with their thousand-digit poses, cost 0.5 ms each)."""
+    """{range end: ({mode: det A = 0 there exactly}, proof)} for the ends where the pose
+    is rational and :mod:`.rational_pose` decides (a few hundred rational determinants
+    per mode), or where a factor of det A in the pose variables it knows exactly
+    vanishes (every mode: x = √2·t, y = sin(2πt)/2 of the biglide at t = 1).  An end
+    where balls prove det A ≠ 0 along every mode is not looked at (a long spline's ends,
+    with their thousand-digit poses, cost 0.5 ms each)."""
     from singcheck.certify.interval_engine import mode_values
-    from singcheck.certify.rational_pose import det_a_zero_modes, rational_pose
+    from singcheck.certify.rational_pose import (
+        det_a_zero_modes,
+        pose_factor_vanishes,
+        pose_values,
+    )
 
     out = {}
     rng = path.trajectory.range
+    model = path.projection.model
     for end in (rng.start, rng.end):
         checkpoint()
         if not feasible:
@@ -648,12 +656,13 @@ def _end_zeros(path: PathModel, feasible: list[WorkingMode]) -> dict:
         _, _, values = mode_values(path, feasible, end.ball())
         if all(isinstance(v, arb) and excludes_zero(v) for v in values.values()):
             continue  # det A ≠ 0 there along every mode, proven by balls: no zero to find
-        pose = rational_pose(path, end)
-        if pose is None:
-            continue
-        zero = det_a_zero_modes(path.projection.model, pose, [m.label for m in feasible])
+        pose = pose_values(path, end)
+        zero = None if any(v is None for v in pose) else \
+            det_a_zero_modes(model, pose, [m.label for m in feasible])
         if zero and any(zero.values()):
-            out[end] = zero
+            out[end] = zero, BY_RATIONAL_POSE
+        elif pose_factor_vanishes(model, pose):
+            out[end] = {m.label: True for m in feasible}, BY_POSE_FACTOR
     return out
 
 
@@ -667,7 +676,7 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
     candidates, settled = [], set()
     rng = path.trajectory.range
     narrow = (float(rng.end) - float(rng.start)) * HINT_WIDTH
-    for end, zero in at_end.items():
+    for end, (zero, proof) in at_end.items():
         ball = end.ball()
         touching = [(m, w) for m in feasible for w in searches[m.label].windows
                     if not w.crossing and w.lo <= float(ball.upper()) and
@@ -693,7 +702,7 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
                            for leg, v in zip(path.legs, joints[m.label], strict=True)}
                  for m in singular}
         candidates.append(Candidate(root, pose_balls, shown,
-                                    [ModeAtCandidate(m.label, SINGULAR, BY_RATIONAL_POSE)
+                                    [ModeAtCandidate(m.label, SINGULAR, proof)
                                      for m in singular], "real"))
     return candidates, settled
 

@@ -34,37 +34,61 @@ MAX_FACTOR_BITS = 200
 def rational_pose(path, end: LinearInPi) -> list[fmpq] | None:
     """The model's pose variables at the piece time ``end``, when all are rational (None
     otherwise)."""
+    values = pose_values(path, end)
+    return None if any(v is None for v in values) else values
+
+
+def pose_values(path, end: LinearInPi) -> list[fmpq | None]:
+    """Each of the model's pose variables at the piece time ``end``, exactly, where it
+    is rational and known so (None where not: x = √2·t at t = 1)."""
     if end.pi_coefficient:
         if end.rational or end.pi_coefficient.denominator != 1:
-            return None
+            return [None] * len(path.coordinates)
         t, s, c = None, fmpq(0), fmpq(1 if end.pi_coefficient.numerator % 2 == 0 else -1)
     else:
         q = end.rational
         t = fmpq(q.numerator, q.denominator)
         s, c = (fmpq(0), fmpq(1)) if q == 0 else (None, None)
-    out = []
-    for x in path.coordinates:
-        if x.context() is not TRIG:
-            value = _exact_ball(x, end)
-            if value is None:
-                return None
-            out.append(value)
-            continue
-        dt, ds, dc = x.degrees()
-        if (dt > 0 and t is None) or ((ds > 0 or dc > 0) and s is None):
-            return None
-        value = fmpq(0)
-        for (i, j, k), coeff in x.terms():
-            term = coeff
-            if i:
-                term *= t ** i
-            if j:
-                term *= s ** j
-            if k:
-                term *= c ** k
-            value += term
-        out.append(value)
-    return out
+    return [_exact_ball(x, end) if x.context() is not TRIG else _trig_value(x, t, s, c)
+            for x in path.coordinates]
+
+
+def pose_factor_vanishes(model, values: list[fmpq | None]) -> bool:
+    """Proven: a factor of det A in the pose variables alone is 0 at the pose ``values``
+    (those it involves known exactly), so det A = 0 there along every working mode
+    whatever the joints (the biglide's y of det A = 4·y·(q − p) at x = √2, y = 0)."""
+    from singcheck.model.robot import det_a_factors
+
+    names = model.context.names()
+    known = {names.index(v): value
+             for v, value in zip(model.pose_variables, values, strict=True)
+             if value is not None}
+    for factor, _ in det_a_factors(model):
+        used = [i for i, d in enumerate(factor.degrees()) if d]
+        if used and all(i in known for i in used):
+            point = [known.get(i, fmpq(0)) for i in range(len(names))]
+            if factor(*point) == 0:
+                return True
+    return False
+
+
+def _trig_value(x, t, s, c) -> fmpq | None:
+    """A coordinate polynomial in (t, sin t, cos t) at the end, when the values it
+    involves are known."""
+    dt, ds, dc = x.degrees()
+    if (dt > 0 and t is None) or ((ds > 0 or dc > 0) and s is None):
+        return None
+    value = fmpq(0)
+    for (i, j, k), coeff in x.terms():
+        term = coeff
+        if i:
+            term *= t ** i
+        if j:
+            term *= s ** j
+        if k:
+            term *= c ** k
+        value += term
+    return value
 
 
 def _exact_ball(x, end: LinearInPi) -> fmpq | None:

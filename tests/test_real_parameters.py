@@ -357,10 +357,12 @@ def test_a_path_may_name_a_real_parameter(tmp_path, cos_robot):
     assert report.verdict == "singularity-free", report.reason
 
 
-def test_a_graze_is_unknown_with_its_window(tmp_path):
-    """The biglide (det A = 4y(q − p)) with a leg of length 2·cos(1/10) on y = t²: det A
-    touches 0 at t = 0 without changing sign, which balls cannot prove: `unknown`, the
-    window holding t = 0 and its bound, and why the exact engine did not run."""
+def test_a_graze_is_proven_at_a_simple_time_and_unknown_elsewhere(tmp_path):
+    """The biglide (det A = 4y(q − p), q − p ≠ 0) with a leg of length 2·cos(1/10): on
+    y = t² det A touches 0 at t = 0 without changing sign, which balls cannot prove, but
+    y = 0 exactly there (a factor of det A in the pose alone): `singular` at t = 0,
+    proven.  On y = (t − √2/2)² the touch is at an irrational time: `unknown`, the
+    window holding √2/2 and its bound, and why the exact engine did not run."""
     text = (ROBOTS / "biglide.yaml").read_text().replace(
         "constraints:", "parameters: {a: 2*cos(1/10)}\nconstraints:").replace(
         "(x - p)^2 + y^2 - 4", "(x - p)^2 + y^2 - a^2")
@@ -368,10 +370,18 @@ def test_a_graze_is_unknown_with_its_window(tmp_path):
     robot = load_robot(str(tmp_path / "biglide.yaml"), backend="flint", cache=False)
     report = check(robot, load_trajectory(str(TRAJECTORIES / "biglide-graze.yaml"), robot),
                    regions=False)
+    assert report.verdict == "singular" and report.reason.endswith("at t = 0 (exactly)")
+    (c,) = report.certificate.candidates
+    assert float(c.t.lower()) <= 0 <= float(c.t.upper())
+    (tmp_path / "graze.yaml").write_text("name: graze\nparameter: t\nrange: [0, 1]\n"
+                                         "pose: {x: t/2, y: (t - sqrt(2)/2)^2}\n")
+    report = check(robot, load_trajectory(str(tmp_path / "graze.yaml"), robot),
+                   regions=False)
     assert report.verdict == "unknown"
     assert "|det A| ≤" in report.reason and "outside the exact field" in report.reason
     windows = report.certificate.undecided
-    assert windows and all(float(t.lower()) <= 0 <= float(t.upper()) for t, _ in windows)
+    root = 2 ** 0.5 / 2
+    assert windows and all(float(t.lower()) <= root <= float(t.upper()) for t, _ in windows)
 
 
 def test_a_batch_on_two_workers_reads_the_real_parameter(tmp_path):

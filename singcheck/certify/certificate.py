@@ -23,6 +23,7 @@ import os
 from fractions import Fraction
 from pathlib import Path
 
+from singcheck.roots.rational import simplest_between
 from singcheck.verify.checker import NotRecheckable, Robot, outside, piece_values, singular_at
 from singcheck.verify.checker import Path as PathSpec
 from singcheck.verify.numbers import ONE, Iv, NotDecided
@@ -122,24 +123,6 @@ class _Prover:
             self.cuts.append(hi)
         for m in self.feasible:
             self.signs[m].append(out[m].replace("?", "0"))
-
-
-def simplest_between(a: Fraction, b: Fraction) -> Fraction:
-    """The rational of smallest denominator in [a, b] (a ≤ b).
-
-    >>> simplest_between(Fraction(-1, 10**12), Fraction(1, 10**12))
-    Fraction(0, 1)
-    >>> simplest_between(Fraction(3, 10), Fraction(4, 10))
-    Fraction(1, 3)
-    """
-    if a <= 0 <= b:
-        return Fraction(0)
-    if b < 0:
-        return -simplest_between(-b, -a)
-    whole = a.numerator // a.denominator
-    if whole == a or whole + 1 <= b:
-        return a if whole == a else Fraction(whole + 1)
-    return whole + 1 / simplest_between(1 / (b - whole), 1 / (a - whole))
 
 
 def _exact_roots(robot: Robot, path: PathSpec, spans: dict) -> dict[str, list[str]]:

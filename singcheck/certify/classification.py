@@ -47,6 +47,7 @@ What is proven, and how:
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from fractions import Fraction
 
 from flint import arb
 
@@ -581,7 +582,9 @@ def _certify_by_intervals(path: PathModel, modes: list[WorkingMode],
         _window_candidate(path, mode, w, tolerance)
         for mode in feasible for w in searches[mode.label].crossings], [m.label for m in modes])
     at_ends, settled = _zeros_at_range_ends(path, feasible, searches, at_end)
-    candidates += at_ends
+    inside, touched = _zeros_inside_windows(path, feasible, searches, settled)
+    candidates += at_ends + inside
+    settled |= touched
     candidates.sort(key=lambda c: float(c.t.mid()))
     for mode in modes:
         mode.singular_times = [c for c in candidates if mode.label in c.singular_modes]
@@ -640,15 +643,9 @@ def _end_zeros(path: PathModel, feasible: list[WorkingMode]) -> dict:
     where balls prove det A ≠ 0 along every mode is not looked at (a long spline's ends,
     with their thousand-digit poses, cost 0.5 ms each)."""
     from singcheck.certify.interval_engine import mode_values
-    from singcheck.certify.rational_pose import (
-        det_a_zero_modes,
-        pose_factor_vanishes,
-        pose_values,
-    )
 
     out = {}
     rng = path.trajectory.range
-    model = path.projection.model
     for end in (rng.start, rng.end):
         checkpoint()
         if not feasible:
@@ -656,13 +653,9 @@ def _end_zeros(path: PathModel, feasible: list[WorkingMode]) -> dict:
         _, _, values = mode_values(path, feasible, end.ball())
         if all(isinstance(v, arb) and excludes_zero(v) for v in values.values()):
             continue  # det A ≠ 0 there along every mode, proven by balls: no zero to find
-        pose = pose_values(path, end)
-        zero = None if any(v is None for v in pose) else \
-            det_a_zero_modes(model, pose, [m.label for m in feasible])
-        if zero and any(zero.values()):
-            out[end] = zero, BY_RATIONAL_POSE
-        elif pose_factor_vanishes(model, pose):
-            out[end] = {m.label: True for m in feasible}, BY_POSE_FACTOR
+        zero, proof = _exact_zeros(path, feasible, end)
+        if any(zero.values()):
+            out[end] = zero, proof
     return out
 
 
@@ -705,6 +698,89 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
                                     [ModeAtCandidate(m.label, SINGULAR, proof)
                                      for m in singular], "real"))
     return candidates, settled
+
+
+#: windows (without a sign change) tried for an exact zero at their simplest time
+MAX_EXACT_WINDOWS = 64
+
+
+def _zeros_inside_windows(path: PathModel, feasible: list[WorkingMode], searches: dict,
+                          settled: set):
+    """Windows the interval engine left without a sign change (a touch it cannot prove)
+    that hold a time where det A = 0 exactly: the simplest rational inside the window,
+    or an integer multiple of π there, where the pose is known exactly and the
+    rational-pose determinant or a factor of det A in the pose decides (y = 1 − cos(t −
+    1) of the biglide touches y = 0 at t = 1: a tangency, singular, proven so).  The
+    zero proves the mode singular there; the window may hold more zeros, and stays its
+    enclosure.  Returns (candidates, {(mode, window)} they settle)."""
+    import math
+
+    from singcheck.algebra.trig import LinearInPi
+    from singcheck.roots.enclosures import AT_POINT, ExactTime
+    from singcheck.roots.rational import simplest_between
+
+    rng = path.trajectory.range
+    tried: dict = {}
+    found: dict = {}
+    for m in feasible:
+        for w in searches[m.label].windows:
+            if w.crossing or (m.label, w) in settled or len(tried) >= MAX_EXACT_WINDOWS:
+                continue
+            lo, hi = Fraction(w.lo), Fraction(w.hi)
+            if not lo < hi:
+                continue
+            points = [LinearInPi(simplest_between(lo, hi))]
+            k = math.ceil(w.lo / math.pi)
+            if k * math.pi < w.hi and k:
+                points.append(LinearInPi(Fraction(0), Fraction(k)))
+            for point in points:
+                if not (rng.start.ball() < point.ball() < rng.end.ball()):
+                    continue
+                key = (point.rational, point.pi_coefficient)
+                if key not in tried:
+                    tried[key] = _exact_zeros(path, feasible, point)
+                zero, proof = tried[key]
+                if zero.get(m.label):
+                    found.setdefault(key, (point, proof, []))[2].append((m, w))
+                    break
+    candidates, touched = [], set()
+    for point, proof, hits in found.values():
+        ball = point.ball()
+        for _, w in hits:
+            ball = ball.union(arb(w.lo).union(arb(w.hi)))
+        lo, hi = inside_range(path, ball)
+        root = RealRoot(lo.union(hi), None, exact=ExactTime(AT_POINT, end=point,
+                                                            inside=True))
+        modes = [m for m, _ in hits]
+        pose, joints, _ = _mode_values(path, modes, point.ball())
+        shown = {m.label: {leg.leg.joint: joint_float(v)
+                           for leg, v in zip(path.legs, joints[m.label], strict=True)}
+                 for m in modes}
+        candidates.append(Candidate(root, pose, shown,
+                                    [ModeAtCandidate(m.label, SINGULAR, proof) for m in modes],
+                                    "real"))
+        touched |= {(m.label, w) for m, w in hits}
+    return candidates, touched
+
+
+def _exact_zeros(path: PathModel, feasible: list[WorkingMode], point) -> tuple[dict, str]:
+    """({mode: det A = 0 exactly at the time ``point``}, proof), where the pose there is
+    known exactly (empty where it is not)."""
+    from singcheck.certify.rational_pose import (
+        det_a_zero_modes,
+        pose_factor_vanishes,
+        pose_values,
+    )
+
+    model = path.projection.model
+    pose = pose_values(path, point)
+    zero = None if any(v is None for v in pose) else \
+        det_a_zero_modes(model, pose, [m.label for m in feasible])
+    if zero and any(zero.values()):
+        return zero, BY_RATIONAL_POSE
+    if pose_factor_vanishes(model, pose):
+        return {m.label: True for m in feasible}, BY_POSE_FACTOR
+    return {}, ""
 
 
 def _merged_crossings(path: PathModel, candidates: list[Candidate], order: list[str]
@@ -853,12 +929,13 @@ WIDE_WINDOW = 1e-4
 
 
 def _at(c: Candidate) -> str:
-    """Where a proven singular time lies: "at t ≈ τ", "at the range end t = e" (det A = 0
-    exactly there), or "somewhere in t ∈ [a, b]" when only a wide window was proven
-    (ball enclosures too wide to narrow it)."""
+    """Where a proven singular time lies: "at t ≈ τ", "at t = e (exactly…)" (det A = 0
+    exactly there: a range end, or a touch inside), or "somewhere in t ∈ [a, b]" when
+    only a wide window was proven (ball enclosures too wide to narrow it)."""
     t = c.t
     if c.root.exact is not None and c.root.exact.end is not None:
-        return f"at t = {c.root.exact.end} (exactly: a range end)"
+        return f"at t = {c.root.exact.end} (exactly" + (
+            ")" if c.root.exact.inside else ": a range end)")
     if float(t.rad()) * 2 > WIDE_WINDOW:
         return f"somewhere in t ∈ [{float(t.lower()):.6g}, {float(t.upper()):.6g}]"
     return f"at t ≈ {float(t.mid()):.6g}"

@@ -74,10 +74,12 @@ class ExactTime:
     c: Fraction | None = None
     t_value: Fraction | None = None
     pi_multiple: int | None = None
-    #: the range end the root is exactly at (a zero met there, decided exactly)
+    #: the range end the root is exactly at (a zero met there, decided exactly), or with
+    #: ``inside`` the exact time inside the range of a zero decided there (a touch)
     end: LinearInPi | None = None
     #: q of the pose angle g(t) + qπ at a zero of g (``AT_ANGLE_ZERO``)
     angle_q: Fraction | None = None
+    inside: bool = False
 
 
 def point_time(t: Fraction | None, s: int, c: int, pi_multiple: int | None = None

@@ -43,6 +43,35 @@ def to_fmpq(x: Fraction | int) -> fmpq:
     return fmpq(x.numerator, x.denominator)
 
 
+def simplest_between(lo: Fraction | None, hi: Fraction | None) -> Fraction:
+    """The rational with the smallest denominator (then numerator) in the open (lo, hi).
+
+    ``None`` stands for -∞ / +∞.  Stern–Brocot descent, exact.  An empty interval
+    (lo ≥ hi) is a caller's error: ValueError, never a division by zero deep inside.
+    """
+    if lo is not None and hi is not None and not lo < hi:
+        raise ValueError(f"simplest_between: empty interval ({lo}, {hi})")
+    if lo is None and hi is None:
+        return Fraction(0)
+    if lo is None:
+        return Fraction(min(0, math.ceil(hi) - 1))
+    if hi is None:
+        return Fraction(max(0, math.floor(lo) + 1))
+    if lo < 0 < hi:
+        return Fraction(0)
+    if hi <= 0:
+        return -simplest_between(-hi, -lo)
+    wholes = []  # while lo and hi share their integer part, go on with the reciprocals
+    while not (hi is None or math.floor(lo) + 1 < hi):  # of their fractional parts (a
+        whole = math.floor(lo)  # loop: balls of 2048 bits give thousands of steps)
+        wholes.append(whole)
+        lo, hi = 1 / (hi - whole), (1 / (lo - whole) if lo > whole else None)
+    value = Fraction(math.floor(lo) + 1)
+    for whole in reversed(wholes):
+        value = whole + 1 / value
+    return value
+
+
 def rational_ball(lo: fmpq, hi: fmpq) -> arb:
     """A ball containing the rational interval [lo, hi], at a precision fine enough
     that rounding does not widen it noticeably."""

@@ -23,7 +23,6 @@ Only full-dimensional cells are built: they are what a solution count is constan
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from fractions import Fraction
 from itertools import combinations
@@ -32,7 +31,7 @@ from flint import fmpq, fmpq_mpoly, fmpq_poly
 
 from singcheck.algebra.polynomials import coefficient_in
 from singcheck.budget import checkpoint
-from singcheck.roots.rational import RationalRoot, real_roots_exact, to_fraction
+from singcheck.roots.rational import RationalRoot, real_roots_exact, simplest_between, to_fraction
 
 
 @dataclass(frozen=True)
@@ -110,35 +109,6 @@ def project(polys: list[fmpq_mpoly], var_index: int) -> list[fmpq_mpoly]:
 
 # ---------------------------------------------------------------------------------
 # sample points
-
-
-def simplest_between(lo: Fraction | None, hi: Fraction | None) -> Fraction:
-    """The rational with the smallest denominator (then numerator) in the open (lo, hi).
-
-    ``None`` stands for -∞ / +∞.  Stern–Brocot descent, exact.  An empty interval
-    (lo ≥ hi) is a caller's error: ValueError, never a division by zero deep inside.
-    """
-    if lo is not None and hi is not None and not lo < hi:
-        raise ValueError(f"simplest_between: empty interval ({lo}, {hi})")
-    if lo is None and hi is None:
-        return Fraction(0)
-    if lo is None:
-        return Fraction(min(0, math.ceil(hi) - 1))
-    if hi is None:
-        return Fraction(max(0, math.floor(lo) + 1))
-    if lo < 0 < hi:
-        return Fraction(0)
-    if hi <= 0:
-        return -simplest_between(-hi, -lo)
-    wholes = []  # while lo and hi share their integer part, go on with the reciprocals
-    while not (hi is None or math.floor(lo) + 1 < hi):  # of their fractional parts (a
-        whole = math.floor(lo)  # loop: balls of 2048 bits give thousands of steps)
-        wholes.append(whole)
-        lo, hi = 1 / (hi - whole), (1 / (lo - whole) if lo > whole else None)
-    value = Fraction(math.floor(lo) + 1)
-    for whole in reversed(wholes):
-        value = whole + 1 / value
-    return value
 
 
 def separated_roots(p: fmpq_poly) -> list[RationalRoot]:

@@ -161,6 +161,27 @@ def test_field_input_matches_the_oracle(tmp_path, name):
     assert_agrees(singcheck(robot_file, traj_file), oracle(robot_file, traj_file))
 
 
+def test_a_leg_stretched_at_a_simple_time_is_proven_infeasible(tmp_path):
+    """x = 0, y = 3/2·cos(t − 1) on [0, 2]: the biglide's leg of length 3/2 is fully
+    stretched at t = 1 (y = 3/2), where its two branches q = ±√(9/4 − y²) meet (the
+    oracle: D = 9/4 − y² ≥ 0, = 0 only there, a touch), so no mode follows the path.
+    Balls see no sign change of D; only the interval engine takes the shifted cosine,
+    and the answer was ``unknown``.  D is now decided exactly at the simplest rational
+    of the window left: 0 at t = 1."""
+    mp.mp.dps = 50
+    d = [mp.mpf(9) / 4 - (mp.mpf(3) / 2 * mp.cos(mp.mpf(k) / 500 - 1)) ** 2
+         for k in range(1001)]
+    assert min(d) == d[500] == 0 and all(v > 0 for k, v in enumerate(d) if k != 500)
+    robot_file, traj_file = files(tmp_path, BIGLIDE, path("[0, 2]", x="0",
+                                                          y="3/2*cos(t - 1)"))
+    truth = oracle(robot_file, traj_file)
+    assert truth.verdict == "infeasible"
+    result = singcheck(robot_file, traj_file)
+    assert result["verdict"] == "infeasible", result["reason"]
+    for mode in result["working_modes"]:
+        assert "the two branches of q meet at t = 1, decided exactly" in mode["reason"]
+
+
 def test_a_csv_table_matches_the_oracle(tmp_path):
     """A four-row CSV log on the Orthoglide, read with the default cubic spline."""
     table = "t,x,y,z\n0,0.25,0.6,1\n1,0.9,1.1,1\n2,1.2,0.3,1\n3,0.4,0.2,1.1\n"
@@ -170,15 +191,27 @@ def test_a_csv_table_matches_the_oracle(tmp_path):
     assert_agrees(singcheck(robot_file, traj_file), truth)
 
 
-def test_a_tangency_of_a_shifted_cosine_is_singular_or_an_unknown_window(tmp_path):
+@pytest.mark.parametrize(("rng", "x", "y", "at", "text"), [
+    ("[0, 2]", "t/2 - 1/2", "1 - cos(t - 1)", 1.0, "1"),
+    ("[5, 7]", "t/2 - 3", "1 + cos(t/2)", float(mp.pi) * 2, "2*pi"),
+])
+def test_a_tangency_at_a_simple_time_is_proven_singular(tmp_path, rng, x, y, at, text):
     """y = 1 − cos(t − 1) touches the biglide's singularity y = 0 at t = 1 without a sign
-    change; the interval engine alone takes the shifted argument, so the answer may be
-    ``unknown`` with a window on t = 1, never ``singularity-free``."""
-    robot_file, traj_file = files(tmp_path, BIGLIDE,
-                                  path("[0, 2]", x="t/2 - 1/2", y="1 - cos(t - 1)"))
+    change, y = 1 + cos(t/2) at t = 2π; only the interval engine takes these arguments,
+    and a touch is no sign change, so it once answered ``unknown`` with a window there.
+    The window's simplest rational (or multiple of π) is tried exactly: det A = 0 there
+    (the rational pose (0, 0); the factor y of det A at (π − 3, 0)), so every mode is
+    singular there, proven.  Oracle: fo.judge (det A along each mode at 50 digits, the
+    touch found as a minimum of |det A|)."""
+    robot_file, traj_file = files(tmp_path, BIGLIDE, path(rng, x=x, y=y))
     truth = oracle(robot_file, traj_file)
-    assert truth.verdict == "singular" and truth.times == [1.0]
-    assert_agrees(singcheck(robot_file, traj_file), truth, touch_may_be_unknown=True)
+    assert truth.verdict == "singular" and len(truth.times) == 1
+    assert abs(truth.times[0] - at) < 1e-9
+    result = singcheck(robot_file, traj_file)
+    assert_agrees(result, truth)
+    assert result["undecided"] == [] and result["reason"].endswith(f"at t = {text} (exactly)")
+    (c,) = result["candidates"]
+    assert all(m["proof"].startswith("det A = 0 exactly") for m in c["modes"])
 
 
 def _biglide_sine_oracle(x):

@@ -72,6 +72,23 @@ def pose_factor_vanishes(model, values: list[fmpq | None]) -> bool:
     return False
 
 
+def leg_discriminant_at(model, leg, pose: list[fmpq | None]) -> fmpq | None:
+    """The discriminant of ``leg`` (b² − 4ac, or Δ = a² + b² − d² for a revolute leg) at
+    the pose ``pose`` exactly, when the values its coefficients involve are known (None
+    otherwise, or for a linear leg)."""
+    from singcheck.certify.path import _leg_coefficients
+
+    if leg.kind != REVOLUTE and leg.degree == 1:
+        return None
+    point = {name: value for name, value in zip(model.pose_variables, pose, strict=True)
+             if value is not None}
+    coeffs = [_value(p, point) for p in _leg_coefficients(leg)]
+    if any(v is None for v in coeffs):
+        return None
+    a, b, c = coeffs
+    return a * a + b * b - c * c if leg.kind == REVOLUTE else b * b - 4 * a * c
+
+
 def _trig_value(x, t, s, c) -> fmpq | None:
     """A coordinate polynomial in (t, sin t, cos t) at the end, when the values it
     involves are known."""

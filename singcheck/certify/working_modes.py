@@ -246,10 +246,11 @@ def _everywhere(predicate, interval: TimeRange, retry_tight: bool = True,
 
 
 def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when,
-                 cover: _Cover | None = None, quick: bool = True):
+                 cover: _Cover | None = None, quick: bool = True, exact=None):
     """Status of both branches of a quadratic leg with respect to step 1 (``when``
     writes a time ball in the user's parameter; ``quick=False`` when the quick proof
-    was tried already, by :mod:`.sweep`)."""
+    was tried already, by :mod:`.sweep`; ``exact``: :func:`_exact_touch` of the leg, for
+    a path only ball arithmetic reads)."""
     joint = leg.leg.joint
     cover = cover or _Cover(leg, interval)
     if quick and _everywhere(lambda t, tight: cover.discriminant(t, tight) > 0,
@@ -258,9 +259,11 @@ def _leg_reality(leg: LegAlongPath, interval: TimeRange, tolerance: float, when,
     iso = _isolate(leg.discriminant, interval, tolerance)
     if iso == OPAQUE:
         bad = _by_intervals(cover, lambda t: cover.discriminant(t) > 0,
-                            lambda t: cover.discriminant(t) < 0)
+                            lambda t: cover.discriminant(t) < 0, exact)
         if bad is True:
             return FEASIBLE, "", None
+        if isinstance(bad, tuple):  # decided at an exact time
+            return INFEASIBLE, bad[1], bad[0]
         if bad is not None:
             return INFEASIBLE, f"{joint} has no real solution at t ≈ {when(bad)} (the path " \
                 "leaves the workspace)", bad
@@ -398,11 +401,14 @@ def _exact_limits_unavailable(leg: LegAlongPath, limits) -> bool:
 INTERVAL_ONLY_BUDGET = 4000
 
 
-def _by_intervals(cover: _Cover, good, bad) -> bool | arb | None:
+def _by_intervals(cover: _Cover, good, bad, exact=None) -> bool | arb | tuple | None:
     """An interval-only proof over the cover's range: True when ``good(piece)`` holds on
     balls covering it; else the first exact point found where ``bad(point)`` is proven
     (a ball of a time); None when the budget of evaluations ends first.  Each failing
-    piece is tried at its midpoint (an exact point), then halved."""
+    piece is tried at its midpoint (an exact point), then halved.  When the budget ends,
+    ``exact(piece)`` (if given) is asked of the pieces left, narrowest first: its
+    (time, reason) where it decides the bad case exactly (a touch the balls cannot see
+    the sign of), returned as it is."""
     import math
 
     todo = cover.pieces()
@@ -419,9 +425,18 @@ def _by_intervals(cover: _Cover, good, bad) -> bool | arb | None:
         if bad(point):
             return point
         if spent + len(todo) + 2 > budget:
+            if exact is not None:
+                for left in sorted([piece, *todo], key=lambda b: b.rad())[:MAX_EXACT_TRIES]:
+                    found = exact(left)
+                    if found is not None:
+                        return found
             return None
         todo += cover.halves(piece)
     return True
+
+
+#: pieces left by an interval-only proof that are tried at an exact time
+MAX_EXACT_TRIES = 16
 
 
 def _field(root) -> str:
@@ -468,6 +483,45 @@ def _sits_on_limit(leg: LegAlongPath, label: str, on_limit: dict, point: arb) ->
     return any(sigma * evaluate_path(w, point) > 0 for w in on_limit.values())
 
 
+def _exact_touch(path: PathModel, leg: LegAlongPath):
+    """``exact(piece)`` for :func:`_by_intervals`: the leg's discriminant at the simplest
+    rational time of the piece (or an integer multiple of π in it), where the pose is
+    known exactly: (the time's ball, why the mode is infeasible) when it is 0 (the
+    branches meet: y = 3/2·cos(t − 1) against a leg of 3/2 at t = 1) or < 0; None
+    otherwise."""
+    import math
+
+    from singcheck.algebra.trig import LinearInPi
+    from singcheck.certify.rational_pose import leg_discriminant_at, pose_values
+    from singcheck.roots.rational import simplest_between
+
+    model = path.projection.model
+    rng = path.trajectory.range
+    joint = leg.leg.joint
+
+    def exact(piece: arb):
+        lo, hi = (Fraction(float(x)) for x in (piece.lower(), piece.upper()))
+        points = [LinearInPi(simplest_between(lo, hi))] if lo < hi else []
+        k = math.ceil(float(lo) / math.pi)
+        if k and k * math.pi < float(hi):
+            points.append(LinearInPi(Fraction(0), Fraction(k)))
+        for point in points:
+            if not rng.start.ball() < point.ball() < rng.end.ball():
+                continue
+            d = leg_discriminant_at(model, leg.leg, pose_values(path, point))
+            at = f"{float(path.trajectory.to_global(point.ball()).mid()):.12g}"
+            if d is not None and d == 0:
+                return point.ball(), (f"the two branches of {joint} meet at t = {at}, "
+                                      "decided exactly (serial singularity: the path "
+                                      "reaches the workspace boundary)")
+            if d is not None and d < 0:
+                return point.ball(), (f"{joint} has no real solution at t = {at}, decided "
+                                      "exactly (the path leaves the workspace)")
+        return None
+
+    return exact
+
+
 def leg_branches(path: PathModel, tolerance: float, covers: list[_Cover] | None = None,
                  starts: list[dict] | None = None) -> list[list[BranchFeasibility]]:
     """Feasibility of every branch of every leg (outer list in joint order); ``covers``
@@ -489,7 +543,8 @@ def leg_branches(path: PathModel, tolerance: float, covers: list[_Cover] | None 
             status, reason, event = FEASIBLE, "", None
         elif leg.discriminant is not None:
             status, reason, event = _leg_reality(leg, interval, tolerance, when, cover,
-                                                 quick=(i, None) not in tried)
+                                                 quick=(i, None) not in tried,
+                                                 exact=_exact_touch(path, leg))
         else:
             status, reason, event = FEASIBLE, "", None
         branches = []

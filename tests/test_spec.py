@@ -106,11 +106,13 @@ BAD_ROBOTS = [
     (ROBOT.replace("{l: 2}", "{l: sqrt(-1)}"), 4, "parameters.l", "not real"),
     # (pi*sqrt(2) and pi are finite reals: accepted, as opaque constants, since issue 27)
     (ROBOT.replace("{l: 2}", "{l: sqrt(1 - 2*cos(1/10))}"), 4, "parameters.l", "not real"),
-    (ROBOT.replace("{l: 2}", "{l: 1/(cos(1) - cos(1))}"), 4, "parameters.l",
+    (ROBOT.replace("{l: 2}", "{l: 1/(cos(1)^2 + sin(1)^2 - 1)}"), 4, "parameters.l",
      "not proven non-zero"),
+    (ROBOT.replace("{l: 2}", "{l: 1/(cos(1) - cos(1))}"), 4, "parameters.l",
+     "division by zero"),  # a − a: exactly 0
     (ROBOT.replace("{l: 2}", "{l: 1/(2 - 2)}"), 4, "parameters.l", "division by zero"),
-    (ROBOT.replace("{l: 2}", "{l: (sin(1) - sin(1))^(-1)}"), 4, "parameters.l",
-     "negative power of a value not proven"),
+    (ROBOT.replace("{l: 2}", "{l: (sin(1)*cos(1) - cos(1)*sin(1))^(-1)}"), 4,
+     "parameters.l", "negative power of a value not proven"),
     (ROBOT.replace("{l: 2}", "{l: cos(1)^(1/2)}"), 4, "parameters.l", "must be integers"),
     (ROBOT.replace("{l: 2}", "{l: tan(1)}"), 4, "parameters.l", "unknown function 'tan'"),
     (ROBOT.replace("{p: [0, 4]}", "{p: [0, sqrt(cos(2))]}"), 8, "joint_limits.p", "not real"),

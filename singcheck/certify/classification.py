@@ -707,8 +707,10 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
     return candidates, settled
 
 
-#: windows (without a sign change) tried for an exact zero at their simplest time
+#: distinct times (the simplest in a window without a sign change) tried for an exact
+#: zero, and the seconds they may take in all (a hexapod's 64 modes: 0.2 s a time)
 MAX_EXACT_WINDOWS = 64
+EXACT_WINDOWS_SECONDS = 0.5
 
 
 def _zeros_inside_windows(path: PathModel, feasible: list[WorkingMode], searches: dict,
@@ -719,8 +721,10 @@ def _zeros_inside_windows(path: PathModel, feasible: list[WorkingMode], searches
     rational-pose determinant or a factor of det A in the pose decides (y = 1 − cos(t −
     1) of the biglide touches y = 0 at t = 1: a tangency, singular, proven so).  The
     zero proves the mode singular there; the window may hold more zeros, and stays its
-    enclosure.  Returns (candidates, {(mode, window)} they settle)."""
+    enclosure.  At most :data:`MAX_EXACT_WINDOWS` times, within
+    :data:`EXACT_WINDOWS_SECONDS`.  Returns (candidates, {(mode, window)} they settle)."""
     import math
+    import time
 
     from singcheck.algebra.trig import LinearInPi
     from singcheck.roots.enclosures import AT_POINT, ExactTime
@@ -729,9 +733,12 @@ def _zeros_inside_windows(path: PathModel, feasible: list[WorkingMode], searches
     rng = path.trajectory.range
     tried: dict = {}
     found: dict = {}
+    until = time.monotonic() + EXACT_WINDOWS_SECONDS
     for m in feasible:
         for w in searches[m.label].windows:
-            if w.crossing or (m.label, w) in settled or len(tried) >= MAX_EXACT_WINDOWS:
+            checkpoint()
+            if w.crossing or (m.label, w) in settled or len(tried) >= MAX_EXACT_WINDOWS \
+                    or time.monotonic() > until:
                 continue
             lo, hi = Fraction(w.lo), Fraction(w.hi)
             if not lo < hi:

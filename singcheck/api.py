@@ -544,10 +544,14 @@ def shared_regions(robot: Robot, head: list, options: dict, notify: Notify = _qu
     share, computed once (:func:`prepare_regions`); ``options["regions"]`` is turned off
     when that ran out of time."""
     from singcheck.elimination.projection import transcendental_limits
+    from singcheck.spec.real_constants import exact_engine_refusal
 
     specs = [t for t in map(spec_of, head) if isinstance(t, TrajectorySpec)]
-    if options["regions"] and transcendental_limits(robot.projection.model):
-        options["regions"] = False  # no algebraic limit surfaces: no region statement
+    if options["regions"] and (transcendental_limits(robot.projection.model) or
+                               exact_engine_refusal(robot.projection.model.spec)):
+        # no algebraic limit surfaces, or no robot over Q (a real parameter): no region
+        # statement (a batch once ended here, an internal error, on such a robot)
+        options["regions"] = False
     if options["regions"] and specs and not prepare_regions(
             robot, specs, options["time_limit"], notify):
         options["regions"] = False

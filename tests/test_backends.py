@@ -117,3 +117,26 @@ def test_backends_agree_on_a_revolute_robot_and_one_with_orientation(name, case,
     assert doc["backend"] == name
     assert _summary(doc) == _summary(angle_references[case])
     assert any(c["status"] == "real" for c in doc["trajectories"][0]["candidates"])
+
+
+def test_auto_hands_a_request_the_cas_does_not_finish_to_flint(monkeypatch):
+    """``auto`` gives the external CAS AUTO_CAS_SECONDS per request, then the in-process
+    flint backend (the stacked Orthoglide: Singular past 600 s, flint 0.4 s).  With a
+    budget no CAS can meet, ξ comes from flint, re-checked, the same surface as flint's
+    own, and the method says why; a backend asked for by name keeps its whole timeout."""
+    from singcheck import api
+    from singcheck.algebra.polynomials import squarefree_part
+    from singcheck.elimination import cas
+
+    _backend("singular")  # (skips, loudly, where Singular is absent; fails in CI)
+    monkeypatch.setattr(cas, "AUTO_CAS_SECONDS", 1e-3)
+    robot = api.load_robot(str(ROBOTS / "orthoglide.yaml"), backend="auto", cache=False)
+    method = robot.projection.method
+    assert method.endswith("singular did not finish within 0.001 s (auto)"), method
+    flint = api.load_robot(str(ROBOTS / "orthoglide.yaml"), backend="flint", cache=False)
+    assert squarefree_part(robot.projection.singularity_surface) == \
+        squarefree_part(flint.projection.singularity_surface)
+    report = api.check(robot, api.load_trajectory(str(TRAJECTORIES / "heart1.yaml"), robot),
+                       regions=False)
+    assert report.verdict == "singular"
+    assert cas.get_backend("singular", timeout=5).timeout == 5

@@ -106,7 +106,8 @@ def cli() -> None:
               type=click.Choice(["auto", "singular", "macaulay2", "sympy", "flint"]),
               default="auto", envvar="SINGCHECK_BACKEND", show_default=True, show_envvar=True,
               help="Elimination engine for the robot's projection; auto picks Singular, else "
-                   "Macaulay2, else SymPy (see `singcheck backends`).")
+                   "Macaulay2, else SymPy, and hands a request the CAS does not finish in "
+                   "60 s to flint (see `singcheck backends`).")
 @click.option("--timeout", type=click.FloatRange(min=0, min_open=True), default=600,
               show_default=True, help="Wall-clock limit in seconds for each CAS run.")
 @click.option("--no-cache", is_flag=True,

@@ -591,3 +591,25 @@ def test_unparse_writes_what_the_grammar_reads():
         assert abs(got - want) <= mp.mpf(10) ** -30 * (1 + abs(want)), unparse(tree)
         checked += 1
     assert checked > 2500
+
+
+def test_sin_and_cos_of_a_constant_inside_a_constraint(tmp_path):
+    """`4*cos(1/100)^2` written in the biglide's constraint instead of a parameter (it
+    was refused: "the argument of sin/cos must be an integer combination of angles"):
+    cos(1/100) is an opaque constant like a real parameter.  det A = 4·y·(q − p) with
+    q − p ≠ 0, so on biglide-double-cross (y = t² − 10⁻⁸) the singular times are ±10⁻⁴
+    in every feasible mode (the oracle: the zeros of y, by hand)."""
+    text = (ROBOTS / "biglide.yaml").read_text().replace(
+        "(x - p)^2 + y^2 - 4", "(x - p)^2 + y^2 - 4*cos(1/100)^2")
+    (tmp_path / "biglide.yaml").write_text(text)
+    out = singcheck("run", str(tmp_path / "biglide.yaml"),
+                    str(TRAJECTORIES / "biglide-double-cross.yaml"), "--format", "json", "-q")
+    assert out.returncode == 1, out.stderr
+    doc = json.loads(out.stdout)
+    assert doc["elimination_method"].startswith("not computed: the constant")
+    (traj,) = doc["trajectories"]
+    feasible = [m for m in traj["working_modes"] if m["feasible"]]
+    assert feasible and traj["verdict"] == "singular"
+    for m in feasible:
+        assert len(m["singular_times"]) == 2
+        assert all(abs(abs(t) - 1e-4) < 1e-9 for t in m["singular_times"])

@@ -443,7 +443,7 @@ def parse_robot(text: str, path: str) -> RobotSpec:
     outside = {p: opaque_parameter(p, v) for p, v in parameters.items() if outside_field(v)}
     # sin/cos of an angle plus such a constant (cos(th1 + a), a: 0.1): cos a, sin a are
     # opaque constants too, and the call is expanded exactly around them
-    offsets = angle_offsets(trees, angles, parameters) if angles else {}
+    offsets = angle_offsets(trees, angles, parameters)
     offset_names = [n for _, c, s in offsets.values() for n in (c, s)]
     # sqrt of such a constant (sqrt(l), l: 2*cos(1/10)): an opaque constant of its own
     roots = root_constants(trees, parameters)

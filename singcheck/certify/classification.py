@@ -47,7 +47,6 @@ What is proven, and how:
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from fractions import Fraction
 
 from flint import arb
 
@@ -723,12 +722,10 @@ def _zeros_inside_windows(path: PathModel, feasible: list[WorkingMode], searches
     zero proves the mode singular there; the window may hold more zeros, and stays its
     enclosure.  At most :data:`MAX_EXACT_WINDOWS` times, within
     :data:`EXACT_WINDOWS_SECONDS`.  Returns (candidates, {(mode, window)} they settle)."""
-    import math
     import time
 
-    from singcheck.algebra.trig import LinearInPi
+    from singcheck.certify.rational_pose import simple_times
     from singcheck.roots.enclosures import AT_POINT, ExactTime
-    from singcheck.roots.rational import simplest_between
 
     rng = path.trajectory.range
     tried: dict = {}
@@ -740,16 +737,7 @@ def _zeros_inside_windows(path: PathModel, feasible: list[WorkingMode], searches
             if w.crossing or (m.label, w) in settled or len(tried) >= MAX_EXACT_WINDOWS \
                     or time.monotonic() > until:
                 continue
-            lo, hi = Fraction(w.lo), Fraction(w.hi)
-            if not lo < hi:
-                continue
-            points = [LinearInPi(simplest_between(lo, hi))]
-            k = math.ceil(w.lo / math.pi)
-            if k * math.pi < w.hi and k:
-                points.append(LinearInPi(Fraction(0), Fraction(k)))
-            for point in points:
-                if not (rng.start.ball() < point.ball() < rng.end.ball()):
-                    continue
+            for point in simple_times(w.lo, w.hi, rng):
                 key = (point.rational, point.pi_coefficient)
                 if key not in tried:
                     tried[key] = _exact_zeros(path, feasible, point)

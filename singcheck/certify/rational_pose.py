@@ -38,6 +38,22 @@ def rational_pose(path, end: LinearInPi) -> list[fmpq] | None:
     return None if any(v is None for v in values) else values
 
 
+def simple_times(lo: float, hi: float, rng) -> list[LinearInPi]:
+    """The times of (lo, hi) where an exact value is tried: its simplest rational, and
+    an integer multiple of π in it, each strictly inside the range ``rng`` (the other
+    points of a touch are not rational where the pose is)."""
+    import math
+
+    from singcheck.roots.rational import simplest_between
+
+    a, b = Fraction(lo), Fraction(hi)
+    out = [LinearInPi(simplest_between(a, b))] if a < b else []
+    k = math.ceil(lo / math.pi)
+    if k and k * math.pi < hi:
+        out.append(LinearInPi(Fraction(0), Fraction(k)))
+    return [t for t in out if rng.start.ball() < t.ball() < rng.end.ball()]
+
+
 def pose_values(path, end: LinearInPi) -> list[fmpq | None]:
     """Each of the model's pose variables at the piece time ``end``, exactly, where it
     is rational and known so (None where not: x = √2·t at t = 1)."""

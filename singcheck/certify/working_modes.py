@@ -489,25 +489,14 @@ def _exact_touch(path: PathModel, leg: LegAlongPath):
     known exactly: (the time's ball, why the mode is infeasible) when it is 0 (the
     branches meet: y = 3/2·cos(t − 1) against a leg of 3/2 at t = 1) or < 0; None
     otherwise."""
-    import math
-
-    from singcheck.algebra.trig import LinearInPi
-    from singcheck.certify.rational_pose import leg_discriminant_at, pose_values
-    from singcheck.roots.rational import simplest_between
+    from singcheck.certify.rational_pose import leg_discriminant_at, pose_values, simple_times
 
     model = path.projection.model
     rng = path.trajectory.range
     joint = leg.leg.joint
 
     def exact(piece: arb):
-        lo, hi = (Fraction(float(x)) for x in (piece.lower(), piece.upper()))
-        points = [LinearInPi(simplest_between(lo, hi))] if lo < hi else []
-        k = math.ceil(float(lo) / math.pi)
-        if k and k * math.pi < float(hi):
-            points.append(LinearInPi(Fraction(0), Fraction(k)))
-        for point in points:
-            if not rng.start.ball() < point.ball() < rng.end.ball():
-                continue
+        for point in simple_times(float(piece.lower()), float(piece.upper()), rng):
             d = leg_discriminant_at(model, leg.leg, pose_values(path, point))
             at = f"{float(path.trajectory.to_global(point.ball()).mid()):.12g}"
             if d is not None and d == 0:

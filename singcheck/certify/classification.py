@@ -670,7 +670,6 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
     """Windows the interval engine left at a range end where det A = 0 exactly (a path
     starting on the singularity: ``at_end``, from :func:`_end_zeros`).  Returns
     (candidates at those ends, {(mode, window)} the zeros settle)."""
-    from singcheck.roots.enclosures import AT_POINT, ExactTime
 
     candidates, settled = [], set()
     rng = path.trajectory.range
@@ -689,21 +688,29 @@ def _zeros_at_range_ends(path: PathModel, feasible: list[WorkingMode], searches:
         # they decide nothing more, but are reported as undecided
         mine = [(m, w) for m, w in touching if zero.get(m.label) and w.hi - w.lo <= narrow]
         settled |= {(m.label, w) for m, w in mine}
-        # the enclosure: the end, and the windows there (the certificate's checker skips
-        # them as the singular stretch, and re-proves det A = 0 at the end exactly)
-        for _, w in mine:
-            ball = ball.union(arb(w.lo).union(arb(w.hi)))
-        lo, hi = inside_range(path, ball)
-        root = RealRoot(lo.union(hi), None, exact=ExactTime(AT_POINT, end=end))
-        ball = end.ball()
-        pose_balls, joints, _ = _mode_values(path, singular, ball)
-        shown = {m.label: {leg.leg.joint: joint_float(v)
-                           for leg, v in zip(path.legs, joints[m.label], strict=True)}
-                 for m in singular}
-        candidates.append(Candidate(root, pose_balls, shown,
-                                    [ModeAtCandidate(m.label, SINGULAR, proof)
-                                     for m in singular], "real"))
+        candidates.append(_exact_candidate(path, end, singular, [w for _, w in mine], proof))
     return candidates, settled
+
+
+def _exact_candidate(path: PathModel, point, modes: list[WorkingMode], windows: list,
+                     proof: str, inside: bool = False) -> Candidate:
+    """The candidate of a time ``point`` where det A = 0 exactly along ``modes`` (a range
+    end, or with ``inside`` a touch inside the range): its enclosure the point and the
+    ``windows`` it settles (the certificate's checker skips them as the singular stretch
+    and re-proves det A = 0 at the point exactly), its pose and joints at the point."""
+    from singcheck.roots.enclosures import AT_POINT, ExactTime
+
+    ball = point.ball()
+    for w in windows:
+        ball = ball.union(arb(w.lo).union(arb(w.hi)))
+    lo, hi = inside_range(path, ball)
+    root = RealRoot(lo.union(hi), None, exact=ExactTime(AT_POINT, end=point, inside=inside))
+    pose, joints, _ = _mode_values(path, modes, point.ball())
+    shown = {m.label: {leg.leg.joint: joint_float(v)
+                       for leg, v in zip(path.legs, joints[m.label], strict=True)}
+             for m in modes}
+    return Candidate(root, pose, shown, [ModeAtCandidate(m.label, SINGULAR, proof)
+                                         for m in modes], "real")
 
 
 #: distinct times (the simplest in a window without a sign change) tried for an exact
@@ -725,7 +732,6 @@ def _zeros_inside_windows(path: PathModel, feasible: list[WorkingMode], searches
     import time
 
     from singcheck.certify.rational_pose import simple_times
-    from singcheck.roots.enclosures import AT_POINT, ExactTime
 
     rng = path.trajectory.range
     tried: dict = {}
@@ -745,24 +751,9 @@ def _zeros_inside_windows(path: PathModel, feasible: list[WorkingMode], searches
                 if zero.get(m.label):
                     found.setdefault(key, (point, proof, []))[2].append((m, w))
                     break
-    candidates, touched = [], set()
-    for point, proof, hits in found.values():
-        ball = point.ball()
-        for _, w in hits:
-            ball = ball.union(arb(w.lo).union(arb(w.hi)))
-        lo, hi = inside_range(path, ball)
-        root = RealRoot(lo.union(hi), None, exact=ExactTime(AT_POINT, end=point,
-                                                            inside=True))
-        modes = [m for m, _ in hits]
-        pose, joints, _ = _mode_values(path, modes, point.ball())
-        shown = {m.label: {leg.leg.joint: joint_float(v)
-                           for leg, v in zip(path.legs, joints[m.label], strict=True)}
-                 for m in modes}
-        candidates.append(Candidate(root, pose, shown,
-                                    [ModeAtCandidate(m.label, SINGULAR, proof) for m in modes],
-                                    "real"))
-        touched |= {(m.label, w) for m, w in hits}
-    return candidates, touched
+    candidates = [_exact_candidate(path, point, [m for m, _ in hits], [w for _, w in hits],
+                                   proof, inside=True) for point, proof, hits in found.values()]
+    return candidates, {(m.label, w) for _, _, hits in found.values() for m, w in hits}
 
 
 def _exact_zeros(path: PathModel, feasible: list[WorkingMode], point) -> tuple[dict, str]:

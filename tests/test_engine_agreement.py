@@ -71,12 +71,12 @@ def _agree(exact, interval) -> str:
         return f"verdicts {exact.verdict} / {interval.verdict}"
     if interval.verdict == "singularity-free" and exact.verdict == "singular":
         return "the intervals prove free a path the exact engine finds singular"
-    for c in interval.candidates:
-        (label,) = c.singular_modes
-        if not any(label in e.singular_modes and _overlaps(c.t, e.t)
-                   for e in exact.candidates) and exact.verdict != "unknown":
-            return f"a crossing in mode {label} near t ≈ {float(c.t.mid()):.6g} that the " \
-                   "exact engine does not find"
+    for c in interval.candidates:  # (crossings proven at one time in several modes: one)
+        for label in c.singular_modes:
+            if not any(label in e.singular_modes and _overlaps(c.t, e.t)
+                       for e in exact.candidates) and exact.verdict != "unknown":
+                return f"a crossing in mode {label} near t ≈ {float(c.t.mid()):.6g} that " \
+                       "the exact engine does not find"
     return ""
 
 
@@ -117,3 +117,23 @@ def test_the_interval_engine_never_contradicts_the_exact_one(machines, tmp_path,
     """A hypothesis property over the same generator: no contradiction, ever."""
     _, _, why = _compare(machines, tmp_path, robot, seed)
     assert not why
+
+
+def test_a_crossing_proven_in_several_modes_at_once_is_checked_mode_by_mode():
+    """The interval engine reports crossings proven at one time in several modes as one
+    candidate (all its modes); the comparison must check each mode, not expect one (it
+    raised on such a candidate, which a wider campaign of 3-RPR paths produced)."""
+    from types import SimpleNamespace as NS
+
+    from flint import arb
+
+    def report(verdict, *candidates):
+        return NS(verdict=verdict, reason="", candidates=[
+            NS(t=arb(t, 1e-9), singular_modes=list(modes)) for t, modes in candidates])
+
+    interval = report("singular", (0.5, ("+-+", "---")))
+    assert _agree(report("singular", (0.5, ("+-+",)), (0.5, ("---",))), interval) == ""
+    assert _agree(report("singular", (0.5, ("---", "+-+"))), interval) == ""
+    why = _agree(report("singular", (0.5, ("+-+",))), interval)
+    assert "mode ---" in why
+    assert _agree(report("unknown"), interval) == ""

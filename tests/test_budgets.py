@@ -316,7 +316,9 @@ def test_the_exact_zeros_at_multiples_of_pi_stop_at_the_time_limit():
     """Found by the campaign: over [6.912, 2^31] the branch-and-bound tests each of the
     683 million multiples of π for an exact zero, with no check of the time limit (a
     fuzz case ran 15 minutes past its 2 s). Over [0, 3·10^6] (a million multiples: 2.7 s
-    past a 0.5 s deadline before, without noticing it) the deadline now stops it."""
+    past a 0.5 s deadline before, without noticing it) the deadline now stops it where
+    every multiple is a zero (sin t), and a function that vanishes at none of them
+    (decided once per parity of k: p(t, 0, ±1) ≢ 0) is done at once."""
     from fractions import Fraction
 
     from singcheck.algebra.trig import TRIG, LinearInPi, TimeRange
@@ -324,13 +326,20 @@ def test_the_exact_zeros_at_multiples_of_pi_stop_at_the_time_limit():
     from singcheck.roots.branch_bound import _exact_zeros
 
     t, s, c = TRIG.gens()
-    p = t / 10 + s + 2  # never 0 at t = kπ (s = 0 there): nothing to find, all to test
     interval = TimeRange(LinearInPi(Fraction(0), Fraction(0)),
                          LinearInPi(Fraction(3 * 10**6), Fraction(0)))
     start = time.monotonic()
     with deadline(0.5), pytest.raises(TimeLimitExceeded):
-        _exact_zeros(p, interval)
+        _exact_zeros(s * (t + 1), interval)  # a zero at each of the million multiples
     assert time.monotonic() - start < 3
+    start = time.monotonic()
+    with deadline(0.5):  # never 0 at t = kπ (s = 0 there): nothing to find
+        assert _exact_zeros(t / 10 + s + 2, interval) == []
+    assert time.monotonic() - start < 0.1
+    few = TimeRange(LinearInPi(Fraction(-7), Fraction(0)), LinearInPi(Fraction(10), Fraction(0)))
+    assert [k for k, *_ in _exact_zeros(t * (c - 1), few)] == [-2, 0, 2]  # even k only
+    assert [(k, m) for k, m, *_ in _exact_zeros(t * s, few)] == \
+        [(-2, 1), (-1, 1), (0, 2), (1, 1), (2, 1), (3, 1)]
 
 
 def test_a_costly_leg_is_refused_up_front_though_legs_compose_lazily(orthoglide_projection,

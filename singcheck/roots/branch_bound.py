@@ -149,9 +149,15 @@ def _exact_zeros(p: fmpq_mpoly, interval: TimeRange) -> list[tuple[int, int, fmp
     rational box [a, b] (proven by the Taylor argument of the module docstring)."""
     start, end = float(interval.start), float(interval.end)
     out = []
-    for k in range(math.floor(start / math.pi) - 1, math.ceil(end / math.pi) + 2):
-        checkpoint()  # a long range has a multiple of π every 3.14: as many exact tests
-        if not vanishes_at_multiple_of_pi(p, k):
+    # at t = kπ ≠ 0 the test depends on k's parity alone (p(t, 0, ±1) ≡ 0 in Q[t], π
+    # being transcendental): two substitutions, however many multiples the range holds,
+    # and only the multiples of a parity where p vanishes (and 0) are visited
+    parity = {r: vanishes_at_multiple_of_pi(p, 2 + r) for r in (0, 1)}
+    first, last = math.floor(start / math.pi) - 1, math.ceil(end / math.pi) + 2
+    ks = range(first, last) if any(parity.values()) else [0] if first <= 0 < last else []
+    for k in ks:
+        checkpoint()  # a long range has a multiple of π every 3.14: as many zeros
+        if not (vanishes_at_multiple_of_pi(p, 0) if k == 0 else parity[k % 2]):
             continue
         with working_precision(128):
             z = k * arb.pi()

@@ -228,3 +228,65 @@ def test_a_constant_pose_with_a_joint_at_pi_agrees_with_the_oracle(tmp_path):
         assert ours == pytest.approx(expected, abs=1e-9)
     singular = any(abs(v) < mp.mpf(10) ** -30 for v in truth.values())
     assert report.verdict == ("singular" if singular else "singularity-free")
+
+
+def _branch_points(a, b, d):
+    """The two points of a·cos + b·sin + d = 0 on the unit circle (50-digit mpmath)."""
+    w = a * a + b * b
+    root = mp.sqrt(w - d * d)
+    return [((-a * d + sigma * b * root) / w, (-b * d - sigma * a * root) / w)
+            for sigma in (1, -1)]
+
+
+@pytest.mark.parametrize("seed", range(12))
+def test_a_path_norm_taken_on_the_legs_circle_is_the_norm(seed):
+    """Along a path (``reduce`` given) a revolute norm first takes g modulo its leg's
+    circle cos² + sin² - 1: the same values at the leg's two points, so the same norm up
+    to a power of W = a² + b² (the degree it is homogenised to may drop).  Checked against
+    the norm without that step, exactly, and against the product of g at the two points
+    (mpmath, 50 digits) at rational times."""
+    import random
+
+    rng = random.Random(seed)
+    mp.mp.dps = 50
+
+    def rand(scale=3):
+        return fmpq(rng.randint(-scale, scale), rng.randint(1, 3))
+
+    g = sum((rand() * t ** rng.randint(0, 2) * cr ** i * sr ** j
+             for i in range(4) for j in range(4 - i) if rng.random() < 0.6), ZERO)
+    g += cr ** 2 * sr ** 2 * (t + 1)  # degree 4 in (cos, sin), always
+    a, b, d = ZERO + rand() + t / 2, ZERO + rand() + 1, ZERO + rand(1) * t
+    f = a * cr + b * sr + d
+    reduced = revolute_norm(g, "cr", "sr", f, reduce=lambda p: p)
+    plain = revolute_norm(g, "cr", "sr", f)
+    w = a * a + b * b
+    power = 0
+    while reduced * w ** power != plain and power < 10:
+        power += 1
+    assert reduced * w ** power == plain, "not the same norm up to a power of W"
+    k = max(int(e[1] + e[2]) for e in divmod(g, cr ** 2 + sr ** 2 - 1)[1].monoms())
+    for t0 in (fmpq(1, 3), fmpq(-2, 7), fmpq(5, 4)):
+        av, bv, dv = (_at(x, t0) for x in (a, b, d))
+        if av * av + bv * bv <= dv * dv:
+            continue  # the leg has no real point there: the norm's value is not a product
+        value = mp.mpf(1)
+        for cv, sv in _branch_points(av, bv, dv):
+            value *= _at(g, t0, cv, sv)
+        scale = (av * av + bv * bv) ** (2 * k)
+        assert abs(_at(reduced, t0) - scale * value) <= mp.mpf(10) ** -30 * (1 + abs(scale * value))
+
+
+def _at(p, t0, cv=0, sv=0):
+    """p(cr = cv, sr = sv, t = t0) at 50 digits (r, s, c absent)."""
+    return sum(mp.mpf(int(q.p)) / int(q.q) * mp.mpf(cv) ** int(e[1]) * mp.mpf(sv) ** int(e[2])
+               * (mp.mpf(int(t0.p)) / int(t0.q)) ** int(e[3])
+               for e, q in zip(p.monoms(), p.coeffs(), strict=True))
+
+
+def test_a_function_zero_on_the_legs_circle_has_norm_zero():
+    """g = (cos² + sin² - 1)·(t + 1) vanishes at both points of any leg: its norm along a
+    path is 0 (the whole range singular), with or without the reduction."""
+    g = (cr ** 2 + sr ** 2 - 1) * (t + 1)
+    assert revolute_norm(g, "cr", "sr", cr + 2 * sr - t, reduce=lambda p: p).is_zero()
+    assert revolute_norm(g, "cr", "sr", cr + 2 * sr - t).is_zero()

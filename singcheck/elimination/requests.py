@@ -133,12 +133,21 @@ def revolute_norm(g: fmpq_mpoly, c: str, s: str, f: fmpq_mpoly, reduce=None) -> 
     depend on its angle) it may vanish too: the degenerate set, handled by the caller.
     ``reduce`` (optional, as for :func:`norm_chain`) is applied to every intermediate
     product, which keeps them small; the result is then the same modulo its relations.
+    With ``reduce``, g is first taken modulo the leg's own circle ``c² + s² - 1`` (degree
+    ≤ 1 in c): it has the same value at both points, whose product the norm is, and no
+    larger degree in (c, s) (the rotary Delta's last leg along a path: 2,326 terms ->
+    1,592, its norm 13.0 -> 9.1 ms, the same μ).
     A :func:`~singcheck.budget.checkpoint` is reached before every product.
     """
     red = reduce or (lambda x: x)
     ctx = g.context()
     names = ctx.names()
     ci, si = names.index(c), names.index(s)
+    if reduce is not None and g.degrees()[ci] + g.degrees()[si] >= 2:
+        gens = ctx.gens()
+        g = divmod(g, gens[ci] ** 2 + gens[si] ** 2 - 1)[1]
+        if g.is_zero():  # zero at both points (at every point of the circle): norm 0
+            return g
     one = ctx.from_dict({(0,) * ctx.nvars(): 1})
     zero = ctx.from_dict({})
     a, b = coefficient_in(f, ci, 1), coefficient_in(f, si, 1)

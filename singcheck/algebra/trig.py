@@ -531,7 +531,8 @@ def _exact_split(p: fmpq_mpoly):
     if dt <= 0 and dc >= 0:
         return sin_cos_parts(q)
     rows = [([0] * (dc + 1), [0] * (dc + 1)) for _ in range(dt + 1)]
-    for (i, j, k), a in zip(q.monoms(), q.coeffs()):  # (a third faster than terms())
+    # (monomials and coefficients: a third faster to read than terms())
+    for (i, j, k), a in zip(q.monoms(), q.coeffs(), strict=True):
         rows[i][j][k] = a
     return [(fmpq_poly(r0), fmpq_poly(r1)) for r0, r1 in rows]
 

@@ -168,7 +168,7 @@ def _cheap_factors(p: fmpq_mpoly) -> list[tuple[fmpq_mpoly, int]] | None:
         return None
     by_trig: dict[tuple[int, int], dict] = {}
     by_t: dict[int, dict] = {}
-    for (i, j, k), a in zip(p.monoms(), p.coeffs()):
+    for (i, j, k), a in zip(p.monoms(), p.coeffs(), strict=True):
         by_trig.setdefault((j, k), {})[i] = a
         by_t.setdefault(i, {})[(0, j, k)] = a
     in_t = _gcd_in_t(by_trig.values())

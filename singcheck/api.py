@@ -534,9 +534,45 @@ def prepare_regions(robot: Robot, trajectories: list[TrajectorySpec], time_limit
 #: the trajectories a batch reads before it starts: the shared region maps are prepared
 #: from them, and a batch of at most 4 runs in this process
 LOOKAHEAD = 100
-#: trajectories per task of a batch's worker processes, and tasks in flight per worker
+#: trajectories per task of a batch's worker processes at first, and tasks in flight per
+#: worker; then each task holds what takes about TASK_SECONDS at the pace seen so far, at
+#: most MAX_CHUNK (:class:`_TaskSizes`)
 CHUNK = 8
 TASKS_PER_WORKER = 4
+MAX_CHUNK = 64
+TASK_SECONDS = 0.25
+
+
+class _TaskSizes:
+    """How many trajectories the next task of a forked batch holds.
+
+    Each task costs the pool its pickling, two pipes and a few thread wake-ups, about
+    1.5 ms of CPU beyond its trajectories', much of it in this process, which shares the
+    cores with the workers: 2,000 hearts (4 ms each) in tasks of 8 took 8.9 s of CPU on
+    2 cores, in tasks of 64 8.5 s.  So the first tasks hold CHUNK, and the next ones what
+    takes about TASK_SECONDS at the pace seen so far (at most MAX_CHUNK): hearts go 64 to
+    a task, paths of a second one by one.  Once the input has ended, what is left is
+    shared among the workers (a task holds at most a (2·jobs)-th of it), so that the
+    batch does not end with one worker on a long task while the others wait."""
+
+    def __init__(self, jobs: int) -> None:
+        from time import monotonic
+
+        self.jobs, self.clock, self.start, self.done = jobs, monotonic, monotonic(), 0
+
+    def finished(self, count: int) -> None:
+        self.done += count
+
+    def next(self, left: int | None = None) -> int:
+        """The next task's size; ``left``: the trajectories still to send, once the
+        input has ended (None before)."""
+        size = CHUNK
+        if self.done:
+            per_path = (self.clock() - self.start) * self.jobs / self.done
+            size = max(1, min(max(CHUNK, MAX_CHUNK), int(TASK_SECONDS / max(per_path, 1e-6))))
+        if left is not None:
+            size = min(size, max(1, -(-left // (2 * self.jobs))))
+        return size
 
 
 def shared_regions(robot: Robot, head: list, options: dict, notify: Notify = _quiet) -> None:
@@ -597,10 +633,11 @@ def check_batch(robot: Robot, trajectories: Iterable[TrajectorySpec | Document],
 
 def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
             line: Callable[[dict], str] | None = None) -> Iterator[dict | Formatted]:
-    """The batch in ``jobs`` forked workers, CHUNK trajectories per task and
-    TASKS_PER_WORKER tasks per worker in flight: a finished task is replaced by the next
-    one read (before its results are yielded), so at most that many trajectories are
-    held here at once, whatever the length of the batch.
+    """The batch in ``jobs`` forked workers, TASKS_PER_WORKER tasks per worker in flight
+    (of CHUNK to MAX_CHUNK trajectories: :class:`_TaskSizes`): a finished task is
+    replaced by the next one read (before its results are yielded), so at most that many
+    trajectories (and two tasks' worth read ahead) are held here at once, whatever the
+    length of the batch.
 
     A worker that dies (killed, out of memory) breaks the pool and every task in flight
     with it: each of those tasks is run again, alone in a new pool (no other task in
@@ -632,6 +669,9 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
     in_flight: dict = {}  # future -> (index of its first trajectory, its trajectories)
     lost: deque = deque()  # (first index, trajectories) of tasks whose worker died
     read = 0
+    sizes = _TaskSizes(jobs)
+    ahead: deque = deque()  # read, not sent yet (to know, near the end, what is left)
+    ended = False
 
     def send(chunk: list):
         nonlocal pool
@@ -647,8 +687,15 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
                 return pool.submit(_check_chunk, chunk)
 
     def submit() -> bool:
-        nonlocal read
-        chunk = list(islice(items, CHUNK))
+        nonlocal read, ended
+        size = sizes.next()
+        while not ended and len(ahead) < 2 * size:
+            more = list(islice(items, 2 * size - len(ahead)))
+            ahead.extend(more)
+            ended = not more
+        if ended:
+            size = sizes.next(len(ahead))
+        chunk = [ahead.popleft() for _ in range(min(size, len(ahead)))]
         if chunk:
             in_flight[send(chunk)] = (read, chunk)
             read += len(chunk)
@@ -686,6 +733,7 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
                 finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
                 for future in finished:
                     first, chunk = in_flight.pop(future)  # a done future holds its results
+                    sizes.finished(len(chunk))
                     try:
                         results += enumerate(future.result(), first)
                     except Exception:  # noqa: BLE001 - its worker died: run it again

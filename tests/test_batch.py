@@ -682,6 +682,7 @@ def _killing(monkeypatch, killer):
 
     monkeypatch.setattr(api, "check_safely", check_safely)
     monkeypatch.setattr(api, "CHUNK", 2)
+    monkeypatch.setattr(api, "MAX_CHUNK", 2)
     monkeypatch.setattr(api, "TASKS_PER_WORKER", 2)
     return real
 
@@ -1136,3 +1137,28 @@ def test_a_long_streamed_batch_leaves_the_parent_as_it_was(tmp_path, monkeypatch
     grown, count = _traced_growth((verdicts.add(r["verdict"]) for r in batch), (1000, 5000))
     assert count == 5200 and verdicts <= {"singular", "singularity-free", "infeasible"}
     assert grown < 256 * 1024, grown  # the 4,000 names were about 680 KB
+
+
+def test_task_sizes_follow_the_pace_and_share_the_end():
+    """A forked batch's tasks: CHUNK trajectories before any has finished, then what
+    takes about TASK_SECONDS at the pace seen (fast paths: MAX_CHUNK; a path of a
+    second: one), and once the input has ended at most a (2·jobs)-th of what is left."""
+    from singcheck import api
+
+    now = [0.0]
+    sizes = api._TaskSizes(2)
+    sizes.clock, sizes.start = (lambda: now[0]), 0.0
+    assert sizes.next() == api.CHUNK
+    now[0] = 0.5
+    sizes.finished(500)  # 2 workers, 2 ms a path
+    assert sizes.next() == api.MAX_CHUNK
+    assert sizes.next(left=40) == 10  # the end: 40 left, shared by 2 workers
+    assert sizes.next(left=3) == 1
+    slow = api._TaskSizes(2)
+    slow.clock, slow.start = (lambda: now[0]), 0.0
+    slow.finished(1)  # one path in 0.5 s on 2 workers: a second each
+    assert slow.next() == 1
+    mid = api._TaskSizes(4)
+    mid.clock, mid.start = (lambda: now[0]), 0.0
+    mid.finished(100)  # 20 ms a path: a task of 0.25 s holds 12
+    assert mid.next() == 12

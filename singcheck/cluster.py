@@ -42,6 +42,7 @@ def check_address(address: str) -> None:
     out of range.  Given one, ``Client`` raised from inside its constructor, printed a
     ``Client.__del__`` traceback and stalled a minute on its way out."""
     try:
+        _import_distributed()
         from distributed.comm.addressing import get_address_host_port, parse_address
         from distributed.comm.registry import get_backend
     except ImportError:
@@ -56,6 +57,31 @@ def check_address(address: str) -> None:
     except (ValueError, TypeError) as e:
         raise SpecError(f"--scheduler {address}: not a scheduler address ({e}); e.g. "
                         "tcp://10.0.0.5:8786") from None
+
+
+#: modules dask.distributed uses when they are there and does without otherwise (NumPy to
+#: allocate receive buffers, Jinja2 for notebook reprs); a batch needs neither
+OPTIONAL_IMPORTS = ("numpy", "jinja2")
+
+
+def _import_distributed() -> None:
+    """``import distributed`` without :data:`OPTIONAL_IMPORTS` (those not imported
+    already): they are 30% of its import time (0.26 s on 2 cores), which the batch's
+    command waits for before the cluster's workers get their first task.  The modules
+    stay importable afterwards.  Raises ImportError when dask.distributed is missing."""
+    import sys
+
+    if "distributed" in sys.modules:
+        return
+    held = [name for name in OPTIONAL_IMPORTS if name not in sys.modules]
+    for name in held:
+        sys.modules[name] = None  # import raises ImportError: the fallback is taken
+    try:
+        import distributed  # noqa: F401
+    finally:
+        for name in held:
+            if sys.modules.get(name, False) is None:
+                del sys.modules[name]
 
 
 def _client(address: str):
@@ -80,12 +106,12 @@ def _remote_check(robot: Robot, chunk: list, options: dict, region_cache: bool,
     return [formatted(check_item(robot, item, **options), line) for item in chunk]
 
 
-#: the periodic diagnostics of a worker and of its nanny that a batch pauses while it
-#: runs (restored when it ends): the statistical profiler (every 10 ms, it stops the
-#: task's thread to read its stack), the event loop's tick measure (20 ms) and the system
-#: monitor (500 ms).  Each wakes the process's event loop, which takes the GIL from the
-#: task; on 2 cores with 2 workers these cost the cluster about 10% of its throughput
-#: against ``--jobs 2`` (docs/speed.md).  None of them guards anything.
+#: the periodic diagnostics of a worker, of its nanny and of the scheduler that a batch
+#: pauses while it runs (restored when it ends): the statistical profiler (every 10 ms,
+#: it stops the task's thread to read its stack), the event loop's tick measure (20 ms)
+#: and the system monitor (500 ms).  Each wakes the process's event loop, which takes the
+#: GIL from the task; on 2 cores with 2 workers these cost the cluster about 10% of its
+#: throughput against ``--jobs 2`` (docs/speed.md).  None of them guards anything.
 DIAGNOSTICS = ("profile", "profile-cycle", "tick", "ticks", "monitor")
 #: periodic guards slowed (not stopped) during a batch, to this many ms: the memory
 #: monitor (spill, pause, restart past the memory limit) polls every 100 ms by default;
@@ -169,13 +195,24 @@ def _resume_diagnostics(dask_worker) -> None:
 
 
 def _on_workers(client, function) -> None:
-    """Run ``function`` on every worker and every nanny; a cluster that refuses
-    (``Client.run`` disabled, a worker gone) only keeps its diagnostics running."""
+    """Run ``function`` on every worker, every nanny and the scheduler; a cluster that
+    refuses (``Client.run`` disabled, a worker gone) only keeps its diagnostics running."""
     for nanny in (False, True):
         try:
             client.run(function, nanny=nanny, on_error="ignore")
         except Exception:  # noqa: BLE001 - an optimisation, never the batch's failure
             pass
+    try:
+        client.run_on_scheduler(_on_scheduler, function)
+    except Exception:  # noqa: BLE001 - as above
+        pass
+
+
+def _on_scheduler(function, dask_scheduler=None) -> None:
+    """``function`` (:func:`_pause_diagnostics` or :func:`_resume_diagnostics`) on the
+    scheduler: its tick measure (every 20 ms) and system monitor (500 ms) wake its event
+    loop on a core the workers need."""
+    function(dask_scheduler)
 
 
 #: trajectories per task: on a 2-worker LocalCluster a task cost about 14 ms of CPU

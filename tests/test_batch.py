@@ -458,12 +458,16 @@ def _diagnostics(dask_worker) -> dict:
     return out
 
 
+def _scheduler_diagnostics(dask_scheduler=None) -> dict:
+    return _diagnostics(dask_scheduler)
+
+
 def test_a_dask_batch_pauses_the_workers_diagnostics_and_restores_them(
         local_cluster, tmp_path, orthoglide_robot):
-    """While a batch runs, every worker's and nanny's profiler, tick and system monitor
-    are paused, the memory monitor polls every second (not 100 ms) and the garbage
-    collector's first threshold is the command line's own; once the batch has ended, or
-    is stopped early, they are as they were."""
+    """While a batch runs, every worker's and nanny's profiler, tick and system monitor,
+    and the scheduler's tick and monitor, are paused, the memory monitor polls every
+    second (not 100 ms) and the garbage collector's first threshold is the command
+    line's own; once the batch has ended, or is stopped early, they are as they were."""
     import gc
 
     from distributed import Client
@@ -487,6 +491,8 @@ def test_a_dask_batch_pauses_the_workers_diagnostics_and_restores_them(
             assert all(d["tick"] and d["monitor"] and d["memory_monitor"] == 100
                        for d in before)
             assert all(d["gc"] < GC_THRESHOLD for d in before)
+            scheduler = client.run_on_scheduler(_scheduler_diagnostics)
+            assert scheduler["tick"] and scheduler["monitor"]
             for stop_early in (False, True):
                 results = check_on_cluster(local_cluster.scheduler_address, orthoglide_robot,
                                            specs, regions=False)
@@ -496,11 +502,14 @@ def test_a_dask_batch_pauses_the_workers_diagnostics_and_restores_them(
                 assert all(not any(v for k, v in d.items() if k not in ("memory_monitor", "gc"))
                            and d["memory_monitor"] == 1000 and d["gc"] == GC_THRESHOLD
                            for d in during), during
+                paused = client.run_on_scheduler(_scheduler_diagnostics)
+                assert not paused["tick"] and not paused["monitor"], paused
                 if stop_early:
                     results.close()  # (the CLI's Ctrl-C, or a consumer that stops)
                 else:
                     assert len(list(results)) == len(specs) - 1
                 assert every(False) + every(True) == before
+                assert client.run_on_scheduler(_scheduler_diagnostics) == scheduler
     finally:
         gc.set_threshold(*threshold)
 
@@ -1162,3 +1171,18 @@ def test_task_sizes_follow_the_pace_and_share_the_end():
     mid.clock, mid.start = (lambda: now[0]), 0.0
     mid.finished(100)  # 20 ms a path: a task of 0.25 s holds 12
     assert mid.next() == 12
+
+
+def test_distributed_is_imported_without_its_optional_modules_which_stay_importable():
+    """The batch's command imports dask.distributed without NumPy and Jinja2 (30% of
+    its import time, before the workers' first task); both import afterwards."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from singcheck.cluster import _import_distributed; "
+            "_import_distributed(); import distributed; "
+            "print('numpy' in sys.modules, 'jinja2' in sys.modules); "
+            "import numpy, jinja2; print(numpy.zeros(2).sum())")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=ROOT, check=True).stdout.split()
+    assert out == ["False", "False", "0.0"]

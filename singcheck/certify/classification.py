@@ -63,6 +63,7 @@ from singcheck.certify.exact import vanishes_at_root
 from singcheck.certify.interval_engine import HINT_WIDTH, inside_range, search_det_a
 from singcheck.certify.interval_engine import mode_values as _mode_values
 from singcheck.certify.path import PathModel, joint_float
+from singcheck.certify.windows import isolate_on_windows, window_ranges
 from singcheck.certify.working_modes import (
     FEASIBLE,
     INFEASIBLE,
@@ -431,7 +432,9 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
         exact = with_mu(path)
         if exact.mu is None:  # the intervals alone, with their whole budget this time
             return _certify_by_intervals(exact, modes, None, tolerance)
-        return _certify_exactly(exact, modes, tolerance, searches)
+        if searches is None:
+            return _certify_exactly(exact, modes, tolerance)
+        return _exactly_on_windows(exact, modes, tolerance, searches)
     if defer:
         report = _certify_by_intervals(replace_path(path, CORROBORATION_PENDING), modes,
                                        searches, tolerance)
@@ -445,6 +448,33 @@ def _interval_engine_first(path: PathModel, modes: list[WorkingMode],
         exact = replace_path(path, f"the exact engine did not finish within its "
                                    f"{EXACT_CORROBORATION_BUDGET:g} s budget")
     return _certify_by_intervals(exact, modes, searches, tolerance)
+
+
+#: seconds the exact engine may take on the whole range when the interval engine left
+#: windows (and at most half the trajectory's time left): past them it isolates μ's
+#: roots on the windows alone (:mod:`.windows`), and the stretches the intervals proved
+#: stand on the intervals, as for a path they decided (EXACT_CORROBORATION_BUDGET)
+EXACT_WHOLE_RANGE_SECONDS = EXACT_CORROBORATION_BUDGET
+
+
+def _exactly_on_windows(path: PathModel, modes: list[WorkingMode], tolerance: float,
+                        searches: dict) -> TrajectoryReport:
+    """The exact engine where the interval engine left windows: μ on the whole range
+    within :data:`EXACT_WHOLE_RANGE_SECONDS` (or half the time left, if less); past
+    that, μ restricted to the windows, with the rest of the time."""
+    from singcheck.budget import TimeLimitExceeded, deadline, remaining
+
+    left = remaining()
+    seconds = EXACT_WHOLE_RANGE_SECONDS if left is None else \
+        min(EXACT_WHOLE_RANGE_SECONDS, left / 2)
+    try:
+        with deadline(seconds):
+            return _certify_exactly(path, modes, tolerance, searches)
+    except TimeLimitExceeded:
+        if left is not None and remaining() <= 0:
+            raise  # the trajectory's own time limit
+    return _certify_exactly(path, modes, tolerance, searches,
+                            window_ranges(path.trajectory.range, searches))
 
 
 def _exactly_within(path: PathModel, modes: list[WorkingMode], searches: dict,
@@ -521,12 +551,19 @@ def replace_path(path: PathModel, why: str) -> PathModel:
 
 
 def _certify_exactly(path: PathModel, modes: list[WorkingMode], tolerance: float,
-                     searches: dict | None = None) -> TrajectoryReport:
+                     searches: dict | None = None,
+                     windows: list | None = None) -> TrajectoryReport:
     """The exact engine's verdict (μ's certified roots, classified per mode), held against
-    the interval engine's (``searches`` when it has run already)."""
+    the interval engine's (``searches`` when it has run already).  ``windows``: the
+    ranges of t (:func:`.windows.window_ranges`) to which μ is restricted (None: the
+    whole range); outside them the verdict rests on the intervals' proof."""
+    def isolate(rng):
+        return isolate_real_roots(path.mu, rng, tolerance, vanishes_at_root)
+
     try:
-        isolation = isolate_real_roots(path.mu, path.trajectory.range, tolerance,
-                                       vanishes_at_root)
+        isolation = isolate(path.trajectory.range) if windows is None else \
+            isolate_on_windows(isolate, windows, WINDOWS_ONLY.format(
+                count=len(windows), seconds=EXACT_WHOLE_RANGE_SECONDS))
     except IdenticallyZeroError:
         return _certify_on_surface(path, modes, tolerance, searches)
     candidates = _classify_all(path, modes, isolation.roots, tolerance)
@@ -538,7 +575,14 @@ def _certify_exactly(path: PathModel, modes: list[WorkingMode], tolerance: float
     verdict, reason = verdict_of(modes, candidates, undecided)
     return _corroborated(TrajectoryReport(path, verdict, reason, candidates, modes,
                                           isolation.method, undecided,
-                                          not isolation.undecided), searches)
+                                          not isolation.undecided and windows is None),
+                         searches)
+
+
+#: the root isolation's name when μ was restricted to the interval engine's windows
+WINDOWS_ONLY = ("on the interval engine's {count} window(s) only (μ restricted to them: "
+                "the whole range took more than {seconds:g} s; det A ≠ 0 elsewhere by ball "
+                "arithmetic)")
 
 
 def _corroborated(report: TrajectoryReport, searches: dict | None = None) -> TrajectoryReport:

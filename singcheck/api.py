@@ -544,21 +544,27 @@ TASK_SECONDS = 0.25
 
 
 class _TaskSizes:
-    """How many trajectories the next task of a forked batch holds.
+    """How many trajectories the next task of a batch holds.
 
     Each task costs the pool its pickling, two pipes and a few thread wake-ups, about
-    1.5 ms of CPU beyond its trajectories', much of it in this process, which shares the
-    cores with the workers: 2,000 hearts (4 ms each) in tasks of 8 took 8.9 s of CPU on
-    2 cores, in tasks of 64 8.5 s.  So the first tasks hold CHUNK, and the next ones what
-    takes about TASK_SECONDS at the pace seen so far (at most MAX_CHUNK): hearts go 64 to
-    a task, paths of a second one by one.  Once the input has ended, what is left is
-    shared among the workers (a task holds at most a (2·jobs)-th of it), so that the
-    batch does not end with one worker on a long task while the others wait."""
+    1.5 ms of CPU beyond its trajectories' (a Dask task about 14 ms), much of it in this
+    process, which shares the cores with the workers: 2,000 hearts (4 ms each) in tasks
+    of 8 took 8.9 s of CPU on 2 cores, in tasks of 64 8.5 s.  So the first tasks hold
+    ``first`` (CHUNK), and the next ones what takes about ``seconds`` (TASK_SECONDS) at
+    the pace seen so far, at most ``most`` (MAX_CHUNK): hearts go 64 to a task, paths of
+    a second one by one.  Once the input has ended, what is left is shared among the
+    workers (a task holds at most a (2·workers)-th of it, at least ``least``), so that
+    the batch does not end with one worker on a long task while the others wait."""
 
-    def __init__(self, jobs: int) -> None:
+    def __init__(self, workers: int, first: int | None = None, most: int | None = None,
+                 seconds: float | None = None, least: int = 1) -> None:
         from time import monotonic
 
-        self.jobs, self.clock, self.start, self.done = jobs, monotonic, monotonic(), 0
+        self.workers, self.clock, self.start, self.done = workers, monotonic, monotonic(), 0
+        self.first = CHUNK if first is None else first
+        self.most = max(self.first, MAX_CHUNK if most is None else most)
+        self.seconds = TASK_SECONDS if seconds is None else seconds
+        self.least = least
 
     def finished(self, count: int) -> None:
         self.done += count
@@ -566,12 +572,12 @@ class _TaskSizes:
     def next(self, left: int | None = None) -> int:
         """The next task's size; ``left``: the trajectories still to send, once the
         input has ended (None before)."""
-        size = CHUNK
+        size = self.first
         if self.done:
-            per_path = (self.clock() - self.start) * self.jobs / self.done
-            size = max(1, min(max(CHUNK, MAX_CHUNK), int(TASK_SECONDS / max(per_path, 1e-6))))
+            per_path = (self.clock() - self.start) * self.workers / self.done
+            size = max(1, min(self.most, int(self.seconds / max(per_path, 1e-6))))
         if left is not None:
-            size = min(size, max(1, -(-left // (2 * self.jobs))))
+            size = min(size, max(self.least, -(-left // (2 * self.workers))))
         return size
 
 

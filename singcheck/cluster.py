@@ -26,6 +26,7 @@ from singcheck.api import (
     Robot,
     _head,
     _quiet,
+    _TaskSizes,
     check_item,
     formatted,
     shared_regions,
@@ -215,10 +216,14 @@ def _on_scheduler(function, dask_scheduler=None) -> None:
     function(dask_scheduler)
 
 
-#: trajectories per task: on a 2-worker LocalCluster a task cost about 14 ms of CPU
-#: beyond its trajectories' own (a heart-like path: about 5 ms), so a long batch goes 64
-#: to a task, a short one in at least TASKS_PER_WORKER tasks per worker thread
-CHUNK = 64
+#: trajectories per task at most, and the seconds a task should take: on a 2-worker
+#: cluster a task costs about 14 ms of CPU beyond its trajectories' own (a heart: about
+#: 4 ms), so tasks start at FIRST_CHUNK and grow to what takes TASK_SECONDS at the pace
+#: seen (:class:`singcheck.api._TaskSizes`; 2,000 hearts on 2 cores: 128 a task ran 5%
+#: faster than 64); a short batch goes in at least TASKS_PER_WORKER tasks per thread
+CHUNK = 128
+FIRST_CHUNK = 16
+TASK_SECONDS = 0.5
 TASKS_PER_WORKER = 4
 
 
@@ -258,10 +263,12 @@ def check_on_cluster(address: str, robot: Robot,
         _on_workers(client, _pause_diagnostics)
         quiet = True
         window = max(8, TASKS_PER_WORKER * threads)  # tasks in flight
-        size = CHUNK if len(head) == LOOKAHEAD else max(1, min(CHUNK, -(-len(head) // window)))
+        first = FIRST_CHUNK if len(head) == LOOKAHEAD else \
+            max(1, min(FIRST_CHUNK, -(-len(head) // window)))
+        sizes = _TaskSizes(threads, first, CHUNK, TASK_SECONDS, TAIL)
         yield from _results(_Submitter(client, shipped, chain(head, items), options,
-                                       robot.region_cache is not None, window, size, line,
-                                       threads), ordered)
+                                       robot.region_cache is not None, window, sizes, line),
+                            ordered)
     finally:
         if quiet:
             _on_workers(client, _resume_diagnostics)
@@ -276,20 +283,21 @@ class _Submitter:
     """Submits the tasks a window at a time (``window`` in flight), so that neither this
     process nor the scheduler holds a task per trajectory of a long batch at once.
 
-    It reads two tasks ahead: once the input has ended, the last trajectories go in
-    smaller and smaller tasks (a share of what is left per worker thread, at least
-    TAIL), so that the batch does not end with one worker on a whole task of 64 while
-    the others wait."""
+    Each task's size is ``sizes.next()`` (:class:`singcheck.api._TaskSizes`: small at
+    first, then what takes about TASK_SECONDS at the pace seen); it reads two tasks
+    ahead, so that once the input has ended the last trajectories go in smaller and
+    smaller tasks (a share of what is left per worker thread, at least TAIL), and the
+    batch does not end with one worker on a whole task while the others wait."""
 
     def __init__(self, client, shipped, items: Iterator, options, region_cache: bool,
-                 window: int, size: int, line=None, threads: int = 1) -> None:
+                 window: int, sizes: _TaskSizes, line=None) -> None:
         from collections import deque
 
         from distributed import as_completed
 
         self.client, self.shipped, self.options, self.line = client, shipped, options, line
         self.region_cache = region_cache
-        self.items, self.size, self.threads = items, size, max(1, threads)
+        self.items, self.sizes = items, sizes
         self.ahead: deque = deque()  # read, not submitted yet
         self.ended = False
         self.read = 0
@@ -301,7 +309,8 @@ class _Submitter:
 
     def next(self) -> None:
         """Submit the next few trajectories as one task, if any is left."""
-        while not self.ended and len(self.ahead) < 2 * self.size:
+        size = self.sizes.next()
+        while not self.ended and len(self.ahead) < 2 * size:
             item = next(self.items, _END)
             if item is _END:
                 self.ended = True
@@ -309,8 +318,7 @@ class _Submitter:
                 self.ahead.append(item)
         if not self.ahead:
             return
-        count = self.size if not self.ended else \
-            min(self.size, max(TAIL, -(-len(self.ahead) // (2 * self.threads))))
+        count = self.sizes.next(len(self.ahead)) if self.ended else size
         chunk = [self.ahead.popleft() for _ in range(min(count, len(self.ahead)))]
         chunk = [item.loaded() if isinstance(item, Span) else item for item in chunk]
         future = self.client.submit(_remote_check, self.shipped, chunk, self.options,
@@ -331,6 +339,7 @@ def _results(tasks: _Submitter, ordered: bool) -> Iterator[dict]:
     next_out = 0
     for future in tasks.completed:
         first, chunk = tasks.chunks.pop(future.key)
+        tasks.sizes.finished(len(chunk))
         try:
             docs = future.result()
         except Exception as e:  # the task was lost (a worker died) or could not run

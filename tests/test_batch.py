@@ -1000,6 +1000,9 @@ def test_a_dask_task_that_killed_its_workers_is_those_paths_error(orthoglide_rob
         line = None
 
         def __init__(self):
+            from singcheck.api import _TaskSizes
+
+            self.sizes = _TaskSizes(2)
             self.completed = [Future("a", KilledWorker("singcheck-0-0", Worker(), 3)),
                               Future("b", RuntimeError("boom"))]
             self.chunks = {"a": (0, [p0, p1]), "b": (2, [p2])}
@@ -1186,3 +1189,45 @@ def test_distributed_is_imported_without_its_optional_modules_which_stay_importa
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          cwd=ROOT, check=True).stdout.split()
     assert out == ["False", "False", "0.0"]
+
+
+def test_dask_tasks_start_small_grow_with_the_pace_and_share_the_end(monkeypatch):
+    """The cluster's submitter: FIRST_CHUNK trajectories a task until some have
+    finished, then what takes TASK_SECONDS at the pace seen (at most CHUNK), and once the
+    input has ended a share of what is left per worker thread (at least TAIL)."""
+    import distributed
+
+    from singcheck import cluster
+    from singcheck.api import _TaskSizes
+
+    class Completed(list):
+        add = list.append
+
+    class Client:
+        loop = None
+
+        def __init__(self):
+            self.sizes = []
+
+        def submit(self, function, shipped, chunk, *args, key, pure):
+            self.sizes.append(len(chunk))
+            return type("Future", (), {"key": key})()
+
+    monkeypatch.setattr(distributed, "as_completed", lambda loop: Completed())
+    now = [0.0]
+    sizes = _TaskSizes(2, cluster.FIRST_CHUNK, cluster.CHUNK, cluster.TASK_SECONDS,
+                       cluster.TAIL)
+    sizes.clock, sizes.start = (lambda: now[0]), 0.0
+    client = Client()
+    tasks = cluster._Submitter(client, None, iter(range(1000)), {}, False, 8, sizes)
+    assert client.sizes == [cluster.FIRST_CHUNK] * 8
+    now[0] = 0.064
+    sizes.finished(32)  # 2 threads, 4 ms a path: a task of 0.5 s holds 125
+    tasks.next()
+    assert client.sizes[-1] == min(cluster.CHUNK, 125)
+    while tasks.ahead or not tasks.ended:
+        tasks.next()
+    assert sum(client.sizes) == 1000
+    tail = client.sizes[9:]
+    assert tail == sorted(tail, reverse=True) and tail[-1] >= cluster.TAIL
+    assert max(tail[1:]) <= -(-(1000 - 128 - 125) // 4)

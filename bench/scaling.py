@@ -51,9 +51,10 @@ def _run(cmd: list[str], stream: Path, env: dict) -> dict:
             sampled = pool.submit(_sample_parent, parent_cpu, parent_rss)
             code, peak_mb, cpu = run_measured(cmd, cwd=ROOT, env=env, stdin=stdin, stdout=out,
                                               stderr=subprocess.DEVNULL)
+            # the run's end, before the sampler's last sleep (up to SAMPLE_S) is waited for
+            wall = time.perf_counter() - start
             parent_cpu.append(None)  # stop the sampler
             sampled.result()
-        wall = time.perf_counter() - start
         out.seek(0)
         lines = sum(1 for line in out if json.loads(line)["verdict"])
     return {"wall_s": wall, "cpu_s": cpu, "parent_cpu_s": parent_cpu[0], "exit_code": code,

@@ -92,3 +92,68 @@ def test_window_ranges_hold_every_window_merged_widened_and_clipped_exactly():
     assert first.end.rational - Fraction(0.3) < Fraction(1, 10 ** 11)
     assert last.start.rational < 3 and last.end is pi
     assert window_ranges(rng, {"a": _search("a")}) == []
+
+
+def _touch_case(rng):
+    """A random biglide path y = a(t − t0)²(1 + b·sin kt) + ε, x = c·sin mt, on a range
+    about t0 (a touch at t0 for ε = 0, two crossings for ε < 0, none for ε > 0), and the
+    oracle's answer: the verdict and the singular times at 50 digits (None: the path
+    comes within 1/100 of the workspace's edge y = 3/2, not this test's question)."""
+    t0 = Fraction(rng.randint(-8, 8), rng.choice([2, 3, 4, 5, 7])) / 4
+    a = Fraction(rng.randint(1, 3), rng.choice([8, 10, 12]))
+    b, c = Fraction(rng.randint(-3, 3), 4), Fraction(rng.randint(-4, 4), 5)
+    k, m = rng.randint(1, 6), rng.randint(1, 5)
+    eps = rng.choice([Fraction(0), Fraction(0), Fraction(1, 10**8), Fraction(-1, 10**8)])
+    lo, hi = Fraction(rng.randint(-6, 0), 4), Fraction(rng.randint(1, 6), 4)
+    text = (f"name: p\nparameter: t\nrange: [{lo}, {hi}]\npose:\n  x: ({c})*sin({m}*t)\n"
+            f"  y: ({a})*(t - ({t0}))^2*(1 + ({b})*sin({k}*t)) + ({eps})\n")
+    mp.mp.dps = 50
+
+    def q(r):
+        return mp.mpf(r.numerator) / r.denominator
+
+    def y(t):
+        return q(a) * (t - q(t0)) ** 2 * (1 + q(b) * mp.sin(k * t)) + q(eps)
+
+    top = max(abs(y(q(lo) + (q(hi) - q(lo)) * j / 4000)) for j in range(4001))
+    if abs(top - mp.mpf(3) / 2) < mp.mpf(1) / 100:
+        return text, None
+    if top > mp.mpf(3) / 2:  # the shorter leg (3/2) cannot reach: no mode follows the path
+        return text, ("infeasible", [])
+    if eps > 0:
+        return text, ("singularity-free", [])
+    if eps == 0:
+        return text, (("singular", [t0]) if lo <= t0 <= hi else ("singularity-free", []))
+    width = 3 * mp.sqrt(q(-eps / a) / (1 - abs(q(b))))
+    zeros = [mp.findroot(y, tuple(sorted((q(t0), q(t0) + side * width))), solver="anderson")
+             for side in (-1, 1)]
+    zeros = [z for z in zeros if q(lo) <= z <= q(hi)]
+    return text, (("singular", zeros) if zeros else ("singularity-free", []))
+
+
+@pytest.mark.slow
+def test_both_routes_agree_with_the_oracle_on_random_touches(biglide, tmp_path, monkeypatch):
+    """40 random touches, near misses and double crossings of the biglide's y = 0 (seed
+    fixed): the default route and μ on the windows alone give the oracle's verdict and
+    singular times (within 1e-6), and the windows route is taken on the touches."""
+    import random
+
+    rng = random.Random(20261128)
+    taken = 0
+    for _ in range(40):
+        text, expected = _touch_case(rng)
+        if expected is None:
+            continue
+        path = tmp_path / "p.yaml"
+        path.write_text(text)
+        for seconds in (classification.EXACT_CORROBORATION_BUDGET, 0.0):
+            monkeypatch.setattr(classification, "EXACT_WHOLE_RANGE_SECONDS", seconds)
+            doc = api.check(biglide, api.load_trajectory(str(path), biglide),
+                            regions=False).to_dict()
+            times = sorted(c["t"] for c in doc["candidates"] if c["singular_modes"])
+            assert doc["verdict"] == expected[0], (text, doc["reason"])
+            assert len(times) == len(expected[1]), (text, times)
+            assert all(abs(s - float(z)) < 1e-6 for s, z in zip(times, expected[1],
+                                                                   strict=True)), text
+            taken += "window(s) only" in doc["root_isolation"]
+    assert taken >= 5  # the windows route did run

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from fractions import Fraction
 from itertools import product
-from math import isqrt
 
 from singcheck.verify.numbers import PI, Iv, NotDecided, cos, sin
 from singcheck.verify.reader import (
@@ -316,11 +315,58 @@ def value(tree, env: dict, leaf: dict):
     return a + b if op == "+" else a - b if op == "-" else a * b if op == "*" else a / b
 
 
-def _exact_root(x: Fraction) -> Fraction:
-    r = [isqrt(max(n, 0)) for n in (x.numerator, x.denominator)]
-    if Fraction(r[0] ** 2, r[1] ** 2) != x:
-        raise NotDecided("an irrational square root at an exact time")
-    return Fraction(r[0], r[1])
+def _exact_root(x: Fraction):
+    """√x exactly: a rational, or a :class:`_Surd` (x > 0 not a square)."""
+    if x < 0:
+        raise NotDecided("the square root of a negative number at an exact time")
+    root, kernel = _square_free(x.numerator * x.denominator)
+    return _surd({kernel: Fraction(root, x.denominator)})
+
+
+class _Surd(dict):
+    """Σ c_k·√k exactly, k squarefree positive integers (1: the rational part), with some
+    k > 1 (a rational is a Fraction: :func:`_surd`): x = √2·t at t = 1.  Square roots of
+    distinct squarefree integers are linearly independent over Q: two are equal exactly
+    when their coefficients are; √k·√l = s·√m with kl = s²·m.  Never divided by, nor a
+    sin, cos or square root argument (NotDecided)."""
+
+    def __add__(self, o):
+        out = dict(self)
+        for k, c in _terms(o).items():
+            out[k] = out.get(k, 0) + c
+        return _surd(out)
+
+    def __mul__(self, o):
+        out: dict = {}
+        for (k, c), (m, d) in product(self.items(), _terms(o).items()):
+            root, kernel = _square_free(k * m)
+            out[kernel] = out.get(kernel, 0) + c * d * root
+        return _surd(out)
+
+    __radd__, __rmul__ = __add__, __mul__
+    __neg__ = lambda self: self * -1  # noqa: E731
+    __sub__ = lambda self, o: self + _surd(_terms(o)) * -1  # noqa: E731
+    __rsub__ = lambda self, o: self * -1 + o  # noqa: E731
+    __truediv__ = lambda self, o: self * (1 / _rational(o))  # noqa: E731
+    __rtruediv__ = lambda self, o: 1 / _rational(self)  # noqa: E731
+    __pow__ = lambda self, n: _rational(self) if n < 0 else (  # noqa: E731
+        self * self ** (n - 1) if n else Fraction(1))
+
+
+def _terms(x) -> dict:
+    if isinstance(x, _Surd):
+        return x
+    if isinstance(x, _Pi):
+        raise NotDecided("π beside a square root at an exact time")
+    return {1: Fraction(x)} if x else {}
+
+
+def _surd(terms: dict):
+    """The number Σ c_k·√k: a Fraction when it is rational, else a :class:`_Surd`."""
+    terms = {k: c for k, c in terms.items() if c}
+    if all(k == 1 for k in terms):
+        return terms.get(1, Fraction(0))
+    return _Surd(terms)
 
 
 class _Pi(tuple):
@@ -345,7 +391,7 @@ class _Pi(tuple):
 
 
 def _qp(x) -> tuple[Fraction, Fraction]:
-    return x if isinstance(x, _Pi) else (Fraction(x), Fraction(0))
+    return x if isinstance(x, _Pi) else (_rational(x), Fraction(0))
 
 
 def _pi(q: Fraction, p: Fraction):
@@ -370,7 +416,9 @@ def _exact_trig(x, quarter: int) -> Fraction:
 def _rational(x) -> Fraction:
     if isinstance(x, _Pi):
         raise NotDecided("π where a rational is needed, at an exact time")
-    return x
+    if isinstance(x, _Surd):
+        raise NotDecided("a square root where a rational is needed, at an exact time")
+    return Fraction(x)
 
 
 INTERVAL = {"num": Iv.q, "pi": lambda: PI, "sin": sin, "cos": cos, "sqrt": Iv.sqrt}
@@ -512,34 +560,50 @@ def _mq_poly(p: dict, values: list, ds: list) -> dict:
 
 def singular_at(robot: Robot, path: Path, t: Fraction, mode: str) -> bool:
     """Proven: at the rational time t the mode's branches are real and distinct and
-    det A = 0 exactly (the branches in Q(√D₀, …), D the legs' discriminants there)."""
-    pose = [_rational(value(tree, {**path.known, path.param: t}, EXACT))
+    det A = 0 exactly (the branches in Q(√D₀, …, √k₀, …), D the legs' discriminants
+    there, k the square roots in the pose itself: x = √2·t at t = 1)."""
+    pose = [value(tree, {**path.known, path.param: t}, EXACT)
             for tree in path.trees_on(Iv.q(t))]
-    if any(pose[j] for j in robot.angles):
+    if any(_rational(pose[j]) for j in robot.angles):
         raise NotDecided("sin or cos of a non-zero pose angle")
+    legs = len(robot.legs)
+    kernels = sorted({k for x in pose if isinstance(x, _Surd) for k in x if k != 1})
+    ds: list = [None] * legs + [Fraction(k) for k in kernels]  # the legs' D set below
+
+    def masked(x) -> dict:  # an exact pose value as Σ c·Π√dᵢ over the bits of ds
+        return {0 if k == 1 else 1 << (legs + kernels.index(k)): c
+                for k, c in _terms(x).items()}
+
     values: list = [{} for _ in range(3 * len(robot.joints))] + [
-        ({0: x} if x else {}) if i == 0 else {0: Fraction(1)} if i == 1 and j in robot.angles
+        masked(x) if i == 0 else {0: Fraction(1)} if i == 1 and j in robot.angles
         else {} for j, x in enumerate(pose) for i in range(3)]
-    point = [m.get(0, Fraction(0)) for m in values]
-    ds = []
+    at_pose = list(values)  # the legs' coefficients: polynomials of the pose alone
     for k, a, b, c, disc, _, kind in robot.legs:
-        av, bv, cv, d = (_mq_poly(p, [{0: x} for x in point], []).get(0, Fraction(0))
-                         for p in (a, b, c, disc))
+        av, bv, cv, d = (_mq_poly(p, at_pose, ds) for p in (a, b, c, disc))
+        av, d = _mq_rational(av), _mq_rational(d)
         s = 1 if mode[k] == "+" else -1
         if kind == "r" and d > 0:
+            bv = _mq_rational(bv)
             w = av * av + bv * bv
-            values[3 * k + 1] = {0: -av * cv / w, 1 << k: s * bv / w}
-            values[3 * k + 2] = {0: -bv * cv / w, 1 << k: -s * av / w}
+            values[3 * k + 1] = _mq_add(_mq_mul(cv, {0: -av / w}, ds), {1 << k: s * bv / w})
+            values[3 * k + 2] = _mq_add(_mq_mul(cv, {0: -bv / w}, ds), {1 << k: -s * av / w})
         elif kind == "p" and a and d > 0 and av != 0:
-            values[3 * k] = {0: -bv / (2 * av), 1 << k: s / (2 * av)}
-        elif kind == "p" and not a and bv != 0:
-            values[3 * k], d = {0: -cv / bv}, Fraction(1)
+            values[3 * k] = _mq_add(_mq_mul(bv, {0: -1 / (2 * av)}, ds), {1 << k: s / (2 * av)})
+        elif kind == "p" and not a and _mq_rational(bv) != 0:
+            values[3 * k], d = _mq_mul(cv, {0: -1 / _mq_rational(bv)}, ds), Fraction(1)
         else:
             return False
-        ds.append(d)
+        ds[k] = d
     total = det([[_mq_poly(p, values, ds) for p in leg[5]] for leg in robot.legs],
                 lambda x, y: _mq_mul(x, y, ds), _mq_add)
     return _is_zero(total, ds)
+
+
+def _mq_rational(x: dict) -> Fraction:
+    """Σ c·Π√dᵢ when rational (a leg's coefficient or discriminant), else NotDecided."""
+    if any(m and c for m, c in x.items()):
+        raise NotDecided("a leg's coefficient is irrational at an exact pose")
+    return Fraction(x.get(0, 0))
 
 
 def _is_zero(value: dict, ds: list) -> bool:

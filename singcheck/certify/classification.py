@@ -474,7 +474,7 @@ def _exactly_on_windows(path: PathModel, modes: list[WorkingMode], tolerance: fl
         if left is not None and remaining() <= 0:
             raise  # the trajectory's own time limit
     return _certify_exactly(path, modes, tolerance, searches,
-                            window_ranges(path.trajectory.range, searches))
+                            window_ranges(path.trajectory.range, searches), seconds)
 
 
 def _exactly_within(path: PathModel, modes: list[WorkingMode], searches: dict,
@@ -551,19 +551,20 @@ def replace_path(path: PathModel, why: str) -> PathModel:
 
 
 def _certify_exactly(path: PathModel, modes: list[WorkingMode], tolerance: float,
-                     searches: dict | None = None,
-                     windows: list | None = None) -> TrajectoryReport:
+                     searches: dict | None = None, windows: list | None = None,
+                     whole_range_seconds: float = 0.0) -> TrajectoryReport:
     """The exact engine's verdict (μ's certified roots, classified per mode), held against
     the interval engine's (``searches`` when it has run already).  ``windows``: the
-    ranges of t (:func:`.windows.window_ranges`) to which μ is restricted (None: the
-    whole range); outside them the verdict rests on the intervals' proof."""
+    ranges of t (:func:`.windows.window_ranges`) to which μ is restricted, after the
+    whole range took more than ``whole_range_seconds`` (None: the whole range); outside
+    them the verdict rests on the intervals' proof."""
     def isolate(rng):
         return isolate_real_roots(path.mu, rng, tolerance, vanishes_at_root)
 
     try:
         isolation = isolate(path.trajectory.range) if windows is None else \
             isolate_on_windows(isolate, windows, WINDOWS_ONLY.format(
-                count=len(windows), seconds=EXACT_WHOLE_RANGE_SECONDS))
+                count=len(windows), seconds=whole_range_seconds))
     except IdenticallyZeroError:
         return _certify_on_surface(path, modes, tolerance, searches)
     candidates = _classify_all(path, modes, isolation.roots, tolerance)

@@ -462,17 +462,14 @@ def _exactly_on_windows(path: PathModel, modes: list[WorkingMode], tolerance: fl
     """The exact engine where the interval engine left windows: μ on the whole range
     within :data:`EXACT_WHOLE_RANGE_SECONDS` (or half the time left, if less); past
     that, μ restricted to the windows, with the rest of the time."""
-    from singcheck.budget import TimeLimitExceeded, deadline, remaining
+    from singcheck.budget import remaining
 
     left = remaining()
     seconds = EXACT_WHOLE_RANGE_SECONDS if left is None else \
         min(EXACT_WHOLE_RANGE_SECONDS, left / 2)
-    try:
-        with deadline(seconds):
-            return _certify_exactly(path, modes, tolerance, searches)
-    except TimeLimitExceeded:
-        if left is not None and remaining() <= 0:
-            raise  # the trajectory's own time limit
+    report, _ = _exactly_within(path, modes, searches, tolerance, seconds)
+    if report is not None:
+        return report
     return _certify_exactly(path, modes, tolerance, searches,
                             window_ranges(path.trajectory.range, searches), seconds)
 

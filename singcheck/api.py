@@ -19,6 +19,7 @@ same :class:`Robot` runs no CAS and reads no cache entry.
 from __future__ import annotations
 
 import signal
+from collections import deque
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -565,6 +566,8 @@ class _TaskSizes:
         self.most = max(self.first, MAX_CHUNK if most is None else most)
         self.seconds = TASK_SECONDS if seconds is None else seconds
         self.least = least
+        self.ahead: deque = deque()  # read by :meth:`take`, not in a task yet
+        self.ended = False  # the input has ended
 
     def finished(self, count: int) -> None:
         self.done += count
@@ -579,6 +582,20 @@ class _TaskSizes:
         if left is not None:
             size = min(size, max(self.least, -(-left // (2 * self.workers))))
         return size
+
+    def take(self, items: Iterator) -> list:
+        """The next task's trajectories from ``items`` (empty once all are taken), read
+        two tasks ahead to know, near the end, what is left."""
+        from itertools import islice
+
+        size = self.next()
+        while not self.ended and len(self.ahead) < 2 * size:
+            more = list(islice(items, 2 * size - len(self.ahead)))
+            self.ahead.extend(more)
+            self.ended = not more
+        if self.ended:
+            size = self.next(len(self.ahead))
+        return [self.ahead.popleft() for _ in range(min(size, len(self.ahead)))]
 
 
 def shared_regions(robot: Robot, head: list, options: dict, notify: Notify = _quiet) -> None:
@@ -657,7 +674,6 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
     from collections import deque
     from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
     from concurrent.futures.process import BrokenProcessPool
-    from itertools import islice
 
     from singcheck.algebra.pickling import register
     from singcheck.elimination.cas.guard import ready_to_fork
@@ -676,8 +692,6 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
     lost: deque = deque()  # (first index, trajectories) of tasks whose worker died
     read = 0
     sizes = _TaskSizes(jobs)
-    ahead: deque = deque()  # read, not sent yet (to know, near the end, what is left)
-    ended = False
 
     def send(chunk: list):
         nonlocal pool
@@ -693,15 +707,8 @@ def _forked(robot, items: Iterator, options, jobs: int, ordered: bool,
                 return pool.submit(_check_chunk, chunk)
 
     def submit() -> bool:
-        nonlocal read, ended
-        size = sizes.next()
-        while not ended and len(ahead) < 2 * size:
-            more = list(islice(items, 2 * size - len(ahead)))
-            ahead.extend(more)
-            ended = not more
-        if ended:
-            size = sizes.next(len(ahead))
-        chunk = [ahead.popleft() for _ in range(min(size, len(ahead)))]
+        nonlocal read
+        chunk = sizes.take(items)
         if chunk:
             in_flight[send(chunk)] = (read, chunk)
             read += len(chunk)

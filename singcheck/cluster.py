@@ -283,23 +283,19 @@ class _Submitter:
     """Submits the tasks a window at a time (``window`` in flight), so that neither this
     process nor the scheduler holds a task per trajectory of a long batch at once.
 
-    Each task's size is ``sizes.next()`` (:class:`singcheck.api._TaskSizes`: small at
-    first, then what takes about TASK_SECONDS at the pace seen); it reads two tasks
-    ahead, so that once the input has ended the last trajectories go in smaller and
+    Each task is ``sizes.take(items)`` (:class:`singcheck.api._TaskSizes`: small at
+    first, then what takes about TASK_SECONDS at the pace seen), read two tasks ahead,
+    so that once the input has ended the last trajectories go in smaller and
     smaller tasks (a share of what is left per worker thread, at least TAIL), and the
     batch does not end with one worker on a whole task while the others wait."""
 
     def __init__(self, client, shipped, items: Iterator, options, region_cache: bool,
                  window: int, sizes: _TaskSizes, line=None) -> None:
-        from collections import deque
-
         from distributed import as_completed
 
         self.client, self.shipped, self.options, self.line = client, shipped, options, line
         self.region_cache = region_cache
         self.items, self.sizes = items, sizes
-        self.ahead: deque = deque()  # read, not submitted yet
-        self.ended = False
         self.read = 0
         self.batch = uuid.uuid4().hex[:12]
         self.chunks: dict[str, tuple[int, list]] = {}  # key -> (first index, trajectories)
@@ -309,17 +305,9 @@ class _Submitter:
 
     def next(self) -> None:
         """Submit the next few trajectories as one task, if any is left."""
-        size = self.sizes.next()
-        while not self.ended and len(self.ahead) < 2 * size:
-            item = next(self.items, _END)
-            if item is _END:
-                self.ended = True
-            else:
-                self.ahead.append(item)
-        if not self.ahead:
+        chunk = self.sizes.take(self.items)
+        if not chunk:
             return
-        count = self.sizes.next(len(self.ahead)) if self.ended else size
-        chunk = [self.ahead.popleft() for _ in range(min(count, len(self.ahead)))]
         chunk = [item.loaded() if isinstance(item, Span) else item for item in chunk]
         future = self.client.submit(_remote_check, self.shipped, chunk, self.options,
                                     self.region_cache, self.line,
@@ -327,9 +315,6 @@ class _Submitter:
         self.chunks[future.key] = (self.read, chunk)
         self.read += len(chunk)
         self.completed.add(future)
-
-
-_END = object()
 
 
 def _results(tasks: _Submitter, ordered: bool) -> Iterator[dict]:

@@ -1225,7 +1225,7 @@ def test_dask_tasks_start_small_grow_with_the_pace_and_share_the_end(monkeypatch
     sizes.finished(32)  # 2 threads, 4 ms a path: a task of 0.5 s holds 125
     tasks.next()
     assert client.sizes[-1] == min(cluster.CHUNK, 125)
-    while tasks.ahead or not tasks.ended:
+    while sizes.ahead or not sizes.ended:
         tasks.next()
     assert sum(client.sizes) == 1000
     tail = client.sizes[9:]

@@ -345,7 +345,7 @@ class _Surd(dict):
 
     __radd__, __rmul__ = __add__, __mul__
     __neg__ = lambda self: self * -1  # noqa: E731
-    __sub__ = lambda self, o: self + _surd(_terms(o)) * -1  # noqa: E731
+    __sub__ = lambda self, o: self + -o  # noqa: E731
     __rsub__ = lambda self, o: self * -1 + o  # noqa: E731
     __truediv__ = lambda self, o: self * (1 / _rational(o))  # noqa: E731
     __rtruediv__ = lambda self, o: 1 / _rational(self)  # noqa: E731
